@@ -1,0 +1,1 @@
+"""bench: matrix harness, refinement loop, marking, result store and CLI (``python -m bench``)."""

@@ -1,0 +1,144 @@
+"""Command line: ``python -m bench run|list``."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+import pandas as pd
+
+from bench.loop import STRATEGIES, LevelResult, LoopConfig
+from bench.marking import MARKINGS
+from bench.matrix import run_matrix
+from bench.store import ResultStore
+from estimators import estimator_descriptions, estimator_names
+from formulations import (
+    formulation_descriptions,
+    formulation_names,
+    solver_descriptions,
+    solver_names,
+)
+from scenes import scene_descriptions, scene_names
+
+SUMMARY_COLUMNS = ["level", "ndofs", "energy", "contact_force", "active_constraints", "eta",
+                   "eta_0", "eta_geometric", "eta_complementarity", "max_h_over_H",
+                   "iterations", "t_solve", "status"]
+
+
+def _names(kind: str, valid: list[str]):
+    def parse(text: str) -> list[str]:
+        names = [name.strip() for name in text.split(",") if name.strip()]
+        unknown = [name for name in names if name not in valid]
+        if not names or unknown:
+            raise argparse.ArgumentTypeError(
+                f"unknown {kind} {', '.join(map(repr, unknown)) or repr(text)}; "
+                f"valid {kind}s: {', '.join(valid)}")
+        return names
+    return parse
+
+
+def _positive_int(name: str):
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            value = None
+        if value is None or value <= 0:
+            raise argparse.ArgumentTypeError(f"{name}={text!r} is not a positive integer")
+        return value
+    return parse
+
+
+def _theta(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not 0.0 < value <= 1.0:
+        raise argparse.ArgumentTypeError(f"theta={text!r} is not a number in (0, 1]")
+    return value
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="python -m bench",
+        description="signorini-bench: compare formulations and a posteriori error estimators "
+                    "for Signorini's contact problem.")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    run = sub.add_parser("run", help="run solve -> estimate -> mark -> refine sequences and "
+                         "write results.parquet and results.csv",
+                         description="Run every combination of the given comma-separated "
+                         "lists and write one row per level to OUT/results.{parquet,csv}.")
+    run.add_argument("--scene", type=_names("scene", scene_names()), default=["paper"],
+                     help=f"scene(s), comma-separated; one of: {', '.join(scene_names())} "
+                          "(default: paper)")
+    run.add_argument("--formulation", type=_names("formulation", formulation_names()),
+                     default=["mixed"], help="formulation(s): "
+                     f"{', '.join(formulation_names())} (default: mixed)")
+    run.add_argument("--solver", type=_names("solver", solver_names()), default=["reference"],
+                     help=f"solver(s): {', '.join(solver_names())} (default: reference)")
+    run.add_argument("--estimator", type=_names("estimator", estimator_names()),
+                     default=["residual"],
+                     help=f"estimator(s): {', '.join(estimator_names())} (default: residual)")
+    run.add_argument("--strategy", type=_names("strategy", list(STRATEGIES)),
+                     default=["adaptive"],
+                     help="refinement strategy(ies): uniform, adaptive (default: adaptive)")
+    run.add_argument("--max-dofs", type=_positive_int("max_dofs"), default=20000,
+                     help="DOF budget: stop before a level with more unknowns (default: 20000)")
+    run.add_argument("--max-levels", type=_positive_int("max_levels"), default=40,
+                     help="maximum number of levels (default: 40)")
+    run.add_argument("--marking", choices=MARKINGS, default="doerfler",
+                     help="adaptive marking: doerfler (bulk) or maximum (default: doerfler)")
+    run.add_argument("--theta", type=_theta, default=0.5,
+                     help="marking parameter in (0, 1] (default: 0.5)")
+    run.add_argument("--out", default="results",
+                     help="output folder for results.parquet and results.csv (default: results)")
+    run.add_argument("--overwrite", action="store_true",
+                     help="delete earlier results in OUT first (default: keep and append)")
+    sub.add_parser("list", help="list registered scenes, formulations, solvers, estimators",
+                   description="List everything registered, with one line of description.")
+    return parser
+
+
+def _progress(result: LevelResult) -> None:
+    r = result.row
+    t = sum(x for x in (r.t_assemble, r.t_solve, r.t_estimate, r.t_refine) if x == x)
+    print(f"{r.scene}/{r.formulation}/{r.solver}/{r.estimator}/{r.strategy} "
+          f"level {r.level:2d}  ndofs {r.ndofs:8d}  eta {r.eta:11.5e}  time {t:7.2f} s  "
+          f"{r.status}{' (' + r.reason + ')' if r.reason else ''}", flush=True)
+
+
+def summary(table: pd.DataFrame) -> str:
+    parts = []
+    keys = ["scene", "formulation", "solver", "estimator", "strategy"]
+    for key, group in table.groupby(keys, sort=False):
+        parts.append("== " + " / ".join(map(str, key)))
+        parts.append(group[SUMMARY_COLUMNS].to_string(index=False, float_format="{:.6g}".format))
+    return "\n".join(parts)
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    if args.command == "list":
+        for title, items in (("scenes", scene_descriptions()),
+                             ("formulations", formulation_descriptions()),
+                             ("solvers", solver_descriptions()),
+                             ("estimators", estimator_descriptions())):
+            print(f"{title}:")
+            for name, text in items.items():
+                print(f"  {name:12s} {text}")
+        return 0
+    config = LoopConfig(max_dofs=args.max_dofs, max_levels=args.max_levels,
+                        marking=args.marking, theta=args.theta)
+    store = ResultStore(args.out, overwrite=args.overwrite)
+    rows = run_matrix(args.scene, args.formulation, args.solver, args.estimator, args.strategy,
+                      store, config, on_level=_progress)
+    print()
+    print(summary(store.run_table()))
+    print(f"\nwrote {len(rows)} rows to {store.parquet} and {store.csv}")
+    failed = [r for r in rows if r.status == "failed"]
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,109 @@
+"""The refinement loop solve -> estimate -> mark -> refine, one result row per level."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+
+import numpy as np
+from skfem import MeshTri
+
+from bench.marking import mark
+from bench.rows import ResultRow
+from estimators import get_estimator
+from formulations import STATUS_FAILED, get_formulation, solve
+from scenes import Scene
+
+STRATEGIES = ("uniform", "adaptive")
+
+
+@dataclass(frozen=True)
+class LoopConfig:
+    """How a refinement sequence is run; validated on construction."""
+
+    strategy: str = "adaptive"
+    max_dofs: int = 20000
+    max_levels: int = 40
+    marking: str = "doerfler"
+    theta: float = 0.5
+
+    def __post_init__(self):
+        if self.strategy not in STRATEGIES:
+            raise ValueError(f"strategy={self.strategy!r} is not one of {', '.join(STRATEGIES)}")
+        if not (isinstance(self.max_dofs, int) and self.max_dofs > 0):
+            raise ValueError(f"max_dofs={self.max_dofs!r} is not a positive integer")
+        if not (isinstance(self.max_levels, int) and self.max_levels > 0):
+            raise ValueError(f"max_levels={self.max_levels!r} is not a positive integer")
+        if self.marking not in ("doerfler", "maximum"):
+            raise ValueError(f"marking={self.marking!r} is not one of doerfler, maximum")
+        if not 0.0 < self.theta <= 1.0:
+            raise ValueError(f"theta={self.theta!r} is not in (0, 1]")
+
+
+@dataclass(frozen=True, eq=False)
+class LevelResult:
+    """Everything one level produced: the row and the objects behind it (for plots, tests)."""
+
+    row: ResultRow
+    solution: object | None
+    estimate: object | None
+
+
+def element_diameters(mesh: MeshTri) -> np.ndarray:
+    p = mesh.p[:, mesh.t]
+    return np.max([np.linalg.norm(p[:, i] - p[:, (i + 1) % 3], axis=0) for i in range(3)], axis=0)
+
+
+def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
+                 config: LoopConfig, identity: dict | None = None,
+                 mesh: MeshTri | None = None) -> Iterator[LevelResult]:
+    """Yield one ``LevelResult`` per level until the DOF budget or the level count is reached,
+    or a level fails (its row says why)."""
+    discretise, estimate = get_formulation(formulation), get_estimator(estimator)
+    ident = dict(scene=scene.name, formulation=formulation, solver=solver, estimator=estimator,
+                 strategy=config.strategy, marking=config.marking, theta=config.theta,
+                 **(identity or {}))
+    mesh = scene.mesh if mesh is None else mesh
+    t_refine = 0.0
+    for level in range(config.max_levels):
+        start = time.perf_counter()
+        disc = discretise(scene, mesh)
+        t_assemble = time.perf_counter() - start
+        if level > 0 and disc.ndofs > config.max_dofs:
+            return
+        sol = solve(disc, solver)
+        start = time.perf_counter()
+        est = estimate(scene, sol) if sol.status != STATUS_FAILED else None
+        t_estimate = time.perf_counter() - start if est is not None else float("nan")
+        h = element_diameters(mesh)
+        numbers = dict(
+            level=level, ndofs=disc.ndofs, n_elements=mesh.t.shape[1], h_max=float(h.max()),
+            h_min=float(h.min()), max_h_over_H=sol.max_h_over_H, energy=sol.energy,
+            contact_force=sol.contact_force(), active_constraints=sol.active_constraints,
+            n_constraints=disc.qp.m, iterations=sol.iterations, t_assemble=t_assemble,
+            t_solve=sol.solve_time, t_estimate=t_estimate, t_refine=t_refine,
+            status=sol.status, reason=sol.reason, **vars(sol.residuals))
+        if est is not None:
+            numbers.update(eta=est.eta, eta_0=est.eta_0, eta_geometric=est.eta_geometric,
+                           eta_complementarity=est.eta_complementarity)
+        yield LevelResult(ResultRow(**ident, **numbers), sol, est)
+        if sol.status == STATUS_FAILED:
+            return
+        start = time.perf_counter()
+        if config.strategy == "uniform":
+            refined = mesh.refined()
+        else:
+            refined = mesh.refined(mark(est.indicators, config.marking, config.theta))
+        t_refine = time.perf_counter() - start
+        mesh = refined
+
+
+def run_to_rows(*args, on_level: Callable[[LevelResult], None] | None = None,
+                **kwargs) -> list[ResultRow]:
+    rows = []
+    for result in run_sequence(*args, **kwargs):
+        rows.append(result.row)
+        if on_level is not None:
+            on_level(result)
+    return rows

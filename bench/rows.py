@@ -1,0 +1,57 @@
+"""One result row per (scene, formulation, solver, estimator, strategy, level).
+
+Column names are a public interface (see the README's table of columns and units): add new
+columns, never rename.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, fields
+
+
+@dataclass(frozen=True)
+class ResultRow:
+    scene: str
+    formulation: str
+    solver: str
+    estimator: str
+    strategy: str
+    level: int
+    ndofs: int = 0
+    n_elements: int = 0
+    h_max: float = math.nan
+    h_min: float = math.nan
+    max_h_over_H: float = math.nan
+    energy: float = math.nan
+    contact_force: float = math.nan
+    active_constraints: int = 0
+    n_constraints: int = 0
+    eta: float = math.nan
+    eta_0: float = math.nan
+    eta_geometric: float = math.nan
+    eta_complementarity: float = math.nan
+    violation: float = math.nan
+    dual_violation: float = math.nan
+    complementarity: float = math.nan
+    stationarity: float = math.nan
+    iterations: int = 0
+    t_assemble: float = math.nan
+    t_solve: float = math.nan
+    t_estimate: float = math.nan
+    t_refine: float = math.nan
+    status: str = ""
+    reason: str = ""
+    marking: str = ""
+    theta: float = math.nan
+    run_id: str = ""
+    commit: str = ""
+    python: str = ""
+    versions: str = ""
+    machine: str = ""
+
+    def as_dict(self) -> dict:
+        return asdict(self)
+
+
+COLUMNS = [f.name for f in fields(ResultRow)]

@@ -1,0 +1,18 @@
+"""Estimators: how the error of a discrete solution is estimated (DESIGN.md section 4).
+
+Importing this package registers every estimator module listed below; adding an estimator is one
+new module with a ``@register_estimator`` ``estimate(scene, solution)`` function and one import
+line here.
+"""
+
+from estimators import residual  # noqa: F401  (registers "residual")
+from estimators.base import (
+    Estimate,
+    estimator_descriptions,
+    estimator_names,
+    get_estimator,
+    register_estimator,
+)
+
+__all__ = ["Estimate", "estimator_descriptions", "estimator_names", "get_estimator",
+           "register_estimator"]

@@ -1,0 +1,34 @@
+"""The estimate of one discrete solution (DESIGN.md section 4)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from scenes.registry import Registry
+
+
+@dataclass(frozen=True, eq=False)
+class Estimate:
+    """Global estimate and per-element indicators.
+
+    eta^2 = eta_0^2 + eta_geometric^2 + eta_complementarity^2 (the paper's (8)), where
+    eta_geometric = ||(g - u_hn)_-||_{1/2,Gamma_C} and
+    eta_complementarity = |(lambda_h, (g - u_hn)_-)_{0,Gamma_C}|^{1/2}.
+    ``indicators`` are squared element contributions; they sum to eta^2.
+    """
+
+    estimator: str
+    eta: float
+    eta_0: float
+    eta_geometric: float
+    eta_complementarity: float
+    indicators: np.ndarray
+
+
+ESTIMATORS = Registry("estimator")
+register_estimator = ESTIMATORS.register
+estimator_names = ESTIMATORS.names
+estimator_descriptions = ESTIMATORS.descriptions
+get_estimator = ESTIMATORS.get

@@ -1,0 +1,25 @@
+"""Formulations: how a scene is discretised and solved (DESIGN.md section 3).
+
+Importing this package registers every formulation module listed below; adding a formulation is
+one new module with a ``@register_formulation`` ``discretise`` function and one import line here.
+"""
+
+from formulations import mixed  # noqa: F401  (registers "mixed")
+from formulations.base import (
+    STATUS_FAILED,
+    STATUS_INACCURATE,
+    STATUS_OK,
+    STATUS_SKIPPED,
+    ContactQP,
+    DiscreteSolution,
+    QPSolution,
+    Residuals,
+)
+from formulations.discretisation import Discretisation, solve
+from formulations.registry import formulation_descriptions, formulation_names, get_formulation
+from formulations.solvers import get_solver, solver_descriptions, solver_names
+
+__all__ = ["STATUS_FAILED", "STATUS_INACCURATE", "STATUS_OK", "STATUS_SKIPPED", "ContactQP",
+           "DiscreteSolution", "Discretisation", "QPSolution", "Residuals",
+           "formulation_descriptions", "formulation_names", "get_formulation", "get_solver",
+           "solve", "solver_descriptions", "solver_names"]

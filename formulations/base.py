@@ -1,0 +1,108 @@
+"""Data passed between formulations, solvers and estimators (DESIGN.md section 3).
+
+* ``ContactQP``: the discrete problem min 1/2 u'Ku - F'u s.t. Bu <= G over the free DOFs.
+* ``QPSolution``: what a solver returns (arrays plus the solver's own status).
+* ``DiscreteSolution``: u_h and lambda_h on Gamma_C with residuals computed from the arrays,
+  the same object for every formulation so that estimators never branch on its name.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy import sparse
+
+from formulations.contact import ContactTrace, gauss_legendre
+from formulations.elasticity import Elasticity
+
+STATUS_OK, STATUS_INACCURATE, STATUS_FAILED = "ok", "inaccurate", "failed"
+STATUS_SKIPPED = "skipped"
+
+
+@dataclass(frozen=True, eq=False)
+class ContactQP:
+    """min 1/2 u'Ku - F'u  s.t.  B u <= G, over the free DOFs.
+
+    ``row_scale`` (> 0, one per constraint) and ``objective_scale`` (> 0) are the natural units
+    of the rows of B (a length) and of K (Young's modulus); solvers divide by them so that the
+    scaled problem is O(1), and multiply the multipliers back.
+    """
+
+    K: sparse.csr_matrix
+    F: np.ndarray
+    B: sparse.csr_matrix
+    G: np.ndarray
+    row_scale: np.ndarray
+    objective_scale: float
+
+    @property
+    def n(self) -> int:
+        return int(self.F.size)
+
+    @property
+    def m(self) -> int:
+        return int(self.G.size)
+
+
+@dataclass(frozen=True, eq=False)
+class QPSolution:
+    """A solver's answer: primal u (free DOFs), multipliers of Bu <= G, and its own report."""
+
+    u: np.ndarray | None
+    multipliers: np.ndarray | None
+    status: str
+    reason: str
+    iterations: int
+    solve_time: float
+    solver: str
+
+
+@dataclass(frozen=True)
+class Residuals:
+    """KKT residuals computed from the returned arrays (see ``formulations.kkt``)."""
+
+    violation: float
+    dual_violation: float
+    complementarity: float
+    stationarity: float
+
+
+@dataclass(frozen=True, eq=False)
+class DiscreteSolution:
+    """u_h and the discrete contact pressure lambda_h >= 0 on Gamma_C.
+
+    ``pressure(t)`` returns lambda_h at local coordinates t in [0, 1] of every contact facet of
+    ``trace`` (shape (n_facets, len(t))). ``multiplier_breaks`` are the end points (in the scene's
+    contact coordinate) of the pieces lambda_h is defined on.
+    """
+
+    formulation: str
+    solver: str
+    elasticity: Elasticity
+    trace: ContactTrace
+    u: np.ndarray
+    pressure: Callable[[np.ndarray], np.ndarray]
+    multiplier_breaks: np.ndarray
+    residuals: Residuals
+    status: str
+    reason: str
+    iterations: int
+    solve_time: float
+    active_constraints: int
+    max_h_over_H: float = float("nan")
+    extra: dict = field(default_factory=dict)
+
+    @property
+    def ok(self) -> bool:
+        return self.status == STATUS_OK
+
+    @property
+    def energy(self) -> float:
+        return self.elasticity.energy(self.u)
+
+    def contact_force(self, quadrature_points: int = 4) -> float:
+        """The integral of lambda_h over Gamma_C."""
+        t, w = gauss_legendre(quadrature_points)
+        return float(self.trace.integrate(self.pressure(t), w).sum())

@@ -1,0 +1,86 @@
+"""The contact boundary Gamma_C of one mesh: facets in order, normals, quadrature.
+
+Facets are sorted by the scene's ``contact_coordinate`` and oriented so that ``start`` has the
+smaller coordinate. Normals are OUTER unit normals (DESIGN.md section 1).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from skfem import MeshTri
+
+from scenes import Scene
+
+
+def gauss_legendre(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """n-point Gauss-Legendre rule on [0, 1]: points t and weights w (sum w = 1)."""
+    x, w = np.polynomial.legendre.leggauss(n)
+    return 0.5 * (x + 1.0), 0.5 * w
+
+
+@dataclass(frozen=True, eq=False)
+class ContactTrace:
+    """Contact facets of ``mesh`` ordered along Gamma_C.
+
+    ``vertices`` (2, n) are the mesh vertices at the start and end of each facet, ``normal``
+    (2, n) the outer unit normal, ``length`` (n,) the facet lengths, ``coordinate`` (2, n) the
+    scene coordinate of start and end, ``element`` (n,) the element each facet belongs to.
+    """
+
+    mesh: MeshTri
+    facets: np.ndarray
+    vertices: np.ndarray
+    normal: np.ndarray
+    length: np.ndarray
+    coordinate: np.ndarray
+    element: np.ndarray
+
+    @property
+    def size(self) -> int:
+        return int(self.facets.size)
+
+    def points(self, t: np.ndarray) -> np.ndarray:
+        """Points at local coordinates t in [0, 1] on each facet; shape (2, n, len(t))."""
+        a = self.mesh.p[:, self.vertices[0]][:, :, None]
+        b = self.mesh.p[:, self.vertices[1]][:, :, None]
+        return a + (b - a) * t[None, None, :]
+
+    def normal_displacement(self, u_nodal: np.ndarray, t: np.ndarray) -> np.ndarray:
+        """u_h . n at local coordinates t (P1: linear along each facet); shape (n, len(t))."""
+        ua = np.einsum("in,in->n", u_nodal[:, self.vertices[0]], self.normal)
+        ub = np.einsum("in,in->n", u_nodal[:, self.vertices[1]], self.normal)
+        return ua[:, None] + (ub - ua)[:, None] * t[None, :]
+
+    def integrate(self, values: np.ndarray, w: np.ndarray) -> np.ndarray:
+        """Per-facet integrals of ``values`` (n, nq) given at points with weights w on [0, 1]."""
+        return (values * w[None, :]).sum(axis=1) * self.length
+
+
+def outer_normals(mesh: MeshTri, v0: np.ndarray, v1: np.ndarray, element: np.ndarray):
+    """Lengths and outer unit normals of boundary facets (v0, v1) of the given elements."""
+    a, b = mesh.p[:, v0], mesh.p[:, v1]
+    length = np.linalg.norm(b - a, axis=0)
+    normal = np.array([b[1] - a[1], a[0] - b[0]]) / length
+    centroid = mesh.p[:, mesh.t[:, element]].mean(axis=1)
+    inward = np.einsum("in,in->n", normal, centroid - 0.5 * (a + b)) > 0
+    normal[:, inward] *= -1.0
+    return length, normal
+
+
+def contact_trace(scene: Scene, mesh: MeshTri) -> ContactTrace:
+    facets = scene.contact_facets(mesh)
+    v0, v1 = mesh.facets[0, facets], mesh.facets[1, facets]
+    s0 = scene.contact_coordinate(mesh.p[:, v0])
+    s1 = scene.contact_coordinate(mesh.p[:, v1])
+    swap = s1 < s0
+    v0, v1 = np.where(swap, v1, v0), np.where(swap, v0, v1)
+    s0, s1 = np.minimum(s0, s1), np.maximum(s0, s1)
+    order = np.argsort(s0, kind="stable")
+    facets, v0, v1, s0, s1 = facets[order], v0[order], v1[order], s0[order], s1[order]
+
+    element = mesh.f2t[0, facets]
+    length, normal = outer_normals(mesh, v0, v1, element)
+    return ContactTrace(mesh=mesh, facets=facets, vertices=np.array([v0, v1]), normal=normal,
+                        length=length, coordinate=np.array([s0, s1]), element=element)

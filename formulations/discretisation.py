@@ -1,0 +1,48 @@
+"""A formulation's discrete problem on one mesh and the generic solve step."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from formulations.base import STATUS_FAILED, ContactQP, DiscreteSolution, QPSolution, Residuals
+from formulations.contact import ContactTrace
+from formulations.elasticity import Elasticity
+from formulations.kkt import judge, qp_residuals
+from formulations.solvers import get_solver
+
+
+@dataclass(frozen=True, eq=False)
+class Discretisation:
+    """What a formulation's ``discretise`` returns: the assembled QP on the free DOFs and how to
+    turn a solver's answer into a ``DiscreteSolution`` (``recover(qp_solution, residuals,
+    status, reason)``)."""
+
+    formulation: str
+    elasticity: Elasticity
+    trace: ContactTrace
+    qp: ContactQP
+    recover: Callable[[QPSolution, Residuals, str, str], DiscreteSolution]
+
+    @property
+    def ndofs(self) -> int:
+        return self.elasticity.ndofs
+
+
+def solve(discretisation: Discretisation, solver: str, **options) -> DiscreteSolution:
+    """Solve with the named solver, compute the KKT residuals from the returned arrays, and
+    judge the result. A failed solve carries status ``failed`` and NaN arrays (never silently)."""
+    answer = get_solver(solver)(discretisation.qp, **options)
+    if answer.u is None or answer.multipliers is None:
+        nan = np.full(discretisation.qp.n, np.nan)
+        answer = QPSolution(nan, np.full(discretisation.qp.m, np.nan), answer.status or
+                            STATUS_FAILED, answer.reason, answer.iterations, answer.solve_time,
+                            answer.solver)
+        residuals = Residuals(*(4 * [float("nan")]))
+        status, reason = judge(answer, None)
+    else:
+        residuals = qp_residuals(discretisation.qp, answer.u, answer.multipliers)
+        status, reason = judge(answer, residuals)
+    return discretisation.recover(answer, residuals, status, reason)

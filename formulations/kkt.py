@@ -1,0 +1,86 @@
+"""KKT residuals of ``min 1/2 u'Ku - F'u s.t. Bu <= G`` computed from the returned arrays.
+
+We never trust a solver's own claim of optimality (qpsolvers' idea): every residual is computed
+here from u and lambda, each relative to a stated scale:
+
+* ``violation``: max_i (Bu - G)_i^+ / row_scale_i (a mean penetration, a length) relative to
+  the displacement scale max(max |u|, max |G_i / row_scale_i|);
+* ``dual_violation``: max(-lambda)^+ relative to max |lambda| (the raw multipliers, before any
+  clipping to lambda >= 0);
+* ``complementarity``: |lambda'(Bu - G)| relative to the energy scale
+  max(u'Ku, objective_scale * displacement_scale^2);
+* ``stationarity``: ||Ku - F + B'lambda||_2 relative to the force scale
+  max(||Ku||, ||F||, ||B'lambda||, max diag(K) * displacement_scale).
+
+The floors built from the displacement scale keep the residuals meaningful when the solution
+is (nearly) zero, e.g. when nothing touches; a scale that still vanishes is replaced by 1.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from formulations.base import (
+    STATUS_FAILED,
+    STATUS_INACCURATE,
+    STATUS_OK,
+    ContactQP,
+    QPSolution,
+    Residuals,
+)
+
+# A converged reference solve (Clarabel, tolerances 1e-9) gives residuals around 1e-9..1e-7
+# relative; a solution worse than this is not an answer we report as "ok".
+RESIDUAL_TOLERANCE = 1e-6
+
+
+def _scale(*values: float) -> float:
+    s = max(float(v) for v in values)
+    return s if s > 0 and np.isfinite(s) else 1.0
+
+
+def qp_residuals(qp: ContactQP, u: np.ndarray, multipliers: np.ndarray) -> Residuals:
+    Ku = qp.K @ u
+    gap = qp.B @ u - qp.G
+    lam = np.maximum(multipliers, 0.0)
+    BTl = qp.B.T @ lam
+    u_scale = _scale(np.abs(u).max(initial=0.0), np.abs(qp.G / qp.row_scale).max(initial=0.0))
+    return Residuals(
+        violation=float(np.maximum(gap / qp.row_scale, 0.0).max(initial=0.0) / u_scale),
+        dual_violation=float(np.maximum(-multipliers, 0.0).max(initial=0.0)
+                             / _scale(np.abs(multipliers).max(initial=0.0))),
+        complementarity=float(abs(lam @ gap) / _scale(u @ Ku, qp.objective_scale * u_scale**2)),
+        stationarity=float(np.linalg.norm(Ku - qp.F + BTl)
+                           / _scale(np.linalg.norm(Ku), np.linalg.norm(qp.F), np.linalg.norm(BTl),
+                                    np.abs(qp.K.diagonal()).max(initial=0.0) * u_scale)),
+    )
+
+
+def judge(solution: QPSolution, residuals: Residuals | None) -> tuple[str, str]:
+    """Final (status, reason): the solver's verdict, overruled by residuals that are too large."""
+    if solution.status != STATUS_OK or residuals is None:
+        return (solution.status if solution.status != STATUS_OK else STATUS_FAILED,
+                solution.reason or "solver returned no solution")
+    if not all(np.isfinite(v) for v in vars(residuals).values()):
+        return STATUS_FAILED, "non-finite residual (NaN or inf in the returned arrays)"
+    too_large = [f"{k}={v:.2e}" for k, v in vars(residuals).items() if v > RESIDUAL_TOLERANCE]
+    if too_large:
+        return STATUS_INACCURATE, (f"residuals above {RESIDUAL_TOLERANCE:g}: "
+                                   + ", ".join(too_large))
+    return STATUS_OK, ""
+
+
+# A constraint counts as active when it is tight, (Bu - G)_i / row_scale_i >= -ACTIVE_FRACTION *
+# displacement scale, and its multiplier exceeds ACTIVE_FRACTION * max lambda. Interior-point
+# solutions leave slacks and inactive multipliers around 1e-9 relative; active-set ones at 0.
+ACTIVE_FRACTION = 1e-6
+
+
+def count_active(qp: ContactQP, u: np.ndarray, multipliers: np.ndarray) -> int:
+    """Number of active contact constraints (tight, with a positive multiplier)."""
+    if qp.m == 0 or not (np.isfinite(multipliers).all() and np.isfinite(u).all()):
+        return 0
+    u_scale = _scale(np.abs(u).max(initial=0.0), np.abs(qp.G / qp.row_scale).max(initial=0.0))
+    tight = (qp.B @ u - qp.G) / qp.row_scale >= -ACTIVE_FRACTION * u_scale
+    loaded = multipliers > ACTIVE_FRACTION * max(multipliers.max(), 0.0)
+    return int((tight & loaded).sum())

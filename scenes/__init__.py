@@ -1,0 +1,12 @@
+"""Scene catalogue: what the problem is (DESIGN.md section 2).
+
+Importing this package registers every scene module listed below; adding a scene is one new
+module with a ``@register_scene`` factory and one import line here.
+"""
+
+from scenes import paper  # noqa: F401  (registers the scene)
+from scenes.base import Material, Scene, SceneError
+from scenes.registry import get_scene, register_scene, scene_descriptions, scene_names
+
+__all__ = ["Material", "Scene", "SceneError", "get_scene", "register_scene",
+           "scene_descriptions", "scene_names"]

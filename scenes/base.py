@@ -1,0 +1,130 @@
+"""Scene data: what a Signorini problem is (DESIGN.md sections 1 and 2).
+
+A scene is declarative: geometry and initial mesh, which boundary part is which, the material,
+the loads, the linearised gap g and a coordinate along Gamma_C. It validates itself on
+construction so that a bad problem is refused before any solve.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+from skfem import MeshTri
+
+PointFunction = Callable[[np.ndarray], np.ndarray]
+"""A function of points ``x`` with shape (2, ...) returning values of shape (...) or (2, ...)."""
+
+
+class SceneError(ValueError):
+    """A scene parameter is out of its allowed range."""
+
+
+def _check(condition: bool, parameter: str, value, allowed: str) -> None:
+    if not condition:
+        raise SceneError(f"{parameter}={value!r} is not {allowed}")
+
+
+@dataclass(frozen=True)
+class Material:
+    """Isotropic linear elastic material (DESIGN.md section 1).
+
+    ``plane`` is ``"stress"`` or ``"strain"``; the Lame parameters follow from it.
+    """
+
+    young_modulus: float
+    poisson_ratio: float
+    plane: str = "stress"
+
+    def __post_init__(self):
+        E, nu = self.young_modulus, self.poisson_ratio
+        _check(isinstance(E, int | float) and np.isfinite(E) and E > 0,
+               "young_modulus", E, "a finite number > 0")
+        _check(isinstance(nu, int | float) and np.isfinite(nu) and nu > -1,
+               "poisson_ratio", nu, "> -1")
+        _check(nu < 0.5, "poisson_ratio", nu, "< 0.5")
+        _check(self.plane in ("stress", "strain"), "plane", self.plane,
+               "one of 'stress', 'strain'")
+
+    @property
+    def lame(self) -> tuple[float, float]:
+        """(lambda, mu); lambda is lambda* = E nu / (1 - nu^2) in plane stress."""
+        E, nu = float(self.young_modulus), float(self.poisson_ratio)
+        mu = E / (2.0 * (1.0 + nu))
+        if self.plane == "stress":
+            return E * nu / (1.0 - nu**2), mu
+        return E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)), mu
+
+
+@dataclass(frozen=True, eq=False)
+class Scene:
+    """A Signorini problem on a 2D body (DESIGN.md section 2).
+
+    Boundary parts are given as predicates on facet midpoints; every boundary facet that is
+    neither Dirichlet nor contact is a Neumann facet (traction ``traction``, zero if None).
+    ``contact_coordinate`` maps points of Gamma_C to a monotone arclength-like coordinate,
+    used to order the contact facets (the multiplier mesh of the mixed method lives on it).
+    """
+
+    name: str
+    description: str
+    mesh: MeshTri
+    material: Material
+    is_dirichlet: PointFunction
+    is_contact: PointFunction
+    gap: PointFunction
+    contact_coordinate: PointFunction
+    body_force: PointFunction | None = None
+    traction: PointFunction | None = None
+    parameters: dict = field(default_factory=dict)
+    tags: tuple[str, ...] = ()
+
+    def __post_init__(self):
+        _check(isinstance(self.material, Material), "material", self.material,
+               "a scenes.Material")
+        dirichlet, contact = self.dirichlet_facets(), self.contact_facets()
+        _check(contact.size > 0, "contact boundary", "empty",
+               "non-empty (no boundary facet satisfies is_contact)")
+        _check(self.facet_lengths(dirichlet).sum() > 0, "dirichlet boundary",
+               "of measure 0", "of positive measure (the body must be clamped somewhere)")
+        _check(np.intersect1d(dirichlet, contact).size == 0, "dirichlet boundary",
+               "overlapping the contact boundary", "disjoint from the contact boundary")
+        # the gap at a few points per contact facet, including the end points
+        x = self.facet_points(contact, np.array([0.0, 0.5, 1.0]))
+        g = np.asarray(self.gap(x), dtype=float)
+        bad = ~np.isfinite(g)
+        _check(not bad.any(), "gap", f"{g[bad].ravel()[0]} at x={x[:, bad][:, 0].tolist()}"
+               if bad.any() else None, "finite on the contact boundary")
+
+    # --- boundary parts -------------------------------------------------------------------
+    def dirichlet_facets(self, mesh: MeshTri | None = None) -> np.ndarray:
+        return self._facets_of(self.is_dirichlet, mesh)
+
+    def contact_facets(self, mesh: MeshTri | None = None) -> np.ndarray:
+        return self._facets_of(self.is_contact, mesh)
+
+    def neumann_facets(self, mesh: MeshTri | None = None) -> np.ndarray:
+        mesh = self.mesh if mesh is None else mesh
+        facets = mesh.boundary_facets()
+        taken = np.union1d(self.dirichlet_facets(mesh), self.contact_facets(mesh))
+        return np.setdiff1d(facets, taken)
+
+    def _facets_of(self, predicate: PointFunction, mesh: MeshTri | None) -> np.ndarray:
+        mesh = self.mesh if mesh is None else mesh
+        facets = mesh.boundary_facets()
+        mid = mesh.p[:, mesh.facets[:, facets]].mean(axis=1)
+        return facets[np.asarray(predicate(mid), dtype=bool)]
+
+    def facet_lengths(self, facets: np.ndarray, mesh: MeshTri | None = None) -> np.ndarray:
+        mesh = self.mesh if mesh is None else mesh
+        a, b = mesh.p[:, mesh.facets[0, facets]], mesh.p[:, mesh.facets[1, facets]]
+        return np.linalg.norm(b - a, axis=0)
+
+    def facet_points(self, facets: np.ndarray, t: np.ndarray,
+                     mesh: MeshTri | None = None) -> np.ndarray:
+        """Points a + t (b - a) on each facet; shape (2, n_facets, len(t))."""
+        mesh = self.mesh if mesh is None else mesh
+        a = mesh.p[:, mesh.facets[0, facets]][:, :, None]
+        b = mesh.p[:, mesh.facets[1, facets]][:, :, None]
+        return a + (b - a) * t[None, None, :]

@@ -1,0 +1,50 @@
+"""A small named registry (benchopt-style) shared by every layer, and the scene catalogue.
+
+It lives in ``scenes`` because that is the bottom layer: formulations, solvers and estimators
+import it downwards.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+
+class Registry:
+    """Name -> object with one line of description; unknown names list the valid ones."""
+
+    def __init__(self, kind: str):
+        self.kind = kind
+        self._items: dict[str, tuple[Any, str]] = {}
+
+    def register(self, name: str, description: str) -> Callable[[Any], Any]:
+        def decorate(item: Any) -> Any:
+            if name in self._items:
+                raise ValueError(f"{self.kind} {name!r} is already registered")
+            self._items[name] = (item, description)
+            return item
+
+        return decorate
+
+    def names(self) -> list[str]:
+        return sorted(self._items)
+
+    def descriptions(self) -> dict[str, str]:
+        return {name: self._items[name][1] for name in self.names()}
+
+    def get(self, name: str) -> Any:
+        if name not in self._items:
+            raise KeyError(f"unknown {self.kind} {name!r}; valid {self.kind}s: "
+                           f"{', '.join(self.names())}")
+        return self._items[name][0]
+
+
+SCENES = Registry("scene")
+register_scene = SCENES.register
+scene_names = SCENES.names
+scene_descriptions = SCENES.descriptions
+
+
+def get_scene(name: str, **parameters):
+    """Build the scene ``name`` from its factory with the given parameters."""
+    return SCENES.get(name)(**parameters)
