@@ -1,9 +1,11 @@
 """The reference QP solver: CVXPY with Clarabel (DESIGN.md section 3).
 
-The judge of correctness, not the workhorse. The problem is scaled before it is handed over:
-the objective by 1/objective_scale (K ~ E) and each constraint row by 1/row_scale (B ~ h), so
-that Clarabel's absolute and relative tolerances mean the same thing on every mesh and for every
-Young's modulus. Multipliers are scaled back: lambda = objective_scale * mu / row_scale.
+The judge of correctness, not the workhorse. The problem is scaled before it is handed over, so
+that Clarabel's absolute and relative tolerances mean the same thing on every mesh, for every
+Young's modulus and every size of gap: u = d v with the displacement scale d (the largest mean
+gap |G_i| / row_scale_i, or 1 if all gaps vanish), the objective divided by E d^2
+(E = objective_scale, K ~ E) and each constraint row by row_scale (B ~ h). The multipliers of the
+scaled problem mu give lambda = E d mu / row_scale.
 """
 
 from __future__ import annotations
@@ -23,13 +25,20 @@ CLARABEL_TOLERANCES = {"tol_gap_abs": 1e-9, "tol_gap_rel": 1e-9, "tol_feas": 1e-
                        "tol_ktratio": 1e-7}
 
 
+def displacement_scale(qp: ContactQP) -> float:
+    """The largest mean gap max_i |G_i| / row_scale_i (a length), or 1 if every gap is 0."""
+    d = float(np.abs(qp.G / qp.row_scale).max(initial=0.0))
+    return d if d > 0 and np.isfinite(d) else 1.0
+
+
 @register_solver("reference", "CVXPY + Clarabel interior point (the judge of correctness)")
 def solve_reference(qp: ContactQP, warm_start=None, **clarabel_options) -> QPSolution:
     settings = {**CLARABEL_TOLERANCES, **clarabel_options}
+    d = displacement_scale(qp)
     K = (qp.K / qp.objective_scale).tocsc()
-    F = qp.F / qp.objective_scale
+    F = qp.F / (qp.objective_scale * d)
     row = sparse.diags(1.0 / qp.row_scale)
-    B, G = (row @ qp.B).tocsr(), qp.G / qp.row_scale
+    B, G = (row @ qp.B).tocsr(), qp.G / (qp.row_scale * d)
 
     u = cp.Variable(qp.n)
     objective = cp.Minimize(0.5 * cp.quad_form(u, cp.psd_wrap(K)) - F @ u)
@@ -52,7 +61,7 @@ def solve_reference(qp: ContactQP, warm_start=None, **clarabel_options) -> QPSol
     if problem.status == cp.OPTIMAL_INACCURATE:
         status, reason = STATUS_INACCURATE, "Clarabel stopped short of its tolerances " \
                                             "(status optimal_inaccurate)"
-    return QPSolution(u=np.asarray(u.value, dtype=float),
-                      multipliers=qp.objective_scale * mu / qp.row_scale,
+    return QPSolution(u=d * np.asarray(u.value, dtype=float),
+                      multipliers=qp.objective_scale * d * mu / qp.row_scale,
                       status=status, reason=reason, iterations=iterations, solve_time=elapsed,
                       solver="reference")

@@ -1,0 +1,41 @@
+"""Small scenes with answers known independently of the code under test."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from skfem import MeshTri
+
+from scenes import Material, Scene
+
+TOL = 1e-10
+
+
+def square_scene(gap, *, young_modulus=1000.0, poisson_ratio=0.0, divisions=4,
+                 body_force=None, traction=None, name="test-square") -> Scene:
+    """(-1,1)^2 clamped on top, contact on the bottom (outer normal (0,-1)), free sides."""
+    grid = np.linspace(-1.0, 1.0, divisions + 1)
+    return Scene(name=name, description="test square", mesh=MeshTri.init_tensor(grid, grid),
+                 material=Material(young_modulus, poisson_ratio, "stress"),
+                 is_dirichlet=lambda x: np.abs(x[1] - 1) < TOL,
+                 is_contact=lambda x: np.abs(x[1] + 1) < TOL,
+                 gap=gap, contact_coordinate=lambda x: x[0],
+                 body_force=body_force, traction=traction)
+
+
+@pytest.fixture
+def compression_scene():
+    """A rigid flat pushes the bottom up by delta = 0.01 (g = -delta), nu = 0.
+
+    Exact solution: u = (0, delta (1 - y) / 2), sigma_yy = -E delta / 2, contact pressure
+    p = E delta / 2 on all of Gamma_C. u is linear and p constant, so P1 x P0 reproduce them.
+    """
+    return square_scene(lambda x: np.full(x.shape[1:], -0.01), young_modulus=1000.0)
+
+
+@pytest.fixture
+def free_scene():
+    """No contact: the obstacle is 1.0 away and a downward body force moves the body ~1e-3."""
+    return square_scene(lambda x: np.full(x.shape[1:], 1.0), young_modulus=1000.0,
+                        poisson_ratio=0.3,
+                        body_force=lambda x: np.array([0.0 * x[0], -1.0 + 0.0 * x[0]]))
