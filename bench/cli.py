@@ -4,12 +4,14 @@ from __future__ import annotations
 
 import argparse
 import sys
+from pathlib import Path
 
 import pandas as pd
 
 from bench.loop import STRATEGIES, LevelResult, LoopConfig
 from bench.marking import MARKINGS
 from bench.matrix import run_matrix
+from bench.report import write_report
 from bench.store import ResultStore
 from estimators import estimator_descriptions, estimator_names
 from formulations import (
@@ -95,6 +97,12 @@ def build_parser() -> argparse.ArgumentParser:
                      help="output folder for results.parquet and results.csv (default: results)")
     run.add_argument("--overwrite", action="store_true",
                      help="delete earlier results in OUT first (default: keep and append)")
+    report = sub.add_parser("report", help="render the Markdown report of a results folder",
+                            description="Render OUT/README.md and OUT/convergence.png from "
+                            "RESULTS/results.parquet without recomputing anything.")
+    report.add_argument("--results", default="results",
+                        help="folder holding results.parquet (default: results)")
+    report.add_argument("--out", default="reports", help="report folder (default: reports)")
     sub.add_parser("list", help="list registered scenes, formulations, solvers, estimators",
                    description="List everything registered, with one line of description.")
     return parser
@@ -127,6 +135,13 @@ def main(argv: list[str] | None = None) -> int:
             print(f"{title}:")
             for name, text in items.items():
                 print(f"  {name:12s} {text}")
+        return 0
+    if args.command == "report":
+        source = Path(args.results) / "results.parquet"
+        if not source.exists():
+            print(f"error: --results={args.results!r} holds no results.parquet", file=sys.stderr)
+            return 2
+        print(f"wrote {write_report(pd.read_parquet(source), args.out)}")
         return 0
     config = LoopConfig(max_dofs=args.max_dofs, max_levels=args.max_levels,
                         marking=args.marking, theta=args.theta)

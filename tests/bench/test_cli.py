@@ -1,0 +1,58 @@
+import subprocess
+import sys
+
+import pandas as pd
+import pytest
+
+from bench.cli import main
+
+
+def run(*args):
+    return subprocess.run([sys.executable, "-m", "bench", *args], capture_output=True, text=True,
+                          timeout=300)
+
+
+def test_help_documents_every_option():
+    out = run("run", "--help").stdout
+    for option in ("--scene", "--formulation", "--solver", "--estimator", "--strategy",
+                   "--max-dofs", "--max-levels", "--marking", "--theta", "--out", "--overwrite"):
+        assert option in out
+    assert "run" in run("--help").stdout
+
+
+@pytest.mark.parametrize("option, value, listed", [
+    ("--scene", "papr", "valid scenes: paper"),
+    ("--formulation", "mortar", "valid formulations: mixed"),
+    ("--solver", "gurobi", "valid solvers: reference"),
+    ("--estimator", "dwr", "valid estimators: residual"),
+    ("--strategy", "random", "valid strategys: uniform, adaptive"),
+])
+def test_unknown_names_list_the_valid_ones(option, value, listed, capsys):
+    with pytest.raises(SystemExit) as exit_:
+        main(["run", option, value])
+    assert exit_.value.code == 2
+    assert listed in capsys.readouterr().err
+
+
+def test_bad_numbers_are_refused(capsys):
+    with pytest.raises(SystemExit):
+        main(["run", "--max-dofs", "-5"])
+    assert "max_dofs='-5' is not a positive integer" in capsys.readouterr().err
+
+
+def test_run_writes_results_and_prints_progress_and_summary(tmp_path):
+    out = tmp_path / "res"
+    result = run("run", "--strategy", "uniform,adaptive", "--max-dofs", "600", "--out", str(out))
+    assert result.returncode == 0, result.stderr
+    assert "level  0  ndofs       40" in result.stdout
+    assert "== paper / mixed / reference / residual / adaptive" in result.stdout
+    table = pd.read_parquet(out / "results.parquet")
+    assert set(table["strategy"]) == {"uniform", "adaptive"}
+    assert (table["status"] == "ok").all()
+    assert len(pd.read_csv(out / "results.csv")) == len(table)
+
+
+def test_list_prints_registered_names():
+    out = run("list").stdout
+    for name in ("paper", "mixed", "reference", "residual"):
+        assert name in out
