@@ -23,7 +23,7 @@ def test_help_documents_every_option():
 @pytest.mark.parametrize("option, value, listed", [
     ("--scene", "papr", "valid scenes: paper"),
     ("--formulation", "mortar", "valid formulations: mixed"),
-    ("--solver", "gurobi", "valid solvers: reference"),
+    ("--solver", "gurobi", "valid solvers: active-set, reference"),
     ("--estimator", "dwr", "valid estimators: residual"),
     ("--strategy", "random", "valid strategys: uniform, adaptive"),
 ])
