@@ -6,13 +6,13 @@ import time
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 
-import numpy as np
 from skfem import MeshTri
 
 from bench.marking import mark
 from bench.rows import ResultRow
 from estimators import get_estimator
 from formulations import STATUS_FAILED, get_formulation, solve
+from formulations.elasticity import element_diameters
 from scenes import Scene
 
 STRATEGIES = ("uniform", "adaptive")
@@ -48,11 +48,6 @@ class LevelResult:
     row: ResultRow
     solution: object | None
     estimate: object | None
-
-
-def element_diameters(mesh: MeshTri) -> np.ndarray:
-    p = mesh.p[:, mesh.t]
-    return np.max([np.linalg.norm(p[:, i] - p[:, (i + 1) % 3], axis=0) for i in range(3)], axis=0)
 
 
 def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,

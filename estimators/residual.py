@@ -22,6 +22,7 @@ from estimators.base import Estimate, register_estimator
 from estimators.contact_terms import contact_terms
 from formulations import DiscreteSolution
 from formulations.contact import gauss_legendre, outer_normals
+from formulations.elasticity import element_diameters
 
 EDGE_QUADRATURE_POINTS = 4
 
@@ -37,8 +38,7 @@ def element_residual(scene, solution: DiscreteSolution) -> np.ndarray:
     n_elements = mesh.t.shape[1]
     if scene.body_force is None:
         return np.zeros(n_elements)
-    diameter = np.max([np.linalg.norm(mesh.p[:, mesh.t[i]] - mesh.p[:, mesh.t[(i + 1) % 3]],
-                                      axis=0) for i in range(3)], axis=0)
+    diameter = element_diameters(mesh)
     f_squared = Functional(lambda w: (scene.body_force(w.x) ** 2).sum(axis=0))
     return diameter**2 * f_squared.elemental(solution.elasticity.basis)
 

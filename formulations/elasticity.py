@@ -58,6 +58,12 @@ class Elasticity:
         return stress_from_gradient(grad, *self.lame)
 
 
+def element_diameters(mesh: MeshTri) -> np.ndarray:
+    """Longest edge of every triangle (h_T)."""
+    p = mesh.p[:, mesh.t]
+    return np.max([np.linalg.norm(p[:, i] - p[:, (i + 1) % 3], axis=0) for i in range(3)], axis=0)
+
+
 def stress_from_gradient(grad: np.ndarray, lam: float, mu: float) -> np.ndarray:
     """sigma = lam tr(eps) I + 2 mu eps from grad[i, j] = d u_i / d x_j; returns (s11, s22, s12)."""
     e11, e22 = grad[0, 0], grad[1, 1]
