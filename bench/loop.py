@@ -3,12 +3,12 @@
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 from skfem import MeshTri
 
-from bench.marking import mark
+from bench.marking import MARKINGS, mark
 from bench.rows import ResultRow
 from estimators import get_estimator
 from formulations import STATUS_FAILED, get_formulation, solve
@@ -35,8 +35,8 @@ class LoopConfig:
             raise ValueError(f"max_dofs={self.max_dofs!r} is not a positive integer")
         if not (isinstance(self.max_levels, int) and self.max_levels > 0):
             raise ValueError(f"max_levels={self.max_levels!r} is not a positive integer")
-        if self.marking not in ("doerfler", "maximum"):
-            raise ValueError(f"marking={self.marking!r} is not one of doerfler, maximum")
+        if self.marking not in MARKINGS:
+            raise ValueError(f"marking={self.marking!r} is not one of {', '.join(MARKINGS)}")
         if not 0.0 < self.theta <= 1.0:
             raise ValueError(f"theta={self.theta!r} is not in (0, 1]")
 
@@ -93,12 +93,3 @@ def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
         t_refine = time.perf_counter() - start
         mesh = refined
 
-
-def run_to_rows(*args, on_level: Callable[[LevelResult], None] | None = None,
-                **kwargs) -> list[ResultRow]:
-    rows = []
-    for result in run_sequence(*args, **kwargs):
-        rows.append(result.row)
-        if on_level is not None:
-            on_level(result)
-    return rows

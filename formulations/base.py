@@ -45,6 +45,11 @@ class ContactQP:
     def m(self) -> int:
         return int(self.G.size)
 
+    @property
+    def gap_scale(self) -> float:
+        """The largest mean gap max_i |G_i| / row_scale_i (a length; 0 if every gap is 0)."""
+        return float(np.abs(self.G / self.row_scale).max(initial=0.0))
+
 
 @dataclass(frozen=True, eq=False)
 class QPSolution:

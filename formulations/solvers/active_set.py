@@ -33,11 +33,13 @@ RHS_BLOCK = 8  # SuperLU's solve is fastest with at most ~8 right-hand sides at 
 
 
 def condensed_operator(lu, B) -> np.ndarray:
-    """S = B K^-1 B' (dense, m x m) from a factorisation ``lu`` of K."""
+    """S = B K^-1 B' (dense, m x m) from a factorisation ``lu`` of K, a block of columns at a
+    time so that K^-1 B' (n x m) is never stored whole."""
+    m = B.shape[0]
     Bt = B.T.tocsc()
-    columns = [lu.solve(Bt[:, j:j + RHS_BLOCK].toarray()) for j in range(0, B.shape[0], RHS_BLOCK)]
-    W = np.hstack(columns) if columns else np.zeros((B.shape[1], 0))
-    S = B @ W
+    S = np.empty((m, m))
+    for j in range(0, m, RHS_BLOCK):
+        S[:, j:j + RHS_BLOCK] = B @ lu.solve(Bt[:, j:j + RHS_BLOCK].toarray())
     return 0.5 * (S + S.T)
 
 

@@ -28,16 +28,12 @@ CLARABEL_TOLERANCES = {"tol_gap_abs": 1e-10, "tol_gap_rel": 1e-10, "tol_feas": 1
                        "tol_ktratio": 1e-8}
 
 
-def displacement_scale(qp: ContactQP) -> float:
-    """The largest mean gap max_i |G_i| / row_scale_i (a length), or 1 if every gap is 0."""
-    d = float(np.abs(qp.G / qp.row_scale).max(initial=0.0))
-    return d if d > 0 and np.isfinite(d) else 1.0
-
-
 @register_solver("reference", "CVXPY + Clarabel interior point (the judge of correctness)")
 def solve_reference(qp: ContactQP, warm_start=None, **clarabel_options) -> QPSolution:
+    """Solve ``qp`` with Clarabel; ``warm_start`` is accepted for the common solver interface
+    and ignored (an interior-point method gains little from it)."""
     settings = {**CLARABEL_TOLERANCES, **clarabel_options}
-    d = displacement_scale(qp)
+    d = qp.gap_scale if 0 < qp.gap_scale < np.inf else 1.0
     K = (qp.K / qp.objective_scale).tocsc()
     F = qp.F / (qp.objective_scale * d)
     row = sparse.diags(1.0 / qp.row_scale)

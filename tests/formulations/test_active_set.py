@@ -57,3 +57,15 @@ def test_active_set_agrees_with_reference(label, mesh):
     assert energy_diff <= 1e-7, energy_diff
     assert lam_diff <= 1e-6, lam_diff
     assert fast.active_constraints == judge.active_constraints
+
+
+def test_warm_start_from_the_solution_needs_one_iteration():
+    from formulations.solvers.active_set import solve_active_set
+
+    scene = get_scene("paper")
+    qp = get_formulation("mixed")(scene, scene.mesh.refined(3)).qp
+    cold = solve_active_set(qp)
+    warm = solve_active_set(qp, warm_start=cold.multipliers)
+    assert cold.status == warm.status == "ok"
+    assert cold.iterations > 1 and warm.iterations == 1  # the active set is right at once
+    assert warm.multipliers == pytest.approx(cold.multipliers, rel=1e-12, abs=0)
