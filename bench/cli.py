@@ -20,11 +20,12 @@ from formulations import (
     solver_descriptions,
     solver_names,
 )
+from formulations.solvers.backends import BACKENDS, check_backend
 from scenes import scene_descriptions, scene_names
 
 SUMMARY_COLUMNS = ["level", "ndofs", "energy", "contact_force", "active_constraints", "eta",
                    "eta_0", "eta_geometric", "eta_complementarity", "max_h_over_H",
-                   "iterations", "t_solve", "status"]
+                   "iterations", "backend", "t_solve", "status"]
 
 
 def _names(kind: str, valid: list[str]):
@@ -93,6 +94,12 @@ def build_parser() -> argparse.ArgumentParser:
                      help="adaptive marking: doerfler (bulk) or maximum (default: doerfler)")
     run.add_argument("--theta", type=_theta, default=0.5,
                      help="marking parameter in (0, 1] (default: 0.5)")
+    run.add_argument("--backend", choices=BACKENDS, default=None,
+                     help="sparse direct back-end of the active-set solver: cholmod (needs "
+                          "scikit-sparse) or splu (scipy) (default: cholmod when installed)")
+    run.add_argument("--cold-start", action="store_true",
+                     help="solve every level from scratch instead of starting from the "
+                          "previous level's contact zone (nested iteration, the default)")
     run.add_argument("--out", default="results",
                      help="output folder for results.parquet and results.csv (default: results)")
     run.add_argument("--overwrite", action="store_true",
@@ -143,8 +150,15 @@ def main(argv: list[str] | None = None) -> int:
             return 2
         print(f"wrote {write_report(pd.read_parquet(source), args.out)}")
         return 0
+    if args.backend is not None:
+        try:
+            check_backend(args.backend)
+        except ValueError as error:
+            print(f"error: {error}", file=sys.stderr)
+            return 2
     config = LoopConfig(max_dofs=args.max_dofs, max_levels=args.max_levels,
-                        marking=args.marking, theta=args.theta)
+                        marking=args.marking, theta=args.theta, nested=not args.cold_start,
+                        solver_options={"backend": args.backend} if args.backend else {})
     store = ResultStore(args.out, overwrite=args.overwrite)
     rows = run_matrix(args.scene, args.formulation, args.solver, args.estimator, args.strategy,
                       store, config, on_level=_progress)

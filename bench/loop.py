@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from skfem import MeshTri
 
@@ -27,6 +27,8 @@ class LoopConfig:
     max_levels: int = 40
     marking: str = "doerfler"
     theta: float = 0.5
+    nested: bool = True
+    solver_options: dict = field(default_factory=dict)
 
     def __post_init__(self):
         if self.strategy not in STRATEGIES:
@@ -60,14 +62,18 @@ def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
                  strategy=config.strategy, marking=config.marking, theta=config.theta,
                  **(identity or {}))
     mesh = scene.mesh if mesh is None else mesh
-    t_refine = 0.0
+    t_refine, previous = 0.0, None
     for level in range(config.max_levels):
         start = time.perf_counter()
         disc = discretise(scene, mesh)
         t_assemble = time.perf_counter() - start
         if level > 0 and disc.ndofs > config.max_dofs:
             return
-        sol = solve(disc, solver)
+        options = dict(config.solver_options)
+        if config.nested and previous is not None and previous.ok:
+            options["warm_start"] = disc.warm_start(previous)  # nested iteration
+        sol = solve(disc, solver, **options)
+        previous = sol
         start = time.perf_counter()
         est = estimate(scene, sol) if sol.status != STATUS_FAILED else None
         t_estimate = time.perf_counter() - start if est is not None else float("nan")
@@ -76,7 +82,8 @@ def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
             level=level, ndofs=disc.ndofs, n_elements=mesh.t.shape[1], h_max=float(h.max()),
             h_min=float(h.min()), max_h_over_H=sol.max_h_over_H, energy=sol.energy,
             contact_force=sol.contact_force(), active_constraints=sol.active_constraints,
-            n_constraints=disc.qp.m, iterations=sol.iterations, t_assemble=t_assemble,
+            n_constraints=disc.qp.m, iterations=sol.iterations, backend=sol.backend,
+            warm_started="warm_start" in options, t_assemble=t_assemble,
             t_solve=sol.solve_time, t_estimate=t_estimate, t_refine=t_refine,
             status=sol.status, reason=sol.reason, **vars(sol.residuals))
         if est is not None:

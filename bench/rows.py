@@ -36,6 +36,8 @@ class ResultRow:
     complementarity: float = math.nan
     stationarity: float = math.nan
     iterations: int = 0
+    backend: str = ""
+    warm_started: bool = False
     t_assemble: float = math.nan
     t_solve: float = math.nan
     t_estimate: float = math.nan

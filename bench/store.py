@@ -24,6 +24,10 @@ class ResultStore:
             for path in (self.csv, self.parquet):
                 path.unlink(missing_ok=True)
         self.previous = pd.read_parquet(self.parquet) if self.parquet.exists() else None
+        if self.previous is not None and list(self.previous.columns) != COLUMNS:
+            # written by a version with fewer columns: new columns are added, never renamed
+            self.previous = self.previous.reindex(columns=COLUMNS)
+            self.previous.to_csv(self.csv, index=False)
         self.rows: list[dict] = []
 
     def append(self, row: ResultRow) -> None:

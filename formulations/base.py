@@ -62,6 +62,7 @@ class QPSolution:
     iterations: int
     solve_time: float
     solver: str
+    backend: str = ""
 
 
 @dataclass(frozen=True)
@@ -97,6 +98,7 @@ class DiscreteSolution:
     solve_time: float
     active_constraints: int
     max_h_over_H: float = float("nan")
+    backend: str = ""
     extra: dict = field(default_factory=dict)
 
     @property
@@ -106,6 +108,13 @@ class DiscreteSolution:
     @property
     def energy(self) -> float:
         return self.elasticity.energy(self.u)
+
+    def pressure_at(self, s: np.ndarray) -> np.ndarray:
+        """lambda_h at contact coordinates ``s``, sampled at the middle of the facet containing
+        each point (exact for piecewise constant pressures; used to transfer a contact zone)."""
+        middle = self.pressure(np.array([0.5]))[:, 0]
+        facet = np.searchsorted(self.trace.coordinate[0], np.asarray(s, dtype=float), "right")
+        return middle[np.clip(facet - 1, 0, middle.size - 1)]
 
     def contact_force(self, quadrature_points: int = 4) -> float:
         """The integral of lambda_h over Gamma_C."""

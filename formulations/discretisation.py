@@ -18,13 +18,20 @@ from formulations.solvers import get_solver
 class Discretisation:
     """What a formulation's ``discretise`` returns: the assembled QP on the free DOFs and how to
     turn a solver's answer into a ``DiscreteSolution`` (``recover(qp_solution, residuals,
-    status, reason)``)."""
+    status, reason)``). ``row_coordinate`` places each constraint row on Gamma_C (the scene's
+    contact coordinate of its segment's middle or its node)."""
 
     formulation: str
     elasticity: Elasticity
     trace: ContactTrace
     qp: ContactQP
     recover: Callable[[QPSolution, Residuals, str, str], DiscreteSolution]
+    row_coordinate: np.ndarray
+
+    def warm_start(self, previous: DiscreteSolution) -> np.ndarray:
+        """Initial multipliers for this QP from a solution on another (coarser) mesh: the
+        previous lambda_h at each constraint row's place on Gamma_C (nested iteration)."""
+        return previous.pressure_at(self.row_coordinate)
 
     @property
     def ndofs(self) -> int:
@@ -39,7 +46,7 @@ def solve(discretisation: Discretisation, solver: str, **options) -> DiscreteSol
         nan = np.full(discretisation.qp.n, np.nan)
         answer = QPSolution(nan, np.full(discretisation.qp.m, np.nan), answer.status or
                             STATUS_FAILED, answer.reason, answer.iterations, answer.solve_time,
-                            answer.solver)
+                            answer.solver, answer.backend)
         residuals = Residuals(*(4 * [float("nan")]))
         status, reason = judge(answer, None)
     else:

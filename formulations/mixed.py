@@ -95,7 +95,8 @@ def discretise(scene: Scene, mesh: MeshTri) -> Discretisation:
             multiplier_breaks=breaks, residuals=residuals, status=status, reason=reason,
             iterations=answer.iterations, solve_time=answer.solve_time,
             active_constraints=count_active(qp, answer.u, lam), max_h_over_H=h_over_H,
+            backend=answer.backend,
             extra={"multipliers": lam, "segment_of_facet": segment})
 
     return Discretisation(formulation="mixed", elasticity=elasticity, trace=trace, qp=qp,
-                          recover=recover)
+                          recover=recover, row_coordinate=0.5 * (breaks[:-1] + breaks[1:]))

@@ -6,16 +6,18 @@ contact unknowns (they live on one boundary line):
 
     y = S lambda - r >= 0,  lambda >= 0,  lambda' y = 0,   S = B K^-1 B',  r = B u0 - G,
 
-where y = G - Bu is the slack. K is factorised once; S costs one solve per constraint (in small
-blocks, since SuperLU slows down with many right-hand sides at once). The LCP is solved by the
-primal-dual active set method (Hintermueller, Ito, Kunisch 2003; a semismooth Newton method):
+where y = G - Bu is the slack. K is factorised once, and S comes from the same factorisation
+through the Schur complement of K on the contact DOFs (``backends``); nothing is refactorised
+between iterations. The LCP is solved by the primal-dual active set method (Hintermueller, Ito,
+Kunisch 2003; a semismooth Newton method):
 
     A = {i : lambda_i - c y_i > 0};  lambda_I = 0,  S_AA lambda_A = r_A;  repeat until A is fixed.
 
 At termination lambda_A >= 0 and y_I >= 0 hold exactly (up to round-off), so the answer is exact.
 A repeated active set (cycling) or the iteration limit stops it with status ``failed`` and the
-reason. The first active set is {i : r_i > 0} (constraints the unconstrained solution violates)
-unless ``warm_start`` multipliers are given.
+reason. The first active set is {i : r_i > 0} (the constraints the unconstrained solution
+violates) unless ``warm_start`` multipliers are given: then it is {i : warm_start_i > 0}, which is
+how the refinement loop's nested iteration passes the previous level's contact zone.
 """
 
 from __future__ import annotations
@@ -24,23 +26,10 @@ import time
 
 import numpy as np
 from scipy import linalg
-from scipy.sparse.linalg import splu
 
 from formulations.base import STATUS_FAILED, STATUS_OK, ContactQP, QPSolution
+from formulations.solvers.backends import factorise_condensed
 from formulations.solvers.registry import register_solver
-
-RHS_BLOCK = 8  # SuperLU's solve is fastest with at most ~8 right-hand sides at once
-
-
-def condensed_operator(lu, B) -> np.ndarray:
-    """S = B K^-1 B' (dense, m x m) from a factorisation ``lu`` of K, a block of columns at a
-    time so that K^-1 B' (n x m) is never stored whole."""
-    m = B.shape[0]
-    Bt = B.T.tocsc()
-    S = np.empty((m, m))
-    for j in range(0, m, RHS_BLOCK):
-        S[:, j:j + RHS_BLOCK] = B @ lu.solve(Bt[:, j:j + RHS_BLOCK].toarray())
-    return 0.5 * (S + S.T)
 
 
 def pdas(S: np.ndarray, r: np.ndarray, active: np.ndarray, max_iter: int):
@@ -68,16 +57,20 @@ def pdas(S: np.ndarray, r: np.ndarray, active: np.ndarray, max_iter: int):
 
 
 @register_solver("active-set", "primal-dual active set (semismooth Newton) on the condensed "
-                               "contact system B K^-1 B', one sparse LU of K")
+                               "contact system B K^-1 B', one sparse factorisation of K")
 def solve_active_set(qp: ContactQP, warm_start: np.ndarray | None = None,
-                     max_iter: int = 100) -> QPSolution:
+                     max_iter: int = 100, backend: str | None = None) -> QPSolution:
+    """``backend``: 'cholmod' or 'splu' (default: the fastest available, see ``backends``)."""
     start = time.perf_counter()
-    lu = splu(qp.K.tocsc())
-    u0 = lu.solve(qp.F)
-    S = condensed_operator(lu, qp.B)
+    factor = factorise_condensed(qp.K, np.unique(qp.B.indices), backend)
+    u0 = factor.solve(qp.F)
+    S = factor.condensed(qp.B)
     r = qp.B @ u0 - qp.G
-    active = (warm_start > 0) if warm_start is not None else (r > 0)
-    lam, iterations, status, reason = pdas(S, r, np.asarray(active, dtype=bool), max_iter)
-    u = lu.solve(qp.F - qp.B.T @ lam)
+    if warm_start is not None and np.shape(warm_start) != (qp.m,):
+        raise ValueError(f"warm_start has shape {np.shape(warm_start)}, not ({qp.m},)")
+    active = (np.asarray(warm_start) > 0) if warm_start is not None else (r > 0)
+    lam, iterations, status, reason = pdas(S, r, active, max_iter)
+    u = factor.solve(qp.F - qp.B.T @ lam)
     return QPSolution(u=u, multipliers=lam, status=status, reason=reason, iterations=iterations,
-                      solve_time=time.perf_counter() - start, solver="active-set")
+                      solve_time=time.perf_counter() - start, solver="active-set",
+                      backend=factor.backend)

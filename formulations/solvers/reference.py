@@ -29,9 +29,11 @@ CLARABEL_TOLERANCES = {"tol_gap_abs": 1e-10, "tol_gap_rel": 1e-10, "tol_feas": 1
 
 
 @register_solver("reference", "CVXPY + Clarabel interior point (the judge of correctness)")
-def solve_reference(qp: ContactQP, warm_start=None, **clarabel_options) -> QPSolution:
-    """Solve ``qp`` with Clarabel; ``warm_start`` is accepted for the common solver interface
-    and ignored (an interior-point method gains little from it)."""
+def solve_reference(qp: ContactQP, warm_start=None, backend=None,
+                    **clarabel_options) -> QPSolution:
+    """Solve ``qp`` with Clarabel; ``warm_start`` and ``backend`` are accepted for the common
+    solver interface and ignored (an interior-point method gains little from a warm start, and
+    Clarabel brings its own sparse LDL')."""
     settings = {**CLARABEL_TOLERANCES, **clarabel_options}
     d = qp.gap_scale if 0 < qp.gap_scale < np.inf else 1.0
     K = (qp.K / qp.objective_scale).tocsc()
@@ -50,13 +52,13 @@ def solve_reference(qp: ContactQP, warm_start=None, **clarabel_options) -> QPSol
             problem.solve(solver=cp.CLARABEL, **settings)
     except cp.SolverError as error:
         return QPSolution(None, None, STATUS_FAILED, f"Clarabel failed: {error}", 0,
-                          time.perf_counter() - start, "reference")
+                          time.perf_counter() - start, "reference", "clarabel")
     elapsed = time.perf_counter() - start
     stats = problem.solver_stats
     iterations = int(stats.num_iters or 0) if stats is not None else 0
     if problem.status not in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE) or u.value is None:
         return QPSolution(None, None, STATUS_FAILED, f"Clarabel status {problem.status!r}",
-                          iterations, elapsed, "reference")
+                          iterations, elapsed, "reference", "clarabel")
     mu = np.asarray(constraint.dual_value if qp.m else np.zeros(0), dtype=float).ravel()
     status, reason = STATUS_OK, ""
     if problem.status == cp.OPTIMAL_INACCURATE:
@@ -65,4 +67,4 @@ def solve_reference(qp: ContactQP, warm_start=None, **clarabel_options) -> QPSol
     return QPSolution(u=d * np.asarray(u.value, dtype=float),
                       multipliers=qp.objective_scale * d * mu / qp.row_scale,
                       status=status, reason=reason, iterations=iterations, solve_time=elapsed,
-                      solver="reference")
+                      solver="reference", backend="clarabel")

@@ -82,3 +82,28 @@ def test_store_keeps_finished_rows_when_a_run_breaks(tmp_path, monkeypatch):
 def test_loop_config_validation(changes, message):
     with pytest.raises(ValueError, match=message):
         LoopConfig(**changes)
+
+
+def test_nested_iteration_keeps_active_set_iterations_flat():
+    # the goal: <= 3 active-set iterations per level after the first when each level
+    # starts from the previous level's contact zone; a cold start needs more on fine levels
+    def iterations(nested):
+        config = LoopConfig(strategy="adaptive", max_dofs=15000, nested=nested)
+        return [r.row for r in run_sequence(get_scene("paper"), "mixed", "active-set",
+                                            "residual", config)]
+    warm, cold = iterations(True), iterations(False)
+    assert all(r.status == "ok" for r in warm + cold)
+    assert [r.warm_started for r in warm] == [False] + [True] * (len(warm) - 1)
+    assert max(r.iterations for r in warm[1:]) <= 3, [r.iterations for r in warm]
+    assert sum(r.iterations for r in warm) < sum(r.iterations for r in cold)
+    # the warm start changes the path, not the answer
+    assert [r.energy for r in warm] == pytest.approx([r.energy for r in cold], rel=1e-10)
+
+
+def test_store_adds_new_columns_to_results_of_an_older_version(tmp_path):
+    old = pd.DataFrame({"scene": ["paper"], "level": [0], "energy": [1.0]})
+    old.to_parquet(tmp_path / "results.parquet")
+    old.to_csv(tmp_path / "results.csv", index=False)
+    store = ResultStore(tmp_path)
+    assert list(store.previous.columns) == COLUMNS
+    assert list(pd.read_csv(tmp_path / "results.csv").columns) == COLUMNS

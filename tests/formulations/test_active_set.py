@@ -5,6 +5,7 @@ import pytest
 
 from formulations import get_formulation, solve
 from formulations.solvers.active_set import pdas
+from formulations.solvers.backends import available_backends
 from scenes import get_scene
 
 
@@ -36,13 +37,15 @@ def paper_meshes():
     yield "graded", mesh
 
 
+@pytest.mark.parametrize("backend", available_backends())
 @pytest.mark.parametrize("label, mesh", list(paper_meshes()), ids=lambda v: v
                          if isinstance(v, str) else "")
-def test_active_set_agrees_with_reference(label, mesh):
+def test_active_set_agrees_with_reference(label, mesh, backend):
     scene = get_scene("paper")
     disc = get_formulation("mixed")(scene, mesh)
-    fast, judge = solve(disc, "active-set"), solve(disc, "reference")
+    fast, judge = solve(disc, "active-set", backend=backend), solve(disc, "reference")
     assert fast.status == "ok", fast.reason
+    assert fast.backend == backend
     assert judge.status == "ok", judge.reason
     # the fast solver is exact: KKT residuals at round-off
     assert max(vars(fast.residuals).values()) < 1e-12

@@ -1,0 +1,45 @@
+"""Sparse back-ends: the Schur-complement route gives the same B K^-1 B' and K^-1 b as a dense
+computation, on every available back-end."""
+
+import numpy as np
+import pytest
+from scipy import sparse
+
+from formulations import get_formulation
+from formulations.solvers import backends
+from scenes import get_scene
+
+
+@pytest.fixture(scope="module")
+def qp():
+    scene = get_scene("paper")
+    return get_formulation("mixed")(scene, scene.mesh.refined(2)).qp
+
+
+@pytest.mark.parametrize("backend", backends.available_backends())
+def test_condensed_operator_and_solve_match_dense_linear_algebra(qp, backend):
+    factor = backends.factorise_condensed(qp.K, np.unique(qp.B.indices), backend)
+    K, B = qp.K.toarray(), qp.B.toarray()
+    S = B @ np.linalg.solve(K, B.T)
+    # both sides are O(1e-5) x cond(K) ~ 1e3 round-off apart
+    assert factor.condensed(qp.B) == pytest.approx(S, rel=1e-9, abs=1e-9 * np.abs(S).max())
+    x = factor.solve(qp.F)
+    assert x == pytest.approx(np.linalg.solve(K, qp.F), rel=1e-9, abs=1e-9 * np.abs(x).max())
+    plain = backends.factorise(qp.K, backend)
+    assert plain(qp.F) == pytest.approx(x, rel=1e-9, abs=1e-9 * np.abs(x).max())
+
+
+def test_splu_handles_a_problem_that_is_all_contact():
+    K = sparse.csc_matrix(np.array([[2.0, -1.0], [-1.0, 2.0]]))
+    factor = backends.factorise_condensed(K, np.array([0, 1]), "splu")
+    assert factor.solve(np.array([1.0, 0.0])) == pytest.approx([2 / 3, 1 / 3], rel=1e-14)
+
+
+def test_unknown_backend_is_refused_with_the_choices():
+    with pytest.raises(backends.BackendError, match=r"backend='mumps' is not one of cholmod, "
+                                                     r"splu"):
+        backends.check_backend("mumps")
+
+
+def test_default_backend_is_available():
+    assert backends.default_backend() in backends.available_backends()
