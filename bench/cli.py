@@ -1,4 +1,4 @@
-"""Command line: ``python -m bench run|list``."""
+"""Command line: ``python -m bench run|report|scaling|list``."""
 
 from __future__ import annotations
 
@@ -12,6 +12,7 @@ from bench.loop import STRATEGIES, LevelResult, LoopConfig
 from bench.marking import MARKINGS
 from bench.matrix import run_matrix
 from bench.report import write_report
+from bench.scaling import SIZES, run_scaling, write_scaling
 from bench.store import ResultStore
 from estimators import estimator_descriptions, estimator_names
 from formulations import (
@@ -110,6 +111,22 @@ def build_parser() -> argparse.ArgumentParser:
     report.add_argument("--results", default="results",
                         help="folder holding results.parquet (default: results)")
     report.add_argument("--out", default="reports", help="report folder (default: reports)")
+    scaling = sub.add_parser(
+        "scaling", help="time assembly, linear solve, fast and reference contact solves and "
+        "the estimator against N, with peak memory",
+        description="Measure every phase once per size, each size in a fresh process, and "
+        "write OUT/scaling.{md,csv} (and the README's table with --readme).")
+    scaling.add_argument("--sizes", type=_names("size", list(SIZES)), default=list(SIZES),
+                         help=f"sizes, comma-separated: {', '.join(SIZES)} (default: all)")
+    scaling.add_argument("--backend", choices=BACKENDS, default=None,
+                         help="sparse back-end (default: cholmod when installed)")
+    scaling.add_argument("--reference-max-dofs", type=_positive_int("reference_max_dofs"),
+                         default=200_000, help="run the reference solver only up to this "
+                         "many DOFs (default: 200000)")
+    scaling.add_argument("--out", default="reports", help="output folder (default: reports)")
+    scaling.add_argument("--readme", default=None,
+                         help="also replace the table between the scaling markers of this "
+                              "README (e.g. README.md)")
     sub.add_parser("list", help="list registered scenes, formulations, solvers, estimators",
                    description="List everything registered, with one line of description.")
     return parser
@@ -142,6 +159,14 @@ def main(argv: list[str] | None = None) -> int:
             print(f"{title}:")
             for name, text in items.items():
                 print(f"  {name:12s} {text}")
+        return 0
+    if args.command == "scaling":
+        def show(row):
+            print(f"{row['size']}: ndofs {row['ndofs']}  fast {row['t_fast_solve']:.2f} s  "
+                  f"linear {row['t_linear_solve']:.2f} s  reference "
+                  f"{row['t_reference_solve']:.2f} s  peak {row['peak_gib']:.2f} GiB", flush=True)
+        frame = run_scaling(args.sizes, args.backend, args.reference_max_dofs, on_row=show)
+        print(f"wrote {write_scaling(frame, args.out, args.readme)}")
         return 0
     if args.command == "report":
         source = Path(args.results) / "results.parquet"

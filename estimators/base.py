@@ -27,6 +27,18 @@ class Estimate:
     indicators: np.ndarray
 
 
+def combine(estimator: str, volume: np.ndarray, contact) -> Estimate:
+    """The estimate from squared per-element volume indicators (eta_0^2 = their sum) and the
+    shared contact terms (``estimators.contact_terms``): eta^2 = eta_0^2 + geometric +
+    complementarity, as in the paper's (8)."""
+    eta_0 = float(np.sqrt(volume.sum()))
+    return Estimate(estimator=estimator,
+                    eta=float(np.sqrt(eta_0**2 + contact.geometric + contact.complementarity)),
+                    eta_0=eta_0, eta_geometric=float(np.sqrt(contact.geometric)),
+                    eta_complementarity=float(np.sqrt(contact.complementarity)),
+                    indicators=volume + contact.per_element)
+
+
 ESTIMATORS = Registry("estimator")
 register_estimator = ESTIMATORS.register
 estimator_names = ESTIMATORS.names

@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 from skfem import Functional
 
-from estimators.base import Estimate, register_estimator
+from estimators.base import Estimate, combine, register_estimator
 from estimators.contact_terms import contact_terms
 from formulations import DiscreteSolution
 from formulations.contact import gauss_legendre, outer_normals
@@ -83,11 +83,4 @@ def edge_residuals(scene, solution: DiscreteSolution) -> np.ndarray:
 def estimate(scene, solution: DiscreteSolution) -> Estimate:
     young = float(scene.material.young_modulus)
     eta0_local = (element_residual(scene, solution) + edge_residuals(scene, solution)) / young
-    contact = contact_terms(scene, solution)
-    indicators = eta0_local + contact.per_element
-    eta_0 = float(np.sqrt(eta0_local.sum()))
-    return Estimate(estimator="residual",
-                    eta=float(np.sqrt(eta_0**2 + contact.geometric + contact.complementarity)),
-                    eta_0=eta_0, eta_geometric=float(np.sqrt(contact.geometric)),
-                    eta_complementarity=float(np.sqrt(contact.complementarity)),
-                    indicators=indicators)
+    return combine("residual", eta0_local, contact_terms(scene, solution))

@@ -27,15 +27,33 @@ class Discretisation:
     qp: ContactQP
     recover: Callable[[QPSolution, Residuals, str, str], DiscreteSolution]
     row_coordinate: np.ndarray
+    transfer: Callable[[DiscreteSolution], np.ndarray] | None = None
 
     def warm_start(self, previous: DiscreteSolution) -> np.ndarray:
         """Initial multipliers for this QP from a solution on another (coarser) mesh: the
-        previous lambda_h at each constraint row's place on Gamma_C (nested iteration)."""
+        previous lambda_h at each constraint row's place on Gamma_C (nested iteration), unless
+        the formulation's rows need their own ``transfer``."""
+        if self.transfer is not None:
+            return self.transfer(previous)
         return previous.pressure_at(self.row_coordinate)
 
     @property
     def ndofs(self) -> int:
         return self.elasticity.ndofs
+
+
+def discrete_solution(formulation: str, elasticity: Elasticity, trace: ContactTrace,
+                      answer: QPSolution, residuals: Residuals, status: str, reason: str, *,
+                      u_free: np.ndarray, pressure, multiplier_breaks: np.ndarray,
+                      active_constraints: int, **specific) -> DiscreteSolution:
+    """The common part of every formulation's ``recover``: a solver's answer plus the
+    formulation's own u_h (free DOFs), lambda_h and contact mesh."""
+    return DiscreteSolution(
+        formulation=formulation, solver=answer.solver, elasticity=elasticity, trace=trace,
+        u=elasticity.expand(u_free), pressure=pressure, multiplier_breaks=multiplier_breaks,
+        residuals=residuals, status=status, reason=reason, iterations=answer.iterations,
+        solve_time=answer.solve_time, active_constraints=active_constraints,
+        backend=answer.backend, **specific)
 
 
 def solve(discretisation: Discretisation, solver: str, **options) -> DiscreteSolution:

@@ -82,7 +82,9 @@ def assemble_elasticity(scene: Scene, mesh: MeshTri) -> Elasticity:
     """Stiffness K, load F = (f, v) + (q, v)_{Gamma_N}, and the free DOFs for ``mesh``."""
     basis = Basis(mesh, ElementVector(ElementTriP1()))
     lam, mu = scene.material.lame
-    K = asm(linear_elasticity(lam, mu), basis).tocsr()
+    # P1 strains are constant per element: the centroid rule is exact and 3x cheaper
+    centroid = Basis(mesh, basis.elem, quadrature=(np.full((2, 1), 1.0 / 3.0), np.array([0.5])))
+    K = asm(linear_elasticity(lam, mu), centroid).tocsr()
     F = np.zeros(basis.N)
     if scene.body_force is not None:
         @LinearForm

@@ -20,7 +20,7 @@ from skfem import MeshTri
 
 from formulations.base import ContactQP, DiscreteSolution, QPSolution, Residuals
 from formulations.contact import ContactTrace, contact_trace, gauss_legendre
-from formulations.discretisation import Discretisation
+from formulations.discretisation import Discretisation, discrete_solution
 from formulations.elasticity import assemble_elasticity
 from formulations.kkt import count_active
 from formulations.registry import register_formulation
@@ -88,15 +88,11 @@ def discretise(scene: Scene, mesh: MeshTri) -> Discretisation:
     def recover(answer: QPSolution, residuals: Residuals, status: str,
                 reason: str) -> DiscreteSolution:
         lam = np.maximum(answer.multipliers, 0.0)
-        return DiscreteSolution(
-            formulation="mixed", solver=answer.solver, elasticity=elasticity, trace=trace,
-            u=elasticity.expand(answer.u),
+        return discrete_solution(
+            "mixed", elasticity, trace, answer, residuals, status, reason, u_free=answer.u,
             pressure=lambda tt: np.repeat(lam[segment][:, None], len(tt), axis=1),
-            multiplier_breaks=breaks, residuals=residuals, status=status, reason=reason,
-            iterations=answer.iterations, solve_time=answer.solve_time,
-            active_constraints=count_active(qp, answer.u, lam), max_h_over_H=h_over_H,
-            backend=answer.backend,
-            extra={"multipliers": lam, "segment_of_facet": segment})
+            multiplier_breaks=breaks, active_constraints=count_active(qp, answer.u, lam),
+            max_h_over_H=h_over_H, extra={"multipliers": lam, "segment_of_facet": segment})
 
     return Discretisation(formulation="mixed", elasticity=elasticity, trace=trace, qp=qp,
                           recover=recover, row_coordinate=0.5 * (breaks[:-1] + breaks[1:]))

@@ -22,9 +22,9 @@ def test_help_documents_every_option():
 
 @pytest.mark.parametrize("option, value, listed", [
     ("--scene", "papr", "valid scenes: paper"),
-    ("--formulation", "mortar", "valid formulations: mixed"),
+    ("--formulation", "mortar", "valid formulations: mixed, penalty, vi"),
     ("--solver", "gurobi", "valid solvers: active-set, reference"),
-    ("--estimator", "dwr", "valid estimators: residual"),
+    ("--estimator", "dwr", "valid estimators: averaging, residual"),
     ("--strategy", "random", "valid strategys: uniform, adaptive"),
 ])
 def test_unknown_names_list_the_valid_ones(option, value, listed, capsys):

@@ -1,0 +1,112 @@
+"""``penalty``: the primal penalty method (DESIGN.md section 3).
+
+Minimise E(v) + 1/(2 eps) int_{Gamma_C} (v_n - g)_+^2 ds over P1 displacements, with
+eps = eps_0 h_e / E on each contact facet e (h_e its length, E Young's modulus). The factor
+1/E makes eps_0 dimensionless: the same eps_0 means the same relative penetration for E = 1 and
+E = 70000. The discrete pressure is lambda_h = (u_hn - g)_+ / eps (a formula, not a multiplier).
+
+Default eps_0 = 1e-3: the penalty's consistency error in the energy norm is about
+sqrt(eps) ||lambda||_{0,Gamma_C} ~ sqrt(eps_0 h) relative, i.e. 3 % of sqrt(h) -- well below the
+O(h^1/2) discretisation error of every formulation here -- while the penalty block stays within a
+factor 1/eps_0 = 1e3 of the stiffness (conditioning). Smaller eps_0 is a hard case (issue 7).
+
+The gap is the P1 interpolant g_h of g on the contact facets (as the nodal constraints of
+``vi`` see it): with the exact g, u_hn - g (linear minus curved) penetrates by O(h^2 g'') between
+any quadrature points, and lambda_h = (u_hn - g)_+ / eps would be O(E h g'' / eps_0) there,
+i.e. garbage for small eps_0 (measured: 4e5 against a true peak of 2e4 on the paper scene). The
+geometric error g - g_h is left to the estimators' contact terms, which use the exact g.
+
+The integral uses Gauss points per facet. As a QP (so that the reference and the active-set
+solvers apply unchanged), (x)_+^2 = min {s^2 : s >= x, s >= 0} gives slack unknowns s_q, one per
+quadrature point:
+
+    min 1/2 u'Ku - F'u + 1/2 sum_q D_q s_q^2   s.t.  u_n(x_q) - s_q <= g(x_q),  -s_q <= 0,
+
+with D_q = w_q h_e / eps_e = E w_q / eps_0 (Gauss weights w_q on [0, 1]). The primal-dual
+active set method on this QP is a semismooth Newton method for the penalised equation
+K u + P' D (P u - g)_+ = F (Hintermueller, Ito, Kunisch 2003).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy import sparse
+from skfem import MeshTri
+
+from formulations.base import ContactQP, DiscreteSolution, QPSolution, Residuals
+from formulations.contact import contact_trace, gauss_legendre
+from formulations.discretisation import Discretisation, discrete_solution
+from formulations.elasticity import assemble_elasticity
+from formulations.registry import register_formulation
+from scenes import Scene
+
+DEFAULT_EPSILON_0 = 1e-3
+QUADRATURE_POINTS = 2  # per contact facet
+
+
+@register_formulation("penalty", "primal penalty, eps = eps_0 h_e / E (eps_0 = 1e-3), "
+                                 "lambda_h = (u_hn - g)_+ / eps")
+def discretise(scene: Scene, mesh: MeshTri,
+               epsilon_0: float = DEFAULT_EPSILON_0) -> Discretisation:
+    if not (np.isfinite(epsilon_0) and epsilon_0 > 0):
+        raise ValueError(f"epsilon_0={epsilon_0!r} is not a finite number > 0")
+    elasticity = assemble_elasticity(scene, mesh)
+    trace = contact_trace(scene, mesh)
+    young = float(scene.material.young_modulus)
+    t, w = gauss_legendre(QUADRATURE_POINTS)
+    nf, nq = trace.size, t.size
+    n = elasticity.free.size
+    ns = nf * nq
+    ends = np.asarray(scene.gap(trace.points(np.array([0.0, 1.0])).reshape(2, -1)),
+                      dtype=float).reshape(nf, 2)
+
+    def gap_h(tt):  # the P1 interpolant of g on each facet, at local coordinates tt
+        return ends[:, :1] + (ends[:, 1:] - ends[:, :1]) * np.asarray(tt)[None, :]
+
+    gap = gap_h(t)
+
+    # P: u_n at the quadrature points (facet f, point q -> row f * nq + q)
+    dofs = elasticity.basis.nodal_dofs
+    rows = np.repeat(np.arange(ns).reshape(nf, nq), 4, axis=1).ravel()
+    shape = np.stack([1 - t, 1 - t, t, t], axis=1)  # (nq, 4): end 0 (x, y), end 1 (x, y)
+    cols = np.stack([dofs[0, trace.vertices[0]], dofs[1, trace.vertices[0]],
+                     dofs[0, trace.vertices[1]], dofs[1, trace.vertices[1]]], axis=1)
+    normal = np.stack([trace.normal[0], trace.normal[1]] * 2, axis=1)  # (nf, 4)
+    vals = (normal[:, None, :] * shape[None, :, :]).ravel()
+    P = sparse.csr_matrix((vals, (rows, np.repeat(cols, nq, axis=0).ravel())),
+                          shape=(ns, elasticity.basis.N))[:, elasticity.free]
+    eye = sparse.identity(ns, format="csr")
+    D = young / epsilon_0 * np.tile(w, nf)
+    qp = ContactQP(K=sparse.block_diag([elasticity.K_free, sparse.diags(D)], format="csr"),
+                   F=np.concatenate([elasticity.F[elasticity.free], np.zeros(ns)]),
+                   B=sparse.bmat([[P, -eye], [None, -eye]], format="csr"),
+                   G=np.concatenate([gap.ravel(), np.zeros(ns)]), row_scale=np.ones(2 * ns),
+                   objective_scale=young)
+    epsilon = epsilon_0 * trace.length / young
+    s_points = trace.coordinate[0][:, None] + np.diff(trace.coordinate, axis=0).T * t[None, :]
+
+    def transfer(previous: DiscreteSolution) -> np.ndarray:
+        pressing = previous.pressure_at(s_points.ravel()) > 0  # u_n - s <= g active
+        return np.concatenate([pressing, ~pressing]).astype(float)  # else s >= 0 active
+
+    def recover(answer: QPSolution, residuals: Residuals, status: str,
+                reason: str) -> DiscreteSolution:
+        u_free = answer.u[:n]
+        u_nodal = elasticity.nodal(elasticity.expand(u_free))
+
+        def pressure(tt):
+            tt = np.asarray(tt, dtype=float)
+            penetration = trace.normal_displacement(u_nodal, tt) - gap_h(tt)
+            return np.maximum(penetration, 0.0) / epsilon[:, None]
+
+        penetrating = int((P @ u_free - gap.ravel() > 0).sum())
+        return discrete_solution(
+            "penalty", elasticity, trace, answer, residuals, status, reason, u_free=u_free,
+            pressure=pressure, multiplier_breaks=np.append(trace.coordinate[0],
+                                                           trace.coordinate[1, -1]),
+            active_constraints=penetrating,
+            extra={"epsilon_0": epsilon_0, "epsilon": epsilon, "slacks": answer.u[n:]})
+
+    return Discretisation(formulation="penalty", elasticity=elasticity, trace=trace, qp=qp,
+                          recover=recover, row_coordinate=np.tile(s_points.ravel(), 2),
+                          transfer=transfer)

@@ -1,0 +1,92 @@
+"""pytest-benchmark benchmarks of every phase at ~10^4, 10^5 and 10^6 DOFs (paper scene, mixed
+method, uniform mesh; the workloads of ``python -m bench scaling``).
+
+The default test run executes the 10^4 size once (``--benchmark-disable`` in pyproject) so the
+benchmarks cannot rot. To measure (the larger sizes are marked slow)::
+
+    python -m pytest tests/benchmarks --benchmark-enable --benchmark-only -m "slow or not slow" \
+        --benchmark-json=benchmarks.json
+
+The reference solver is benchmarked at 10^4 and 10^5 only: at 10^6 DOFs one Clarabel solve
+takes minutes (see the README's scaling table), too long to repeat.
+"""
+
+import numpy as np
+import pytest
+
+from bench.scaling import linear_rhs, paper_problem
+from estimators import get_estimator
+from formulations import get_formulation, solve
+from formulations.solvers.backends import default_backend, factorise
+
+SIZES = ["1e4", pytest.param("1e5", marks=pytest.mark.slow),
+         pytest.param("1e6", marks=pytest.mark.slow)]
+ROUNDS = {"1e4": 5, "1e5": 3, "1e6": 1}
+
+
+@pytest.fixture(scope="module", params=SIZES)
+def problem(request):
+    scene, mesh = paper_problem(request.param)
+    disc = get_formulation("mixed")(scene, mesh)
+    return request.param, scene, mesh, disc
+
+
+def _info(benchmark, disc, **more):
+    benchmark.extra_info.update(ndofs=disc.ndofs, n_constraints=disc.qp.m,
+                                backend=default_backend(), **more)
+
+
+def _residuals(solution) -> dict:
+    return {name: float(value) for name, value in vars(solution.residuals).items()}
+
+
+def test_assembly(benchmark, problem):
+    size, scene, mesh, disc = problem
+    result = benchmark.pedantic(get_formulation("mixed"), args=(scene, mesh),
+                                rounds=ROUNDS[size], iterations=1)
+    assert result.ndofs == disc.ndofs
+    _info(benchmark, disc)
+
+
+def test_linear_solve(benchmark, problem):
+    size, _, _, disc = problem
+
+    b = linear_rhs(disc.qp)
+
+    def linear_solve():
+        return factorise(disc.qp.K)(b)
+
+    u = benchmark.pedantic(linear_solve, rounds=ROUNDS[size], iterations=1)
+    residual = np.linalg.norm(disc.qp.K @ u - b) / np.linalg.norm(b)
+    assert residual < 1e-10  # a direct solve of an SPD system with cond ~ 1e5: round-off
+    _info(benchmark, disc, relative_residual=float(residual))
+
+
+def test_fast_contact_solve(benchmark, problem):
+    size, _, _, disc = problem
+    sol = benchmark.pedantic(solve, args=(disc, "active-set"), rounds=ROUNDS[size], iterations=1)
+    assert sol.status == "ok", sol.reason
+    _info(benchmark, disc, iterations=sol.iterations, **_residuals(sol))
+
+
+@pytest.fixture(scope="module")
+def solution(problem):
+    return solve(problem[3], "active-set")
+
+
+def test_estimator(benchmark, problem, solution):
+    size, scene, _, disc = problem
+    est = benchmark.pedantic(get_estimator("residual"), args=(scene, solution),
+                             rounds=ROUNDS[size], iterations=1)
+    assert np.isfinite(est.eta) and est.eta > 0
+    _info(benchmark, disc, eta=float(est.eta))
+
+
+@pytest.mark.parametrize("size", ["1e4", pytest.param("1e5", marks=pytest.mark.slow)])
+def test_reference_solve(benchmark, size):
+    scene, mesh = paper_problem(size)
+    disc = get_formulation("mixed")(scene, mesh)
+    sol = benchmark.pedantic(solve, args=(disc, "reference"), rounds=min(ROUNDS[size], 2),
+                             iterations=1)
+    assert sol.status == "ok", sol.reason
+    _info(benchmark, disc, iterations=sol.iterations, **_residuals(sol))
