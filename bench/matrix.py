@@ -12,8 +12,23 @@ from bench.loop import LevelResult, LoopConfig, run_sequence
 from bench.provenance import provenance
 from bench.rows import ResultRow
 from bench.store import ResultStore
-from formulations import STATUS_FAILED
-from scenes import get_scene
+from estimators.base import ESTIMATORS
+from formulations import STATUS_FAILED, STATUS_SKIPPED
+from formulations.registry import FORMULATIONS
+from formulations.solvers.registry import SOLVERS
+from scenes import Scene, get_scene
+
+
+def why_skipped(scene: Scene, formulation: str, solver: str, estimator: str) -> str | None:
+    """The reason a combination is impossible (declared by the registrations), or None."""
+    return (FORMULATIONS.why_not(formulation, scene=scene)
+            or SOLVERS.why_not(solver, scene=scene, formulation=formulation)
+            or ESTIMATORS.why_not(estimator, scene=scene, formulation=formulation))
+
+
+def _whole_run_row(names: dict, status: str, reason: str) -> LevelResult:
+    """One row (level -1) standing for a whole combination that was skipped or crashed."""
+    return LevelResult(ResultRow(level=-1, status=status, reason=reason, **names), None, None)
 
 
 def run_matrix(scenes: Sequence[str], formulations: Sequence[str], solvers: Sequence[str],
@@ -21,28 +36,33 @@ def run_matrix(scenes: Sequence[str], formulations: Sequence[str], solvers: Sequ
                config: LoopConfig, on_level: Callable[[LevelResult], None] | None = None,
                scene_parameters: dict | None = None) -> list[ResultRow]:
     """Run the cross product; each finished level is stored at once. An exception inside one
-    combination becomes a ``failed`` row with the reason, and the next combination runs."""
+    combination becomes a ``failed`` row with the reason, and the next combination runs; an
+    impossible combination becomes one ``skipped`` row with the reason."""
     run_id = time.strftime("%Y%m%dT%H%M%S")
     identity = {"run_id": run_id, **provenance()}
     rows = []
+
+    def record(result: LevelResult) -> None:
+        store.append(result.row)
+        rows.append(result.row)
+        if on_level is not None:
+            on_level(result)
+
     for scene_name, formulation, solver, estimator, strategy in itertools.product(
             scenes, formulations, solvers, estimators, strategies):
         cfg = replace(config, strategy=strategy)
+        names = dict(scene=scene_name, formulation=formulation, solver=solver,
+                     estimator=estimator, strategy=strategy, marking=cfg.marking,
+                     theta=cfg.theta, **identity)
         try:
             scene = get_scene(scene_name, **(scene_parameters or {}))
+            reason = why_skipped(scene, formulation, solver, estimator)
+            if reason is not None:
+                record(_whole_run_row(names, STATUS_SKIPPED, reason))
+                continue
             for result in run_sequence(scene, formulation, solver, estimator, cfg, identity):
-                store.append(result.row)
-                rows.append(result.row)
-                if on_level is not None:
-                    on_level(result)
+                record(result)
         except Exception as error:  # recorded, never silent: the row carries type and message
-            row = ResultRow(scene=scene_name, formulation=formulation, solver=solver,
-                            estimator=estimator, strategy=strategy, level=-1,
-                            status=STATUS_FAILED, reason=f"{type(error).__name__}: {error}",
-                            marking=cfg.marking, theta=cfg.theta, **identity)
-            store.append(row)
-            rows.append(row)
-            if on_level is not None:
-                on_level(LevelResult(row, None, None))
+            record(_whole_run_row(names, STATUS_FAILED, f"{type(error).__name__}: {error}"))
             traceback.print_exc()
     return rows

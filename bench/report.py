@@ -35,7 +35,8 @@ def latest_run(table: pd.DataFrame) -> pd.DataFrame:
 def write_report(table: pd.DataFrame, out: str | Path) -> Path:
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    table = latest_run(table[table["level"] >= 0]).copy()
+    everything = latest_run(table)
+    table = everything[everything["level"] >= 0].copy()
     figure, axes = plt.subplots(figsize=(6.5, 4.5))
     lines, summary = [], []
     for key, group in table.groupby(KEYS, sort=True):
@@ -73,8 +74,8 @@ def write_report(table: pd.DataFrame, out: str | Path) -> Path:
             pd.DataFrame(summary).to_markdown(index=False, floatfmt=".5g"), "",
             "## Convergence", "", "![eta against ndofs](convergence.png)", "",
             "## Levels", "", *lines]
-    failures = table[table["status"] != "ok"]
-    text += ["## Failures", "", failures[KEYS + ["level", "status", "reason"]].to_markdown(
+    failures = everything[everything["status"] != "ok"]
+    text += ["## Failed, inaccurate and skipped rows", "", failures[KEYS + ["level", "status", "reason"]].to_markdown(
         index=False) if len(failures) else "None.", ""]
     path = out / "README.md"
     path.write_text("\n".join(text))

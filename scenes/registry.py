@@ -16,15 +16,31 @@ class Registry:
     def __init__(self, kind: str):
         self.kind = kind
         self._items: dict[str, tuple[Any, str]] = {}
+        self._applies: dict[str, Callable[..., str | None]] = {}
 
-    def register(self, name: str, description: str) -> Callable[[Any], Any]:
+    def register(self, name: str, description: str,
+                 applies: Callable[..., str | None] | None = None) -> Callable[[Any], Any]:
+        """``applies(**context)`` (optional) returns why ``name`` cannot be combined with the
+        context (e.g. scene=..., formulation=...), or None when it can."""
         def decorate(item: Any) -> Any:
             if name in self._items:
                 raise ValueError(f"{self.kind} {name!r} is already registered")
             self._items[name] = (item, description)
+            if applies is not None:
+                self._applies[name] = applies
             return item
 
         return decorate
+
+    def unregister(self, name: str) -> None:
+        self._items.pop(name, None)
+        self._applies.pop(name, None)
+
+    def why_not(self, name: str, **context) -> str | None:
+        """The reason ``name`` does not apply to ``context``, or None."""
+        self.get(name)
+        check = self._applies.get(name)
+        return check(**context) if check is not None else None
 
     def names(self) -> list[str]:
         return sorted(self._items)

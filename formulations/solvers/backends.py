@@ -103,6 +103,8 @@ def _cholmod_condensed(K, interior, contact) -> CondensedFactor:
     order = cholmod.analyze(K[interior][:, interior], ordering_method="amd").P()
     perm = np.concatenate([interior[order], contact])
     factor = cholmod.cholesky(K[perm][:, perm].tocsc(), ordering_method="natural")
+    if not np.array_equal(factor.P(), np.arange(n)):  # the trailing block must stay C
+        raise RuntimeError("CHOLMOD reordered a factorisation asked for in natural order")
     L_CC = factor.L()[n - nc:, n - nc:].toarray()
     inverse = np.empty(n, dtype=np.int64)
     inverse[perm] = np.arange(n)

@@ -1,0 +1,62 @@
+"""The penalty formulation: non-negative pressure, penetration ~ eps_0, scale invariance."""
+
+import numpy as np
+import pytest
+
+from formulations import get_formulation, solve
+from formulations.contact import gauss_legendre
+from scenes import get_scene
+
+
+def penalty_solution(epsilon_0, young_modulus=70000.0, refinements=3):
+    scene = get_scene("paper", young_modulus=young_modulus)
+    disc = get_formulation("penalty")(scene, scene.mesh.refined(refinements),
+                                      epsilon_0=epsilon_0)
+    sol = solve(disc, "active-set")
+    assert sol.status == "ok", sol.reason
+    return sol
+
+
+def max_penetration(sol):
+    # penetration against the interpolated gap, lambda_h * eps, at many points per facet
+    t = np.linspace(0.0, 1.0, 11)
+    return float((sol.pressure(t) * sol.extra["epsilon"][:, None]).max())
+
+
+def test_pressure_is_non_negative_and_matches_the_active_set():
+    sol = penalty_solution(1e-3)
+    pressure = sol.pressure(np.linspace(0.0, 1.0, 7))
+    assert pressure.min() >= 0.0 and pressure.max() > 0.0
+    assert sol.active_constraints > 0
+
+
+def test_penetration_shrinks_linearly_with_eps_0():
+    # penetration = eps lambda = eps_0 h lambda / E, and lambda converges as eps_0 -> 0, so one
+    # decade of eps_0 must remove (close to) one decade of penetration
+    penetrations = [max_penetration(penalty_solution(e)) for e in (1e-1, 1e-2, 1e-3, 1e-4)]
+    ratios = np.array(penetrations[:-1]) / np.array(penetrations[1:])
+    assert (ratios > 5.0).all(), penetrations
+
+
+def test_eps_0_means_the_same_for_every_young_modulus():
+    # eps = eps_0 h / E: the displacement does not depend on E (pure Dirichlet-obstacle
+    # loading), the pressure scales with E
+    soft, stiff = penalty_solution(1e-3, 1.0), penalty_solution(1e-3, 70000.0)
+    assert soft.u == pytest.approx(stiff.u, rel=1e-8, abs=1e-12)
+    assert 70000.0 * soft.contact_force() == pytest.approx(stiff.contact_force(), rel=1e-8)
+
+
+def test_bad_eps_0_is_refused():
+    scene = get_scene("paper")
+    with pytest.raises(ValueError, match=r"epsilon_0=0.0 is not a finite number > 0"):
+        get_formulation("penalty")(scene, scene.mesh, epsilon_0=0.0)
+
+
+def test_penalty_integral_uses_the_stated_gauss_rule():
+    # sum of the slack weights D_q / (E / eps_0) over one facet is 1 (Gauss weights on [0, 1])
+    scene = get_scene("paper")
+    disc = get_formulation("penalty")(scene, scene.mesh, epsilon_0=1e-3)
+    n = disc.elasticity.free.size
+    D = disc.qp.K.diagonal()[n:] / (70000.0 / 1e-3)
+    _, w = gauss_legendre(2)
+    assert D == pytest.approx(np.tile(w, D.size // 2), rel=1e-14)
