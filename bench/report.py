@@ -75,8 +75,9 @@ def write_report(table: pd.DataFrame, out: str | Path) -> Path:
             "## Convergence", "", "![eta against ndofs](convergence.png)", "",
             "## Levels", "", *lines]
     failures = everything[everything["status"] != "ok"]
-    text += ["## Failed, inaccurate and skipped rows", "", failures[KEYS + ["level", "status", "reason"]].to_markdown(
-        index=False) if len(failures) else "None.", ""]
+    listed = failures[KEYS + ["level", "status", "reason"]]
+    text += ["## Failed, inaccurate and skipped rows", "",
+             listed.to_markdown(index=False) if len(listed) else "None.", ""]
     path = out / "README.md"
     path.write_text("\n".join(text))
     return path
