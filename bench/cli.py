@@ -11,6 +11,7 @@ import pandas as pd
 from bench.loop import STRATEGIES, LevelResult, LoopConfig
 from bench.marking import MARKINGS
 from bench.matrix import run_matrix
+from bench.rates import write_rates
 from bench.report import write_report
 from bench.scaling import SIZES, run_scaling, write_scaling
 from bench.store import ResultStore
@@ -25,8 +26,8 @@ from formulations.solvers.backends import BACKENDS, check_backend
 from scenes import scene_descriptions, scene_names
 
 SUMMARY_COLUMNS = ["level", "ndofs", "energy", "contact_force", "active_constraints", "eta",
-                   "eta_0", "eta_geometric", "eta_complementarity", "max_h_over_H",
-                   "iterations", "backend", "t_solve", "status"]
+                   "eta_0", "eta_geometric", "eta_complementarity", "energy_error",
+                   "effectivity_index", "iterations", "t_solve", "status"]
 
 
 def _names(kind: str, valid: list[str]):
@@ -101,6 +102,10 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--cold-start", action="store_true",
                      help="solve every level from scratch instead of starting from the "
                           "previous level's contact zone (nested iteration, the default)")
+    run.add_argument("--reference-dofs", type=_positive_int("reference_dofs"), default=None,
+                     help="measure errors of scenes without an exact solution against a "
+                          "cached adaptive overkill reference with about this many DOFs "
+                          "(default: only scenes with an exact solution get errors)")
     run.add_argument("--out", default="results",
                      help="output folder for results.parquet and results.csv (default: results)")
     run.add_argument("--overwrite", action="store_true",
@@ -186,7 +191,8 @@ def main(argv: list[str] | None = None) -> int:
                         solver_options={"backend": args.backend} if args.backend else {})
     store = ResultStore(args.out, overwrite=args.overwrite)
     rows = run_matrix(args.scene, args.formulation, args.solver, args.estimator, args.strategy,
-                      store, config, on_level=_progress)
+                      store, config, on_level=_progress, reference_dofs=args.reference_dofs)
+    print(f"wrote {write_rates(store.run_table(), store.out)}")
     print()
     print(summary(store.run_table()))
     print(f"\nwrote {len(rows)} rows to {store.parquet} and {store.csv}")

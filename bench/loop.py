@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 
 from skfem import MeshTri
 
+from bench.errors import TOO_COARSE
 from bench.marking import MARKINGS, mark
 from bench.rows import ResultRow
 from estimators import get_estimator
@@ -52,11 +53,29 @@ class LevelResult:
     estimate: object | None
 
 
+def error_columns(truth, solution, estimate) -> dict:
+    """Errors against ``truth`` (``bench.truth``) and effectivity indices eta / error."""
+    start = time.perf_counter()
+    errors = truth.errors(solution)
+    out = dict(vars(errors), truth=truth.kind, reference_error=truth.estimated_error,
+               reference_too_coarse=bool(truth.estimated_error > TOO_COARSE *
+                                         errors.energy_error))
+    if estimate is not None and errors.energy_error > 0:
+        out.update(effectivity_index=estimate.eta / errors.energy_error,
+                   effectivity_0=estimate.eta_0 / errors.energy_error,
+                   effectivity_geometric=estimate.eta_geometric / errors.energy_error,
+                   effectivity_complementarity=estimate.eta_complementarity
+                   / errors.energy_error)
+    out["t_error"] = time.perf_counter() - start
+    return out
+
+
 def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
                  config: LoopConfig, identity: dict | None = None,
-                 mesh: MeshTri | None = None) -> Iterator[LevelResult]:
+                 mesh: MeshTri | None = None, truth=None) -> Iterator[LevelResult]:
     """Yield one ``LevelResult`` per level until the DOF budget or the level count is reached,
-    or a level fails (its row says why)."""
+    or a level fails (its row says why). With a ``truth`` (``bench.truth``) every level also
+    gets its errors and effectivity indices."""
     discretise, estimate = get_formulation(formulation), get_estimator(estimator)
     ident = dict(scene=scene.name, formulation=formulation, solver=solver, estimator=estimator,
                  strategy=config.strategy, marking=config.marking, theta=config.theta,
@@ -89,6 +108,8 @@ def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
         if est is not None:
             numbers.update(eta=est.eta, eta_0=est.eta_0, eta_geometric=est.eta_geometric,
                            eta_complementarity=est.eta_complementarity)
+        if truth is not None and sol.status != STATUS_FAILED:
+            numbers.update(error_columns(truth, sol, est))
         yield LevelResult(ResultRow(**ident, **numbers), sol, est)
         if sol.status == STATUS_FAILED:
             return

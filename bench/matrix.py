@@ -12,6 +12,7 @@ from bench.loop import LevelResult, LoopConfig, run_sequence
 from bench.provenance import provenance
 from bench.rows import ResultRow
 from bench.store import ResultStore
+from bench.truth import truth_for
 from estimators.base import ESTIMATORS
 from formulations import STATUS_FAILED, STATUS_SKIPPED
 from formulations.registry import FORMULATIONS
@@ -34,13 +35,16 @@ def _whole_run_row(names: dict, status: str, reason: str) -> LevelResult:
 def run_matrix(scenes: Sequence[str], formulations: Sequence[str], solvers: Sequence[str],
                estimators: Sequence[str], strategies: Sequence[str], store: ResultStore,
                config: LoopConfig, on_level: Callable[[LevelResult], None] | None = None,
-               scene_parameters: dict | None = None) -> list[ResultRow]:
+               scene_parameters: dict | None = None,
+               reference_dofs: int | None = None) -> list[ResultRow]:
     """Run the cross product; each finished level is stored at once. An exception inside one
     combination becomes a ``failed`` row with the reason, and the next combination runs; an
-    impossible combination becomes one ``skipped`` row with the reason."""
+    impossible combination becomes one ``skipped`` row with the reason. Errors are measured
+    against each scene's exact solution, or an overkill reference of ``reference_dofs`` DOFs
+    (``bench.truth``; None and no exact solution: no errors)."""
     run_id = time.strftime("%Y%m%dT%H%M%S")
     identity = {"run_id": run_id, **provenance()}
-    rows = []
+    rows, truths = [], {}
 
     def record(result: LevelResult) -> None:
         store.append(result.row)
@@ -60,7 +64,10 @@ def run_matrix(scenes: Sequence[str], formulations: Sequence[str], solvers: Sequ
             if reason is not None:
                 record(_whole_run_row(names, STATUS_SKIPPED, reason))
                 continue
-            for result in run_sequence(scene, formulation, solver, estimator, cfg, identity):
+            if scene_name not in truths:
+                truths[scene_name] = truth_for(scene, reference_dofs)
+            for result in run_sequence(scene, formulation, solver, estimator, cfg, identity,
+                                       truth=truths[scene_name]):
                 record(result)
         except Exception as error:  # recorded, never silent: the row carries type and message
             record(_whole_run_row(names, STATUS_FAILED, f"{type(error).__name__}: {error}"))

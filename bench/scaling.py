@@ -128,7 +128,13 @@ def markdown_table(frame: pd.DataFrame) -> str:
             lambda t: "not run" if t != t else f"{t:.2f}"),
         "reference / fast": frame["reference_over_fast"].map(
             lambda r: "" if r != r else f"{r:.1f}x"),
+        "energy-norm difference": frame["energy_norm_difference"].map(
+            lambda d: "" if d != d else f"{d:.1e}"),
+        "max lambda difference": frame["max_lambda_difference"].map(
+            lambda d: "" if d != d else f"{d:.1e}"),
         "estimator [s]": frame["t_estimate"].map("{:.2f}".format),
+        "peak memory without reference [GiB]": frame["peak_gib_without_reference"].map(
+            "{:.2f}".format),
         "peak memory [GiB]": frame["peak_gib"].map("{:.2f}".format),
     })
     backend = ", ".join(sorted(set(frame["backend"])))

@@ -109,12 +109,19 @@ class DiscreteSolution:
     def energy(self) -> float:
         return self.elasticity.energy(self.u)
 
-    def pressure_at(self, s: np.ndarray) -> np.ndarray:
-        """lambda_h at contact coordinates ``s``, sampled at the middle of the facet containing
-        each point (exact for piecewise constant pressures; used to transfer a contact zone)."""
-        middle = self.pressure(np.array([0.5]))[:, 0]
-        facet = np.searchsorted(self.trace.coordinate[0], np.asarray(s, dtype=float), "right")
-        return middle[np.clip(facet - 1, 0, middle.size - 1)]
+    def pressure_at(self, s: np.ndarray, samples: int = 17) -> np.ndarray:
+        """lambda_h at contact coordinates ``s``: located in its facet, interpolated linearly
+        between ``samples`` equispaced values per facet (exact for the piecewise constant and
+        piecewise linear pressures; for the penalty's kinked one, error O(h / samples)^2)."""
+        s = np.asarray(s, dtype=float)
+        t = np.linspace(0.0, 1.0, samples)
+        values = self.pressure(t)
+        s0, s1 = self.trace.coordinate
+        facet = np.clip(np.searchsorted(s0, s, "right") - 1, 0, s0.size - 1)
+        local = np.clip((s - s0[facet]) / (s1[facet] - s0[facet]), 0.0, 1.0) * (samples - 1)
+        k = np.minimum(np.floor(local).astype(int), samples - 2)
+        frac = local - k
+        return (1 - frac) * values[facet, k] + frac * values[facet, k + 1]
 
     def contact_force(self, quadrature_points: int = 4) -> float:
         """The integral of lambda_h over Gamma_C."""

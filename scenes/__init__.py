@@ -4,9 +4,9 @@ Importing this package registers every scene module listed below; adding a scene
 module with a ``@register_scene`` factory and one import line here.
 """
 
-from scenes import paper  # noqa: F401  (registers the scene)
-from scenes.base import Material, Scene, SceneError
+from scenes import free_boundary, hertz, paper  # noqa: F401  (register themselves)
+from scenes.base import ExactSolution, Material, Scene, SceneError
 from scenes.registry import get_scene, register_scene, scene_descriptions, scene_names
 
-__all__ = ["Material", "Scene", "SceneError", "get_scene", "register_scene",
+__all__ = ["ExactSolution", "Material", "Scene", "SceneError", "get_scene", "register_scene",
            "scene_descriptions", "scene_names"]

@@ -58,6 +58,19 @@ class Material:
 
 
 @dataclass(frozen=True, eq=False)
+class ExactSolution:
+    """A scene's known solution: u (``displacement(x)``, shape (2, ...)), its gradient
+    (``gradient(x)``, shape (2, 2, ...), grad[i, j] = du_i/dx_j), the contact pressure as a function
+    of the contact coordinate, and the contact-zone end points (contact coordinates)."""
+
+    displacement: PointFunction
+    gradient: PointFunction
+    pressure: Callable[[np.ndarray], np.ndarray]
+    contact_zone: tuple[float, float]
+    source: str = ""
+
+
+@dataclass(frozen=True, eq=False)
 class Scene:
     """A Signorini problem on a 2D body (DESIGN.md section 2).
 
@@ -79,6 +92,7 @@ class Scene:
     traction: PointFunction | None = None
     parameters: dict = field(default_factory=dict)
     tags: tuple[str, ...] = ()
+    exact: ExactSolution | None = None
 
     def __post_init__(self):
         _check(isinstance(self.material, Material), "material", self.material,

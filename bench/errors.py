@@ -1,0 +1,100 @@
+"""Errors of a discrete solution against the truth: an exact solution or an overkill reference.
+
+* energy-norm error ||u - u_h|| = a(u - u_h, u - u_h)^(1/2);
+* contact-pressure error ||lambda - lambda_h||_{0, Gamma_C};
+* contact-zone error: the larger distance between computed and true zone end points.
+
+Against an exact solution the integrals run over the mesh of u_h with a 6th-order rule (exact
+for u_h, accurate for the smooth u). Against a reference on another mesh they run over the
+(finer) reference mesh: u_h's gradient is found at each reference quadrature point by point
+location in u_h's mesh. When the reference mesh refines u_h's mesh (uniform or nested adaptive
+sequences) this is exact; otherwise a reference element that straddles an edge of u_h's mesh is
+integrated with u_h's gradient from one side at each point, an error confined to a layer of
+reference elements along u_h's edges (tested against nested meshes in tests/bench).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from skfem import Basis, ElementTriP1, ElementVector
+
+from formulations import DiscreteSolution
+from formulations.contact import gauss_legendre
+from formulations.elasticity import stress_from_gradient
+
+TOO_COARSE = 0.1  # a reference whose own error exceeds 10 % of the measured error is too coarse
+EXACT_INTORDER = 6
+PRESSURE_POINTS = 6  # Gauss points per contact facet for ||lambda - lambda_h||
+
+
+@dataclass(frozen=True)
+class Errors:
+    energy_error: float
+    pressure_error: float
+    zone_error: float
+    contact_zone_start: float
+    contact_zone_end: float
+
+
+def energy_density(grad: np.ndarray, lam: float, mu: float) -> np.ndarray:
+    """sigma(e) : eps(e) for the displacement gradient grad[i, j] of e."""
+    s11, s22, s12 = stress_from_gradient(grad, lam, mu)
+    return s11 * grad[0, 0] + s22 * grad[1, 1] + s12 * (grad[0, 1] + grad[1, 0])
+
+
+def element_gradients(solution: DiscreteSolution) -> np.ndarray:
+    """The constant P1 gradient per element, shape (2, 2, n_elements)."""
+    return solution.elasticity.basis.interpolate(solution.u).grad[:, :, :, 0]
+
+
+def contact_zone(solution: DiscreteSolution) -> tuple[float, float]:
+    """End points (contact coordinates) of the union of contact facets where lambda_h > 0."""
+    pressed = (solution.pressure(np.array([0.25, 0.5, 0.75])) > 0).any(axis=1)
+    if not pressed.any():
+        return float("nan"), float("nan")
+    s0, s1 = solution.trace.coordinate
+    return float(s0[pressed].min()), float(s1[pressed].max())
+
+
+def _zone_error(zone, true_zone) -> float:
+    return float(max(abs(zone[0] - true_zone[0]), abs(zone[1] - true_zone[1])))
+
+
+def pressure_error(solution: DiscreteSolution, true_pressure, trace=None) -> float:
+    """||lambda - lambda_h||_{0,Gamma_C} on the facets of ``trace`` (the finer one; default
+    u_h's), with ``true_pressure(s)`` a function of the contact coordinate."""
+    trace = solution.trace if trace is None else trace
+    t, w = gauss_legendre(PRESSURE_POINTS)
+    s = trace.coordinate[0][:, None] + np.diff(trace.coordinate, axis=0).T * t[None, :]
+    diff = true_pressure(s) - solution.pressure_at(s.ravel()).reshape(s.shape)
+    return float(np.sqrt(trace.integrate(diff**2, w).sum()))
+
+
+def exact_errors(scene, solution: DiscreteSolution) -> Errors:
+    exact = scene.exact
+    mesh = solution.elasticity.mesh
+    basis = Basis(mesh, ElementVector(ElementTriP1()), intorder=EXACT_INTORDER)
+    grad_h = basis.interpolate(solution.u).grad
+    diff = exact.gradient(basis.global_coordinates().value) - grad_h
+    density = energy_density(diff, *solution.elasticity.lame)
+    energy = float((density * basis.dx).sum())
+    zone = contact_zone(solution)
+    return Errors(np.sqrt(max(energy, 0.0)), pressure_error(solution, exact.pressure),
+                  _zone_error(zone, exact.contact_zone), *zone)
+
+
+def energy_error_on(mesh, u_nodal: np.ndarray, lame, solution: DiscreteSolution) -> float:
+    """||u - u_h|| for a P1 field u (vertex values ``u_nodal`` (2, nv)) on another ``mesh``,
+    integrated over ``mesh`` with u_h located point by point (module docstring)."""
+    basis = Basis(mesh, ElementVector(ElementTriP1()), intorder=2)
+    u = np.zeros(basis.N)
+    u[basis.nodal_dofs] = u_nodal
+    grad = basis.interpolate(u).grad  # (2, 2, nT, nq)
+    x = basis.global_coordinates().value  # (2, nT, nq)
+    finder = solution.elasticity.mesh.element_finder()
+    element = finder(x[0].ravel(), x[1].ravel())
+    grad_h = element_gradients(solution)[:, :, element].reshape(grad.shape)
+    energy = float((energy_density(grad - grad_h, *lame) * basis.dx).sum())
+    return float(np.sqrt(max(energy, 0.0)))

@@ -1,0 +1,57 @@
+"""``hertz``: Hertz's line contact, as Hertz modelled it.
+
+Hertz's 2D theory (K. L. Johnson, Contact Mechanics, 1985, sections 4.2 and 5.3) treats a
+cylinder of radius R on a rigid flat as an elastic half-space with the parabolic gap
+g(x) = x^2 / (2 R) - delta. That is exactly what this scene discretises: a block
+(-W, W) x (-D, 0) clamped on top, pushed up along its bottom edge by a rigid parabola with
+approach delta, plane strain, traction-free sides. With the contact force P per unit thickness
+and E* = E / (1 - nu^2) (a rigid flat), Hertz gives the contact half-width and peak pressure
+
+    b = sqrt(4 P R / (pi E*)),    p0 = 2 P / (pi b),    p(x) = p0 sqrt(1 - x^2 / b^2),
+
+valid while b << D and b << W (the half-space assumption); the defaults give b ~ 0.1 against
+D = W = 2. The approach delta itself has no closed form in 2D (it depends on the body's size),
+which is why the comparison is made at the computed force P.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from skfem import MeshTri
+
+from scenes.base import Material, Scene
+from scenes.registry import register_scene
+
+_TOL = 1e-10
+
+
+def hertz_prediction(scene: Scene, contact_force: float) -> dict:
+    """Hertz's half-width and peak pressure for the force ``contact_force`` (per thickness)."""
+    E, nu = scene.material.young_modulus, scene.material.poisson_ratio
+    e_star = E / (1 - nu**2)
+    b = np.sqrt(4 * contact_force * scene.parameters["radius"] / (np.pi * e_star))
+    return {"half_width": float(b), "peak_pressure": float(2 * contact_force / (np.pi * b)),
+            "e_star": float(e_star)}
+
+
+@register_scene("hertz", "Hertz line contact: a block pressed by a rigid parabola of radius R "
+                         "(half-space model), plane strain; closed-form width and peak pressure")
+def hertz(young_modulus: float = 1000.0, poisson_ratio: float = 0.3, radius: float = 1.0,
+          approach: float = 0.005, half_size: float = 2.0, initial_divisions: int = 4) -> Scene:
+    W = D = float(half_size)
+    xs = np.linspace(-W, W, initial_divisions + 1)
+    ys = np.linspace(-D, 0.0, initial_divisions // 2 + 1)
+    return Scene(
+        name="hertz",
+        description="block (-W,W)x(-D,0) pressed up by the parabola y = x^2/(2R) - delta - D",
+        mesh=MeshTri.init_tensor(xs, ys), material=Material(young_modulus, poisson_ratio,
+                                                            "strain"),
+        is_dirichlet=lambda x: np.abs(x[1]) < _TOL,
+        is_contact=lambda x: np.abs(x[1] + D) < _TOL,
+        gap=lambda x: x[0] ** 2 / (2 * radius) - approach,
+        contact_coordinate=lambda x: x[0],
+        parameters={"young_modulus": young_modulus, "poisson_ratio": poisson_ratio,
+                    "radius": radius, "approach": approach, "half_size": half_size,
+                    "initial_divisions": initial_divisions},
+        tags=("exact", "hertz"),
+    )
