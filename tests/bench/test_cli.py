@@ -21,7 +21,7 @@ def test_help_documents_every_option():
 
 
 @pytest.mark.parametrize("option, value, listed", [
-    ("--scene", "papr", "valid scenes: paper"),
+    ("--scene", "papr", "valid scenes: free-boundary, hertz, paper"),
     ("--formulation", "mortar", "valid formulations: mixed, penalty, vi"),
     ("--solver", "gurobi", "valid solvers: active-set, reference"),
     ("--estimator", "dwr", "valid estimators: averaging, residual"),

@@ -68,7 +68,7 @@ def test_paper_scene_matches_design():
 
 
 def test_unknown_scene_lists_valid_ones():
-    with pytest.raises(KeyError, match="valid scenes: paper"):
+    with pytest.raises(KeyError, match="valid scenes: free-boundary, hertz, paper"):
         get_scene("hertzz")
 
 
