@@ -132,6 +132,14 @@ def build_parser() -> argparse.ArgumentParser:
     scaling.add_argument("--readme", default=None,
                          help="also replace the table between the scaling markers of this "
                               "README (e.g. README.md)")
+    verify = sub.add_parser("verify", help="run the verification gates of bench/expected.toml "
+                            "and print a pass/fail table",
+                            description="Run small sequences on the exact-solution scenes and "
+                            "the paper scene (against a cached overkill reference), fit rates, "
+                            "compute effectivity indices and the Hertz comparison, and check "
+                            "every gate of bench/expected.toml. Exit status 1 if any fails.")
+    verify.add_argument("--out", default="results-verify",
+                        help="folder for the gate runs' results (default: results-verify)")
     sub.add_parser("list", help="list registered scenes, formulations, solvers, estimators",
                    description="List everything registered, with one line of description.")
     return parser
@@ -173,6 +181,17 @@ def main(argv: list[str] | None = None) -> int:
         frame = run_scaling(args.sizes, args.backend, args.reference_max_dofs, on_row=show)
         print(f"wrote {write_scaling(frame, args.out, args.readme)}")
         return 0
+    if args.command == "verify":
+        from bench.verify import verdict_table
+        from bench.verify import verify as run_verify
+
+        verdicts, rates, hertz = run_verify(args.out, on_level=_progress)
+        print("\n" + hertz.to_markdown(index=False, floatfmt=".4g") + "\n")
+        print(verdict_table(verdicts))
+        failed = [v for v in verdicts if not v.passed]
+        print(f"\n{len(verdicts) - len(failed)} of {len(verdicts)} gates pass"
+              f"{'' if not failed else '; FAILED: ' + ', '.join(sorted({v.gate for v in failed}))}")
+        return 1 if failed else 0
     if args.command == "report":
         source = Path(args.results) / "results.parquet"
         if not source.exists():

@@ -78,7 +78,7 @@ def exact_errors(scene, solution: DiscreteSolution) -> Errors:
     mesh = solution.elasticity.mesh
     basis = Basis(mesh, ElementVector(ElementTriP1()), intorder=EXACT_INTORDER)
     grad_h = basis.interpolate(solution.u).grad
-    diff = exact.gradient(basis.global_coordinates().value) - grad_h
+    diff = exact.gradient(np.asarray(basis.global_coordinates())) - grad_h
     density = energy_density(diff, *solution.elasticity.lame)
     energy = float((density * basis.dx).sum())
     zone = contact_zone(solution)
@@ -104,7 +104,7 @@ def energy_error_on(mesh, u_nodal: np.ndarray, lame, solution: DiscreteSolution)
     u = np.zeros(basis.N)
     u[basis.nodal_dofs] = u_nodal
     grad = basis.interpolate(u).grad  # (2, 2, nT, nq)
-    x = basis.global_coordinates().value  # (2, nT, nq)
+    x = np.asarray(basis.global_coordinates())  # (2, nT, nq)
     element = locate(solution.elasticity.mesh, x[0].ravel(), x[1].ravel())
     grad_h = element_gradients(solution)[:, :, element].reshape(grad.shape)
     energy = float((energy_density(grad - grad_h, *lame) * basis.dx).sum())
