@@ -1,8 +1,9 @@
-"""Command line: ``python -m bench run|report|scaling|list``."""
+"""Command line: ``python -m bench run|compare|report|scaling|verify|list``."""
 
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 from pathlib import Path
 
@@ -50,6 +51,18 @@ def _positive_int(name: str):
             value = None
         if value is None or value <= 0:
             raise argparse.ArgumentTypeError(f"{name}={text!r} is not a positive integer")
+        return value
+    return parse
+
+
+def _non_negative_int(name: str):
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            value = -1
+        if value < 0:
+            raise argparse.ArgumentTypeError(f"{name}={text!r} is not an integer >= 0")
         return value
     return parse
 
@@ -106,6 +119,9 @@ def build_parser() -> argparse.ArgumentParser:
                      help="measure errors of scenes without an exact solution against a "
                           "cached adaptive overkill reference with about this many DOFs "
                           "(default: only scenes with an exact solution get errors)")
+    run.add_argument("--crosscheck-dofs", type=_non_negative_int("crosscheck_dofs"), default=0,
+                     help="also solve levels with at most this many DOFs with the reference "
+                          "solver and record the differences (default: 0, never)")
     run.add_argument("--out", default="results",
                      help="output folder for results.parquet and results.csv (default: results)")
     run.add_argument("--overwrite", action="store_true",
@@ -132,6 +148,20 @@ def build_parser() -> argparse.ArgumentParser:
     scaling.add_argument("--readme", default=None,
                          help="also replace the table between the scaling markers of this "
                               "README (e.g. README.md)")
+    compare = sub.add_parser(
+        "compare", help="the default comparison (the README's main job): run, then report",
+        description="Run every scene x formulation x estimator x {uniform, adaptive} with the "
+        "active-set solver (cross-checked by the reference on small levels), errors against "
+        "exact solutions or cached overkill references, then render the report.")
+    compare.add_argument("--max-dofs", type=_positive_int("max_dofs"), default=20000,
+                         help="DOF budget per sequence (default: 20000)")
+    compare.add_argument("--reference-dofs", type=_positive_int("reference_dofs"),
+                         default=500000, help="overkill reference size (default: 500000)")
+    compare.add_argument("--crosscheck-dofs", type=_non_negative_int("crosscheck_dofs"),
+                         default=3000, help="cross-check levels up to this size with the "
+                         "reference solver (default: 3000)")
+    compare.add_argument("--out", default="results", help="results folder (default: results)")
+    compare.add_argument("--reports", default="reports", help="report folder (default: reports)")
     verify = sub.add_parser("verify", help="run the verification gates of bench/expected.toml "
                             "and print a pass/fail table",
                             description="Run small sequences on the exact-solution scenes and "
@@ -197,8 +227,28 @@ def main(argv: list[str] | None = None) -> int:
         if not source.exists():
             print(f"error: --results={args.results!r} holds no results.parquet", file=sys.stderr)
             return 2
-        print(f"wrote {write_report(pd.read_parquet(source), args.out)}")
+        print(f"wrote {write_report(pd.read_parquet(source), args.out, args.results)}")
         return 0
+    if args.command == "compare":
+        return _compare(args)
+    return _run(args, " ".join(["python -m bench", *(argv if argv is not None else
+                                                       sys.argv[1:])]))
+
+
+def _compare(args) -> int:
+    argv = ["run", "--scene", ",".join(scene_names()), "--formulation",
+            ",".join(formulation_names()), "--solver", "active-set", "--estimator",
+            ",".join(estimator_names()), "--strategy", "uniform,adaptive", "--max-dofs",
+            str(args.max_dofs), "--reference-dofs", str(args.reference_dofs),
+            "--crosscheck-dofs", str(args.crosscheck_dofs), "--out", args.out, "--overwrite"]
+    command = "python -m bench compare (= python -m bench " + " ".join(argv) + ")"
+    status = _run(build_parser().parse_args(argv), command)
+    source = Path(args.out) / "results.parquet"
+    print(f"wrote {write_report(pd.read_parquet(source), args.reports, args.out, command)}")
+    return status
+
+
+def _run(args, command: str) -> int:
     if args.backend is not None:
         try:
             check_backend(args.backend)
@@ -209,8 +259,12 @@ def main(argv: list[str] | None = None) -> int:
                         marking=args.marking, theta=args.theta, nested=not args.cold_start,
                         solver_options={"backend": args.backend} if args.backend else {})
     store = ResultStore(args.out, overwrite=args.overwrite)
+    configuration = {k: v for k, v in vars(args).items() if k != "command"}
+    (store.out / "run.json").write_text(json.dumps(
+        {"command": command, "configuration": configuration}, indent=1, default=str))
     rows = run_matrix(args.scene, args.formulation, args.solver, args.estimator, args.strategy,
-                      store, config, on_level=_progress, reference_dofs=args.reference_dofs)
+                      store, config, on_level=_progress, reference_dofs=args.reference_dofs,
+                      crosscheck_dofs=args.crosscheck_dofs)
     print(f"wrote {write_rates(store.run_table(), store.out)}")
     print()
     print(summary(store.run_table()))

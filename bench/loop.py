@@ -6,6 +6,7 @@ import time
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 
+import numpy as np
 from skfem import MeshTri
 
 from bench.errors import TOO_COARSE
@@ -70,9 +71,28 @@ def error_columns(truth, solution, estimate) -> dict:
     return out
 
 
+def crosscheck_columns(disc, sol) -> dict:
+    """Solve the same discrete problem with the reference solver and compare: relative
+    energy-norm difference of u_h and max pressure difference relative to max lambda_h."""
+    judge = solve(disc, "reference")
+    out = {"crosscheck_status": judge.status}
+    if judge.status == STATUS_FAILED:
+        return out
+    K = disc.elasticity.K
+    du = sol.u - judge.u
+    t = np.linspace(0.0, 1.0, 5)
+    lam_fast, lam_ref = sol.pressure(t), judge.pressure(t)
+    out.update(crosscheck_energy_difference=float(np.sqrt(du @ K @ du) /
+                                                  max(np.sqrt(judge.u @ K @ judge.u), 1e-300)),
+               crosscheck_pressure_difference=float(np.abs(lam_fast - lam_ref).max() /
+                                                    max(np.abs(lam_ref).max(), 1e-300)))
+    return out
+
+
 def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
                  config: LoopConfig, identity: dict | None = None,
-                 mesh: MeshTri | None = None, truth=None) -> Iterator[LevelResult]:
+                 mesh: MeshTri | None = None, truth=None,
+                 crosscheck_dofs: int = 0) -> Iterator[LevelResult]:
     """Yield one ``LevelResult`` per level until the DOF budget or the level count is reached,
     or a level fails (its row says why). With a ``truth`` (``bench.truth``) every level also
     gets its errors and effectivity indices."""
@@ -110,6 +130,8 @@ def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
                            eta_complementarity=est.eta_complementarity)
         if truth is not None and sol.status != STATUS_FAILED:
             numbers.update(error_columns(truth, sol, est))
+        if solver != "reference" and disc.ndofs <= crosscheck_dofs and sol.status != STATUS_FAILED:
+            numbers.update(crosscheck_columns(disc, sol))
         yield LevelResult(ResultRow(**ident, **numbers), sol, est)
         if sol.status == STATUS_FAILED:
             return

@@ -1,29 +1,34 @@
-"""A first comparison report, a pure function of a results table: Markdown + convergence plot.
-
-Rates are least-squares slopes of log(eta) against log(ndofs) over the last levels; in 2D,
-O(h^1/2) is slope -1/4 and O(h) is slope -1/2 (DESIGN.md section 4).
-"""
+"""The comparison report: ``reports/README.md`` and ONE self-contained ``reports/index.html``,
+rendered by Jinja2 templates (``bench/templates``) from the same data, a pure function of a
+results folder (results.parquet, plus artifacts/, truth.json and run.json when present)."""
 
 from __future__ import annotations
 
+import base64
+import io
+import json
 from pathlib import Path
 
-import matplotlib
+import jinja2
+import matplotlib.pyplot as plt
+import numpy as np
+import pandas as pd
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-import pandas as pd  # noqa: E402
+from bench import figures
+from bench.artifacts import artifact_path, load_artifact
+from bench.rates import RATE_LEVELS, rates_table
+from bench.report_tables import (
+    accuracy_table,
+    agreement_table,
+    effectivity_table,
+    failure_table,
+    rate_verdicts,
+    timing_table,
+)
+from bench.rows import COLUMNS
 
 KEYS = ["scene", "formulation", "solver", "estimator", "strategy"]
-RATE_LEVELS = 4  # fit the slope over the last 4 levels (pre-asymptotic levels are left out)
-
-
-def eta_rate(group: pd.DataFrame, levels: int = RATE_LEVELS) -> float:
-    ok = group[(group["status"] == "ok") & (group["eta"] > 0)].tail(levels)
-    if len(ok) < 2:
-        return float("nan")
-    return float(np.polyfit(np.log(ok["ndofs"]), np.log(ok["eta"]), 1)[0])
+TEMPLATES = Path(__file__).with_name("templates")
 
 
 def latest_run(table: pd.DataFrame) -> pd.DataFrame:
@@ -32,52 +37,144 @@ def latest_run(table: pd.DataFrame) -> pd.DataFrame:
     return table[table["run_id"] == last]
 
 
-def write_report(table: pd.DataFrame, out: str | Path) -> Path:
+class Figures:
+    """Saves each figure as PNG under ``out/figures`` and keeps its base64 for the HTML."""
+
+    def __init__(self, out: Path):
+        self.out = out / "figures"
+        self.out.mkdir(parents=True, exist_ok=True)
+        self.items: list[dict] = []
+
+    def add(self, figure, name: str, caption: str) -> dict | None:
+        if figure is None:
+            return None
+        buffer = io.BytesIO()
+        figure.savefig(buffer, format="png", dpi=110)
+        plt.close(figure)
+        data = buffer.getvalue()
+        (self.out / f"{name}.png").write_bytes(data)
+        item = {"file": f"figures/{name}.png", "caption": caption,
+                "data": base64.b64encode(data).decode("ascii")}
+        self.items.append(item)
+        return item
+
+
+def _artifacts(results: Path | None, group: pd.DataFrame) -> dict:
+    out = {}
+    if results is None:
+        return out
+    for _, row in group.drop_duplicates(KEYS).iterrows():
+        data = load_artifact(artifact_path(results, row))
+        if data is not None:
+            out[(row["formulation"], row["estimator"], row["strategy"])] = data
+    return out
+
+
+def _scene(name: str):
+    from scenes import get_scene
+
+    try:
+        return get_scene(name)
+    except KeyError:
+        return None
+
+
+def _pressure_curve(scene, artifacts: dict):
+    if scene is None:
+        return None
+    if scene.exact is not None:
+        s = np.linspace(*np.sort(scene.contact_coordinate(scene.mesh.p))[[0, -1]], 801)
+        return s, scene.exact.pressure(s), "exact pressure"
+    if scene.name == "hertz" and artifacts:
+        from scenes.hertz import hertz_prediction
+
+        data = next(iter(v for k, v in sorted(artifacts.items()) if k[2] == "adaptive"), None)
+        if data is None:
+            return None
+        hertz = hertz_prediction(scene, float(data["contact_force"]))
+        s = np.linspace(-1.5 * hertz["half_width"], 1.5 * hertz["half_width"], 601)
+        values = hertz["peak_pressure"] * np.sqrt(np.clip(1 - (s / hertz["half_width"])**2, 0,
+                                                          None))
+        return s, values, f"Hertz, b = {hertz['half_width']:.4g}, p0 = {hertz['peak_pressure']:.4g}"
+    return None
+
+
+def scene_section(name: str, group: pd.DataFrame, results: Path | None, figs: Figures,
+                  truth: dict) -> dict:
+    scene = _scene(name)
+    artifacts = _artifacts(results, group)
+    section = {"name": name, "truth": truth.get(name, {"kind": "unknown"}), "figures": []}
+    preferred = artifacts.get(("mixed", "residual", "adaptive")) or next(
+        iter(v for k, v in sorted(artifacts.items()) if k[2] == "adaptive"), None)
+    for figure, suffix, caption in (
+            (figures.scene_picture(scene) if scene is not None else None, "scene",
+             "Geometry (initial mesh), boundary parts and the obstacle."),
+            (figures.convergence(group), "convergence",
+             "Error and estimator against ndofs, uniform (squares) and adaptive (circles), with "
+             "O(h^1/2) and O(h) slope triangles (the paper's Figure 2)."),
+            (figures.effectivity(group), "effectivity",
+             "Effectivity index eta / ||u - u_h||; crosses mark rows whose reference is too "
+             "coarse."),
+            (figures.work_precision(group), "work-precision",
+             "Work-precision: error (eta without a truth) against cumulative wall time and "
+             "against the level's solve time."),
+            (figures.meshes(artifacts), "meshes",
+             "Final adaptive meshes per formulation/estimator (the paper's Figure 1b)."),
+            (figures.deformed(preferred, name), "deformed",
+             "Deformed body coloured by von Mises stress; the colour scale is clipped at the "
+             f"{figures.VON_MISES_PERCENTILE:g}th percentile because the stress is singular at "
+             "the clamped corners (the paper's Figure 1a)."),
+            (figures.pressures(artifacts, _pressure_curve(scene, artifacts)), "pressure",
+             "Contact pressure lambda_h along Gamma_C (adaptive, last level) per formulation; "
+             "dotted lines are the contact-zone end points.")):
+        item = figs.add(figure, f"{name}-{suffix}", caption)
+        if item is not None:
+            section["figures"].append(item)
+    if scene is None:
+        section["missing"] = f"scene {name!r} is not registered here: no picture"
+    return section
+
+
+def write_report(table: pd.DataFrame, out: str | Path, results: str | Path | None = None,
+                 command: str = "") -> Path:
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    everything = latest_run(table)
-    table = everything[everything["level"] >= 0].copy()
-    figure, axes = plt.subplots(figsize=(6.5, 4.5))
-    lines, summary = [], []
-    for key, group in table.groupby(KEYS, sort=True):
-        ok = group[group["status"] == "ok"]
-        label = "/".join(map(str, key))
-        axes.loglog(ok["ndofs"], ok["eta"], "o-" if key[-1] == "adaptive" else "s--",
-                    label=label, markersize=3)
-        last = group.iloc[-1]
-        summary.append({**dict(zip(KEYS, key, strict=True)), "levels": len(group),
-                        "ndofs": last["ndofs"], "energy": last["energy"],
-                        "contact_force": last["contact_force"], "eta": last["eta"],
-                        "eta_0": last["eta_0"], "eta_geometric": last["eta_geometric"],
-                        "eta_complementarity": last["eta_complementarity"],
-                        "eta_rate": eta_rate(group), "status": last["status"]})
-        lines += [f"### {label}", "", group[["level", "ndofs", "energy", "contact_force",
-                  "eta", "eta_0", "eta_geometric", "eta_complementarity", "iterations",
-                  "t_solve", "status"]].to_markdown(index=False, floatfmt=".5g"), ""]
-    n = np.array([1e2, 1e4])
-    for slope, style in ((-0.25, ":"), (-0.5, "-.")):
-        axes.loglog(n, 30 * (n / n[0]) ** slope, "k" + style, linewidth=0.8,
-                    label=f"slope {slope} (O(h^{-2 * slope:g}))")
-    axes.set_xlabel("ndofs")
-    axes.set_ylabel("eta")
-    axes.legend(fontsize=7)
-    axes.grid(True, which="both", alpha=0.3)
-    figure.tight_layout()
-    figure.savefig(out / "convergence.png", dpi=120)
-    plt.close(figure)
-    head = table.iloc[0]
-    text = ["# signorini-bench report", "",
-            f"Commit `{head['commit']}`, {head['versions']}, machine: {head['machine']}.", "",
-            "## Summary (last level of each combination)", "",
-            f"`eta_rate` is the slope of log(eta) against log(ndofs) over the last "
-            f"{RATE_LEVELS} levels: -1/4 is O(h^1/2), -1/2 is O(h).", "",
-            pd.DataFrame(summary).to_markdown(index=False, floatfmt=".5g"), "",
-            "## Convergence", "", "![eta against ndofs](convergence.png)", "",
-            "## Levels", "", *lines]
-    failures = everything[everything["status"] != "ok"]
-    listed = failures[KEYS + ["level", "status", "reason"]]
-    text += ["## Failed, inaccurate and skipped rows", "",
-             listed.to_markdown(index=False) if len(listed) else "None.", ""]
+    results = Path(results) if results is not None else None
+    missing = [c for c in COLUMNS if c not in table.columns]
+    table = table.reindex(columns=list(dict.fromkeys([*COLUMNS, *table.columns])))
+    everything = latest_run(table) if len(table) else table
+    rows = everything[everything["level"] >= 0]
+    run_info = {}
+    if results is not None and (results / "run.json").exists():
+        run_info = json.loads((results / "run.json").read_text())
+    truth = {}
+    if results is not None and (results / "truth.json").exists():
+        truth = json.loads((results / "truth.json").read_text())
+    figs = Figures(out)
+    scenes = [scene_section(name, group, results, figs, truth)
+              for name, group in rows.groupby("scene", sort=True)]
+    rates = rates_table(rows) if len(rows) else pd.DataFrame()
+    head = everything.iloc[0] if len(everything) else pd.Series(dtype=object)
+    context = {
+        "command": command or run_info.get("command", "(not recorded)"),
+        "configuration": run_info.get("configuration", {}),
+        "commit": head.get("commit", ""), "versions": head.get("versions", ""),
+        "machine": head.get("machine", ""), "python": head.get("python", ""),
+        "rate_levels": RATE_LEVELS, "missing_columns": missing, "scenes": scenes,
+        "tables": {
+            "rates": rate_verdicts(rates), "effectivity": effectivity_table(rates),
+            "accuracy": accuracy_table(rows), "timing": timing_table(rows),
+            "agreement": agreement_table(rows), "failures": failure_table(everything)},
+        "n_rows": len(everything), "n_too_coarse": int(rows["reference_too_coarse"]
+                                                        .fillna(False).astype(bool).sum()),
+    }
+    env = jinja2.Environment(loader=jinja2.FileSystemLoader(TEMPLATES),
+                             autoescape=jinja2.select_autoescape(["html", "html.j2"]),
+                             undefined=jinja2.StrictUndefined, trim_blocks=True,
+                             lstrip_blocks=True)
+    env.filters["markdown_table"] = lambda t: t.to_markdown(index=False) if len(t) else "None."
+    env.filters["records"] = lambda t: t.to_dict("records")
+    (out / "index.html").write_text(env.get_template("report.html.j2").render(**context))
     path = out / "README.md"
-    path.write_text("\n".join(text))
+    path.write_text(env.get_template("report.md.j2").render(**context))
     return path

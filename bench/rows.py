@@ -57,6 +57,9 @@ class ResultRow:
     reference_error: float = math.nan
     reference_too_coarse: bool = False
     t_error: float = math.nan
+    crosscheck_status: str = ""
+    crosscheck_energy_difference: float = math.nan
+    crosscheck_pressure_difference: float = math.nan
     marking: str = ""
     theta: float = math.nan
     run_id: str = ""
