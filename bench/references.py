@@ -14,6 +14,7 @@ assembly or a formulation changes). The folder is ``$SIGNORINI_BENCH_CACHE`` or
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import os
@@ -23,7 +24,14 @@ from pathlib import Path
 import numpy as np
 from skfem import MeshTri
 
-from bench.errors import Errors, _zone_error, contact_zone, energy_error_on, pressure_error
+from bench.errors import (
+    Errors,
+    P1Field,
+    _zone_error,
+    contact_zone,
+    energy_error_on,
+    pressure_error,
+)
 from bench.loop import LoopConfig, run_sequence
 from formulations import DiscreteSolution
 
@@ -49,9 +57,13 @@ class Reference:
     def pressure(self, s: np.ndarray) -> np.ndarray:
         return np.interp(s, self.pressure_s, self.pressure_values)
 
+    @functools.cached_property
+    def field(self) -> P1Field:
+        return P1Field.from_nodal(self.mesh, self.u_nodal)
+
     def errors(self, solution: DiscreteSolution) -> Errors:
         zone = contact_zone(solution)
-        return Errors(energy_error_on(self.mesh, self.u_nodal, self.lame, solution),
+        return Errors(energy_error_on(self.field, self.lame, solution),
                       pressure_error(solution, self.pressure), _zone_error(zone, self.zone),
                       *zone)
 
@@ -90,8 +102,8 @@ def build_reference(scene, max_dofs: int) -> Reference:
         previous, last = last, result
     sol = last.solution
     u_nodal = sol.elasticity.nodal(sol.u)
-    difference = energy_error_on(sol.elasticity.mesh, u_nodal, sol.elasticity.lame,
-                                 previous.solution)
+    difference = energy_error_on(P1Field.from_nodal(sol.elasticity.mesh, u_nodal),
+                                 sol.elasticity.lame, previous.solution)
     ratio = last.row.ndofs / previous.row.ndofs
     s, values = _sampled_pressure(sol)
     return Reference(key=reference_key(scene, max_dofs), mesh=sol.elasticity.mesh,

@@ -5,7 +5,7 @@ import pytest
 from skfem import Basis, ElementTriP1, ElementVector
 
 from bench import references
-from bench.errors import energy_density, energy_error_on, exact_errors
+from bench.errors import P1Field, energy_density, energy_error_on, exact_errors
 from formulations import get_formulation, solve
 from scenes import get_scene
 
@@ -34,7 +34,7 @@ def test_transfer_is_exact_on_nested_meshes():
     coarse, fine = scene.mesh.refined(2), scene.mesh.refined(4)
     sol, ref = solved(scene, coarse), solved(scene, fine)
     ref_nodal = ref.elasticity.nodal(ref.u)
-    via_location = energy_error_on(fine, ref_nodal, ref.elasticity.lame, sol)
+    via_location = energy_error_on(P1Field.from_nodal(fine, ref_nodal), ref.elasticity.lame, sol)
     basis = ref.elasticity.basis
     interpolated = np.zeros(basis.N)
     interpolated[basis.nodal_dofs] = _interpolate(sol, fine.p)
