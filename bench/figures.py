@@ -86,6 +86,7 @@ def effectivity(table: pd.DataFrame):
         coarse = ok[ok["reference_too_coarse"].astype(bool)]
         ax.semilogx(coarse["ndofs"], coarse["effectivity_index"], "x", color="k", markersize=5)
     ax.axhline(1.0, color="k", linewidth=0.6)
+    ax.set_yscale("log")  # coarse levels can be off by 100x and would flatten the rest
     ax.set_xlabel("ndofs")
     ax.set_ylabel("eta / ||u - u_h||")
     ax.grid(True, which="both", alpha=0.3)

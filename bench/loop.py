@@ -10,7 +10,7 @@ import numpy as np
 from skfem import MeshTri
 
 from bench.errors import TOO_COARSE
-from bench.marking import MARKINGS, mark
+from bench.marking import MARKINGS, grade_contact_trace, mark
 from bench.rows import ResultRow
 from estimators import get_estimator
 from formulations import STATUS_FAILED, get_formulation, solve
@@ -30,6 +30,7 @@ class LoopConfig:
     marking: str = "doerfler"
     theta: float = 0.5
     nested: bool = True
+    grade_contact: bool = True  # 2:1 grading closure along Gamma_C (bench.marking)
     solver_options: dict = field(default_factory=dict)
 
     def __post_init__(self):
@@ -139,7 +140,12 @@ def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
         if config.strategy == "uniform":
             refined = mesh.refined()
         else:
-            refined = mesh.refined(mark(est.indicators, config.marking, config.theta))
+            marked = mark(est.indicators, config.marking, config.theta)
+            if config.grade_contact:
+                trace = sol.trace
+                marked = grade_contact_trace(marked, trace.length, trace.element,
+                                             trace.coordinate, mesh.t.shape[1])
+            refined = mesh.refined(marked)
         t_refine = time.perf_counter() - start
         mesh = refined
 

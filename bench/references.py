@@ -35,7 +35,7 @@ from bench.errors import (
 from bench.loop import LoopConfig, run_sequence
 from formulations import DiscreteSolution
 
-ASSEMBLY_VERSION = 1
+ASSEMBLY_VERSION = 2  # 2: greedy multiplier segments, contact grading closure
 RECIPE = {"formulation": "mixed", "solver": "active-set", "estimator": "residual",
           "strategy": "adaptive", "marking": "doerfler", "theta": 0.5}
 

@@ -4,12 +4,13 @@ lambda_H is piecewise constant on a contact mesh T_{C,H} coarser than the trace 
 min 1/2 u'Ku - F'u s.t. Bu <= G with B_ij = int_{S_i} phi_j . n ds and G_i = int_{S_i} g ds, so
 the KKT multiplier of row i is the value of lambda_H on segment S_i.
 
-Contact mesh (h/H <= 1/2 by construction, on uniform and adaptive meshes alike). Every contact
-facet is a dyadic piece of an initial contact facet (scikit-fem's red and red-green-blue
-refinements bisect edges). A facet's *parent* is the dyadic interval one level up; the parent of
-an initial facet is its pair of initial facets. Dyadic intervals are nested or disjoint, so the
-maximal parents partition Gamma_C; these are the multiplier segments, and every facet is at most
-half of the segment containing it.
+Contact mesh (h/H <= 1/2 by construction, on uniform and adaptive meshes alike): the segments
+are runs of consecutive contact facets, each as short as possible subject to every facet in it
+being at most half its length. On a uniform trace that pairs neighbouring facets (H = 2h, as in
+the paper); on a graded trace the segments follow the grading. (An earlier construction used the
+maximal dyadic parents of the facets; on graded traces those stay as coarse as the coarsest
+facet around, and on the Hertz scene, whose contact zone is smaller than one initial facet, the
+multiplier mesh then lagged the refinement by a dozen levels.)
 """
 
 from __future__ import annotations
@@ -19,7 +20,7 @@ from scipy import sparse
 from skfem import MeshTri
 
 from formulations.base import ContactQP, DiscreteSolution, QPSolution, Residuals
-from formulations.contact import ContactTrace, contact_trace, gauss_legendre
+from formulations.contact import contact_trace, gauss_legendre
 from formulations.discretisation import Discretisation, discrete_solution
 from formulations.elasticity import assemble_elasticity
 from formulations.kkt import count_active
@@ -29,35 +30,30 @@ from scenes import Scene
 GAP_QUADRATURE_POINTS = 6  # G_i = int g: g is smooth on each facet; 6 Gauss points is plenty
 
 
-class NotDyadicError(ValueError):
-    """The contact trace is not a bisection refinement of the initial mesh's trace."""
+def multiplier_segments(lengths: np.ndarray) -> np.ndarray:
+    """Segment index of every contact facet (facets in order along Gamma_C), see the module
+    docstring: greedy runs of consecutive facets, each closed as soon as its length reaches
+    twice its longest facet; a short remainder is merged backwards until it qualifies.
 
-
-def multiplier_segments(trace: ContactTrace, initial: ContactTrace) -> np.ndarray:
-    """Segment index of every contact facet (see the module docstring)."""
-    breaks = np.append(initial.coordinate[0], initial.coordinate[1, -1])
-    n0 = breaks.size - 1
-    tol = 1e-9 * (breaks[-1] - breaks[0])
-    s0, s1 = trace.coordinate
-    root = np.clip(np.searchsorted(breaks, 0.5 * (s0 + s1)) - 1, 0, n0 - 1)
-    width = breaks[root + 1] - breaks[root]
-    a, b = (s0 - breaks[root]) / width, (s1 - breaks[root]) / width
-    level = np.rint(-np.log2(b - a)).astype(int)
-    index = np.rint(a * 2.0**level).astype(int)
-    if (np.abs(b - a - 2.0**-level) > 1e-8).any() or (np.abs(a - index * 2.0**-level) > 1e-8).any():
-        raise NotDyadicError("the mixed formulation needs a contact trace obtained by bisecting "
-                             "the initial mesh's contact facets")
-    # parent interval: dyadic one level up, or the pair of initial facets for level 0
-    parent_width = 2.0 ** (1 - level)
-    p0 = breaks[root] + width * (index // 2) * parent_width
-    p1 = p0 + width * parent_width
-    pair = np.minimum(root // 2, max(n0 // 2 - 1, 0))
-    top = level == 0
-    p0[top] = breaks[2 * pair[top]]
-    p1[top] = breaks[np.where(2 * pair[top] + 2 >= n0 - 1, n0, 2 * pair[top] + 2)]
-    covered = np.maximum.accumulate(np.concatenate([[-np.inf], p1[:-1]]))
-    starts = p0 >= covered - tol
-    return np.cumsum(starts) - 1
+    A sequential scan over the contact facets only (O(n) with n ~ sqrt(ndofs)); the rule
+    depends on the running maximum, which has no closed vectorised form."""
+    tol = 1e-12 * float(lengths.sum())
+    ends, run_length, run_max = [], 0.0, 0.0
+    for k, h in enumerate(lengths):
+        run_length, run_max = run_length + h, max(run_max, h)
+        if run_length >= 2.0 * run_max - tol:
+            ends.append(k + 1)
+            run_length, run_max = 0.0, 0.0
+    if not ends or ends[-1] != lengths.size:
+        ends = ends[:-1] + [lengths.size]  # merge the remainder with the run before it
+        while len(ends) > 1:
+            tail = lengths[ends[-2]:]
+            if tail.sum() >= 2.0 * tail.max() - tol:
+                break
+            del ends[-2]
+    starts = np.zeros(lengths.size, dtype=int)
+    starts[np.array(ends[:-1], dtype=int)] = 1
+    return np.cumsum(starts)
 
 
 @register_formulation("mixed", "Haslinger's mixed method: piecewise constant multiplier on a "
@@ -65,7 +61,7 @@ def multiplier_segments(trace: ContactTrace, initial: ContactTrace) -> np.ndarra
 def discretise(scene: Scene, mesh: MeshTri) -> Discretisation:
     elasticity = assemble_elasticity(scene, mesh)
     trace = contact_trace(scene, mesh)
-    segment = multiplier_segments(trace, contact_trace(scene, scene.mesh))
+    segment = multiplier_segments(trace.length)
     m = int(segment.max()) + 1
     H = np.bincount(segment, weights=trace.length, minlength=m)
     h_over_H = float((trace.length / H[segment]).max())

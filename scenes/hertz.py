@@ -37,7 +37,7 @@ def hertz_prediction(scene: Scene, contact_force: float) -> dict:
 @register_scene("hertz", "Hertz line contact: a block pressed by a rigid parabola of radius R "
                          "(half-space model), plane strain; closed-form width and peak pressure")
 def hertz(young_modulus: float = 1000.0, poisson_ratio: float = 0.3, radius: float = 1.0,
-          approach: float = 0.005, half_size: float = 2.0, initial_divisions: int = 4) -> Scene:
+          approach: float = 0.005, half_size: float = 2.0, initial_divisions: int = 16) -> Scene:
     W = D = float(half_size)
     xs = np.linspace(-W, W, initial_divisions + 1)
     ys = np.linspace(-D, 0.0, initial_divisions // 2 + 1)

@@ -5,7 +5,6 @@ import pytest
 
 from conftest import square_scene
 from formulations import get_formulation, solve
-from formulations.contact import contact_trace
 from formulations.mixed import multiplier_segments
 from scenes import get_scene
 
@@ -17,7 +16,7 @@ def test_B_integrates_normal_displacement_and_G_integrates_a_linear_gap_exactly(
     scene = square_scene(lambda x: a * x[0] + b, divisions=4)
     disc = discretise(scene, scene.mesh.refined(2))
     trace = disc.trace
-    seg = multiplier_segments(trace, contact_trace(scene, scene.mesh))
+    seg = multiplier_segments(trace.length)
     x0 = np.array([trace.coordinate[0, seg == i].min() for i in range(disc.qp.m)])
     x1 = np.array([trace.coordinate[1, seg == i].max() for i in range(disc.qp.m)])
     assert disc.qp.G == pytest.approx(a * (x1**2 - x0**2) / 2 + b * (x1 - x0), rel=1e-13)
@@ -48,12 +47,25 @@ def test_contact_mesh_satisfies_h_over_H_on_adaptive_meshes():
         mesh = mesh.refined(np.sort(marked))
         disc = discretise(scene, mesh)
         trace = disc.trace
-        seg = multiplier_segments(trace, contact_trace(scene, scene.mesh))
+        seg = multiplier_segments(trace.length)
         H = np.bincount(seg, trace.length)
         assert (trace.length / H[seg]).max() <= 0.5 + 1e-12
         # segments are contiguous and cover Gamma_C
         assert (np.diff(seg) >= 0).all() and H.sum() == pytest.approx(2.0, rel=1e-14)
     assert len(np.unique(np.round(trace.length, 12))) > 2  # the mesh is really graded
+
+
+@pytest.mark.parametrize("lengths, expected", [
+    ([1, 1, 1, 1], [0, 0, 1, 1]),                 # uniform: pairs, H = 2h
+    ([2, 1, 1, 0.5, 0.5, 0.5, 0.5], [0, 0, 0, 1, 1, 2, 2]),  # graded: follows the grading
+    ([1, 1, 1], [0, 0, 0]),                       # odd remainder merged backwards
+    ([0.25, 0.25, 0.5, 2, 1, 1], [0, 0, 1, 1, 1, 1]),  # a long facet forces a long segment
+])
+def test_segments_are_the_shortest_runs_with_h_over_H_at_most_half(lengths, expected):
+    seg = multiplier_segments(np.array(lengths, dtype=float))
+    assert seg.tolist() == expected
+    H = np.bincount(seg, np.array(lengths, dtype=float))
+    assert (np.array(lengths) / H[seg]).max() <= 0.5
 
 
 def test_exact_linear_solution_is_reproduced(compression_scene):
