@@ -28,7 +28,8 @@ import numpy as np
 from scipy import linalg
 
 from formulations.base import STATUS_FAILED, STATUS_OK, ContactQP, QPSolution
-from formulations.solvers.backends import factorise_condensed
+from formulations.solvers.augmented import initial_active_set, solve_augmented
+from formulations.solvers.backends import check_backend, factorise_condensed
 from formulations.solvers.registry import register_solver
 
 
@@ -60,14 +61,23 @@ def pdas(S: np.ndarray, r: np.ndarray, active: np.ndarray, max_iter: int):
                                "contact system B K^-1 B', one sparse factorisation of K")
 def solve_active_set(qp: ContactQP, warm_start: np.ndarray | None = None,
                      max_iter: int = 100, backend: str | None = None) -> QPSolution:
-    """``backend``: 'cholmod' or 'splu' (default: the fastest available, see ``backends``)."""
+    """``backend``: 'cholmod' (condensed iteration) or 'splu' (augmented iteration, see
+    ``augmented``); default: the fastest available, see ``backends``."""
     start = time.perf_counter()
+    backend = check_backend(backend)
+    if warm_start is not None and np.shape(warm_start) != (qp.m,):
+        raise ValueError(f"warm_start has shape {np.shape(warm_start)}, not ({qp.m},)")
+    if backend == "splu":
+        active = (np.asarray(warm_start) > 0) if warm_start is not None else \
+            initial_active_set(qp)
+        u, lam, iterations, status, reason = solve_augmented(qp, active, max_iter)
+        return QPSolution(u=u, multipliers=lam, status=status, reason=reason,
+                          iterations=iterations, solve_time=time.perf_counter() - start,
+                          solver="active-set", backend="splu")
     factor = factorise_condensed(qp.K, np.unique(qp.B.indices), backend)
     u0 = factor.solve(qp.F)
     S = factor.condensed(qp.B)
     r = qp.B @ u0 - qp.G
-    if warm_start is not None and np.shape(warm_start) != (qp.m,):
-        raise ValueError(f"warm_start has shape {np.shape(warm_start)}, not ({qp.m},)")
     active = (np.asarray(warm_start) > 0) if warm_start is not None else (r > 0)
     lam, iterations, status, reason = pdas(S, r, active, max_iter)
     u = factor.solve(qp.F - qp.B.T @ lam)
