@@ -45,7 +45,7 @@ QUADRATURE_POINTS = 2  # per contact facet
 
 
 @register_formulation("penalty", "primal penalty, eps = eps_0 h_e / E (eps_0 = 1e-3), "
-                                 "lambda_h = (u_hn - g)_+ / eps")
+                                 "lambda_h = (u_hn - g_h)_+ / eps")
 def discretise(scene: Scene, mesh: MeshTri,
                epsilon_0: float = DEFAULT_EPSILON_0) -> Discretisation:
     if not (np.isfinite(epsilon_0) and epsilon_0 > 0):

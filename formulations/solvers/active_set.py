@@ -57,8 +57,9 @@ def pdas(S: np.ndarray, r: np.ndarray, active: np.ndarray, max_iter: int):
     return lam, max_iter, STATUS_FAILED, f"active set still changing after {max_iter} iterations"
 
 
-@register_solver("active-set", "primal-dual active set (semismooth Newton) on the condensed "
-                               "contact system B K^-1 B', one sparse factorisation of K")
+@register_solver("active-set", "primal-dual active set (semismooth Newton): condensed "
+                               "B K^-1 B' from one factorisation (cholmod) or the augmented "
+                               "saddle-point system (splu); nested iteration")
 def solve_active_set(qp: ContactQP, warm_start: np.ndarray | None = None,
                      max_iter: int = 100, backend: str | None = None) -> QPSolution:
     """``backend``: 'cholmod' (condensed iteration) or 'splu' (augmented iteration, see
