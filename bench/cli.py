@@ -236,7 +236,10 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _compare(args) -> int:
-    argv = ["run", "--scene", ",".join(scene_names()), "--formulation",
+    from scenes import get_scene
+
+    default_scenes = [n for n in scene_names() if "hard" not in get_scene(n).tags]
+    argv = ["run", "--scene", ",".join(default_scenes), "--formulation",
             ",".join(formulation_names()), "--solver", "active-set", "--estimator",
             ",".join(estimator_names()), "--strategy", "uniform,adaptive", "--max-dofs",
             str(args.max_dofs), "--reference-dofs", str(args.reference_dofs),

@@ -68,7 +68,8 @@ def test_paper_scene_matches_design():
 
 
 def test_unknown_scene_lists_valid_ones():
-    with pytest.raises(KeyError, match="valid scenes: free-boundary, hertz, paper"):
+    with pytest.raises(KeyError, match="valid scenes: free-boundary, full-contact, hertz, "
+                       "incompressible, no-contact, paper, thin, wedge"):
         get_scene("hertzz")
 
 

@@ -1,0 +1,62 @@
+"""Hard scenes (tag ``hard``): cases where a formulation or a solver may break (issue 7).
+
+Each is a rectangle clamped on top with Gamma_C its bottom edge (outer normal (0, -1)), so the
+gap is g(x) along n = (0, -1): negative g means the obstacle pushes the body up. They are left
+out of the default comparison (``python -m bench compare``) and exercised by tests/scenes.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from skfem import MeshTri
+
+from scenes.base import Material, Scene
+from scenes.registry import register_scene
+
+_TOL = 1e-10
+
+
+def _block(name, description, gap, *, width=2.0, height=2.0, nx=4, ny=4, poisson_ratio=0.3,
+           plane="stress", young_modulus=70000.0, body_force=None, parameters=None) -> Scene:
+    xs = np.linspace(-width / 2, width / 2, nx + 1)
+    ys = np.linspace(-height / 2, height / 2, ny + 1)
+    return Scene(name=name, description=description, mesh=MeshTri.init_tensor(xs, ys),
+                 material=Material(young_modulus, poisson_ratio, plane),
+                 is_dirichlet=lambda x: np.abs(x[1] - height / 2) < _TOL,
+                 is_contact=lambda x: np.abs(x[1] + height / 2) < _TOL,
+                 gap=gap, contact_coordinate=lambda x: x[0], body_force=body_force,
+                 parameters=parameters or {}, tags=("hard",))
+
+
+@register_scene("no-contact", "hard: a body pulled down by its weight, the obstacle 1.0 away "
+                              "(nothing touches)")
+def no_contact() -> Scene:
+    return _block("no-contact", "gap 1.0, body force (0, -1000)",
+                  lambda x: np.full(x.shape[1:], 1.0),
+                  body_force=lambda x: np.array([0.0 * x[0], -1000.0 + 0.0 * x[0]]))
+
+
+@register_scene("full-contact", "hard: a flat obstacle pushes the whole of Gamma_C up by 0.01")
+def full_contact() -> Scene:
+    return _block("full-contact", "flat obstacle, g = -0.01 on all of Gamma_C",
+                  lambda x: np.full(x.shape[1:], -0.01))
+
+
+@register_scene("incompressible", "hard: the paper's obstacle on a nearly incompressible body "
+                                  "(plane strain, nu = 0.4999; P1 locking)")
+def incompressible(poisson_ratio: float = 0.4999) -> Scene:
+    return _block("incompressible", f"paper geometry, plane strain, nu = {poisson_ratio}",
+                  lambda x: 0.85 - np.sqrt(np.clip(1.0 - x[0] ** 2, 0.0, None)),
+                  poisson_ratio=poisson_ratio, plane="strain",
+                  parameters={"poisson_ratio": poisson_ratio})
+
+
+@register_scene("wedge", "hard: an obstacle with a kink, g = 0.5 |x| - 0.05")
+def wedge() -> Scene:
+    return _block("wedge", "wedge obstacle g = 0.5|x| - 0.05", lambda x: 0.5 * np.abs(x[0]) - 0.05)
+
+
+@register_scene("thin", "hard: a 50:1 strip pressed by a parabola (thin body, long elements)")
+def thin() -> Scene:
+    return _block("thin", "strip (-1,1) x (-0.02,0.02), g = x^2 - 0.001",
+                  lambda x: x[0] ** 2 - 0.001, height=0.04, nx=50, ny=1)
