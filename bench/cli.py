@@ -14,6 +14,7 @@ from bench.marking import MARKINGS
 from bench.matrix import run_matrix
 from bench.rates import write_rates
 from bench.report import write_report
+from bench.rows import KEYS
 from bench.scaling import SIZES, run_scaling, write_scaling
 from bench.store import ResultStore
 from estimators import estimator_descriptions, estimator_names
@@ -185,8 +186,7 @@ def _progress(result: LevelResult) -> None:
 
 def summary(table: pd.DataFrame) -> str:
     parts = []
-    keys = ["scene", "formulation", "solver", "estimator", "strategy"]
-    for key, group in table.groupby(keys, sort=False):
+    for key, group in table.groupby(KEYS, sort=False):
         parts.append("== " + " / ".join(map(str, key)))
         parts.append(group[SUMMARY_COLUMNS].to_string(index=False, float_format="{:.6g}".format))
     return "\n".join(parts)

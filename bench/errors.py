@@ -39,6 +39,17 @@ class Errors:
     contact_zone_end: float
 
 
+def solution_difference(discretisation, solution, judge) -> tuple[float, float]:
+    """Two solutions of the same discrete problem compared: relative energy-norm difference of
+    u_h and max pressure difference (at 5 points per contact facet) relative to max lambda_h."""
+    K = discretisation.elasticity.K
+    du = solution.u - judge.u
+    t = np.linspace(0.0, 1.0, 5)
+    lam, lam_ref = solution.pressure(t), judge.pressure(t)
+    return (float(np.sqrt(du @ K @ du) / max(np.sqrt(judge.u @ K @ judge.u), 1e-300)),
+            float(np.abs(lam - lam_ref).max() / max(np.abs(lam_ref).max(), 1e-300)))
+
+
 def energy_density(grad: np.ndarray, lam: float, mu: float) -> np.ndarray:
     """sigma(e) : eps(e) for the displacement gradient grad[i, j] of e."""
     s11, s22, s12 = stress_from_gradient(grad, lam, mu)

@@ -13,7 +13,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-KEYS = ["scene", "formulation", "solver", "estimator", "strategy"]
+from bench.rows import KEYS
+
 RATE_LEVELS = 4
 
 

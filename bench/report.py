@@ -25,9 +25,8 @@ from bench.report_tables import (
     rate_verdicts,
     timing_table,
 )
-from bench.rows import COLUMNS
+from bench.rows import COLUMNS, KEYS
 
-KEYS = ["scene", "formulation", "solver", "estimator", "strategy"]
 TEMPLATES = Path(__file__).with_name("templates")
 
 

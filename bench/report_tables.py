@@ -5,6 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from bench.rows import KEYS
+
 # Claimed slopes of log(error) against log(ndofs): the seed paper for its scene (section 5:
 # "nearly O(h^1/2)" uniform, O(h) adaptive); theory for the smooth manufactured solution.
 CLAIMS = {("paper", "uniform"): (-0.25, "paper: nearly O(h^1/2)"),
@@ -63,10 +65,9 @@ def _total_time(group: pd.DataFrame) -> float:
 
 def accuracy_table(rows: pd.DataFrame) -> pd.DataFrame:
     out = []
-    keys = ["scene", "formulation", "solver", "estimator", "strategy"]
-    for key, group in rows.groupby(keys, sort=True):
+    for key, group in rows.groupby(KEYS, sort=True):
         last = group.sort_values("level").iloc[-1]
-        out.append({**dict(zip(keys, key, strict=True)), "ndofs": int(last["ndofs"]),
+        out.append({**dict(zip(KEYS, key, strict=True)), "ndofs": int(last["ndofs"]),
                     "energy": _fmt(last["energy"], ".6g"),
                     "contact force": _fmt(last["contact_force"], ".6g"),
                     "error": _fmt(last["energy_error"]), "eta": _fmt(last["eta"]),
@@ -118,6 +119,5 @@ def agreement_table(rows: pd.DataFrame) -> pd.DataFrame:
 
 def failure_table(everything: pd.DataFrame) -> pd.DataFrame:
     bad = everything[everything["status"].fillna("missing") != "ok"]
-    cols = ["scene", "formulation", "solver", "estimator", "strategy", "level", "status",
-            "reason"]
+    cols = [*KEYS, "level", "status", "reason"]
     return bad[cols].astype(str) if len(bad) else pd.DataFrame()

@@ -73,3 +73,4 @@ class ResultRow:
 
 
 COLUMNS = [f.name for f in fields(ResultRow)]
+KEYS = ["scene", "formulation", "solver", "estimator", "strategy"]  # identity of a combination
