@@ -99,10 +99,14 @@ def test_extreme_penalty_fast_solver_stays_exact_and_penetration_scales(penalty_
     vi, runs = penalty_sweep
     fast = [runs[eps][0] for eps in EPSILONS]
     assert all(s.status == "ok" and max(vars(s.residuals).values()) < 1e-12 for s in fast)
-    # penetration = eps lambda, lambda converges: linear in eps_0 (measured 1.05e-3 .. 1.06e-14)
+    # penetration = eps lambda, lambda converges: linear in eps_0 (measured 1.05e-3 .. 1.06e-12
+    # down to eps_0 = 1e-10). At 1e-12 it reaches round-off in u (max|u| = 0.15): measured
+    # 1.06e-14 with cholmod and 3.1e-14 with splu, so the fit stops at 1e-10 and the last
+    # point is only bounded by round-off
     pen = np.array([_penetration(s) for s in fast])
-    slope = np.polyfit(np.log(EPSILONS), np.log(pen), 1)[0]
+    slope = np.polyfit(np.log(EPSILONS[:-1]), np.log(pen[:-1]), 1)[0]
     assert slope == pytest.approx(1.0, abs=0.01)
+    assert pen[-1] <= 1e-12 * np.abs(fast[-1].u).max()
     # the limit eps_0 -> 0 is the nodal VI (u_hn <= g_h at two Gauss points per facet means
     # at both end points): measured |E - E_vi| / E_vi = 1.3e-7 at 1e-6, < 1e-9 below 1e-8
     assert abs(fast[-1].energy - vi.energy) <= 1e-9 * abs(vi.energy)
