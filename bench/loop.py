@@ -13,6 +13,7 @@ from bench.marking import MARKINGS, grade_contact_trace, mark
 from bench.rows import ResultRow
 from estimators import get_estimator
 from formulations import STATUS_FAILED, get_formulation, solve
+from formulations.diagnostics import inf_sup_constant, pressure_oscillation
 from formulations.elasticity import element_diameters
 from scenes import Scene
 
@@ -30,6 +31,7 @@ class LoopConfig:
     theta: float = 0.5
     nested: bool = True
     grade_contact: bool = True  # 2:1 grading closure along Gamma_C (bench.marking)
+    diagnostics: bool = True  # the inf-sup constant costs a factorisation and m solves per level
     solver_options: dict = field(default_factory=dict)
 
     def __post_init__(self):
@@ -68,6 +70,20 @@ def error_columns(truth, solution, estimate) -> dict:
                    effectivity_complementarity=estimate.eta_complementarity
                    / errors.energy_error)
     out["t_error"] = time.perf_counter() - start
+    return out
+
+
+def diagnostic_columns(disc, sol, config: LoopConfig) -> dict:
+    """The solver's diagnostics and the stability measures of ``formulations.diagnostics``."""
+    start = time.perf_counter()
+    diag = sol.diagnostics
+    out = dict(condition_estimate=diag.get("condition_estimate", float("nan")),
+               active_set_changes=",".join(map(str, diag.get("active_set_changes", ()))),
+               cycled=bool(diag.get("cycled", False)), safeguard=diag.get("safeguard", ""),
+               pressure_oscillation=pressure_oscillation(sol))
+    if config.diagnostics:
+        out["inf_sup"] = inf_sup_constant(disc, config.solver_options.get("backend"))
+    out["t_diagnostics"] = time.perf_counter() - start
     return out
 
 
@@ -119,6 +135,11 @@ def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
             warm_started="warm_start" in options, t_assemble=t_assemble,
             t_solve=sol.solve_time, t_estimate=t_estimate, t_refine=t_refine,
             status=sol.status, reason=sol.reason, **vars(sol.residuals))
+        if sol.status != STATUS_FAILED:
+            numbers.update(diagnostic_columns(disc, sol, config))
+        else:
+            numbers.update(cycled=bool(sol.diagnostics.get("cycled", False)),
+                           safeguard=sol.diagnostics.get("safeguard", ""))
         if est is not None:
             numbers.update(eta=est.eta, eta_0=est.eta_0, eta_geometric=est.eta_geometric,
                            eta_complementarity=est.eta_complementarity)

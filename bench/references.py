@@ -93,7 +93,7 @@ def _sampled_pressure(solution: DiscreteSolution):
 
 def build_reference(scene, max_dofs: int) -> Reference:
     config = LoopConfig(strategy="adaptive", max_dofs=max_dofs, marking=RECIPE["marking"],
-                        theta=RECIPE["theta"])
+                        theta=RECIPE["theta"], diagnostics=False)
     previous, last = None, None
     for result in run_sequence(scene, RECIPE["formulation"], RECIPE["solver"],
                                RECIPE["estimator"], config):

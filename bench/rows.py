@@ -62,6 +62,13 @@ class ResultRow:
     crosscheck_pressure_difference: float = math.nan
     marking: str = ""
     theta: float = math.nan
+    condition_estimate: float = math.nan
+    active_set_changes: str = ""
+    cycled: bool = False
+    safeguard: str = ""
+    inf_sup: float = math.nan
+    pressure_oscillation: float = math.nan
+    t_diagnostics: float = math.nan
     run_id: str = ""
     commit: str = ""
     python: str = ""

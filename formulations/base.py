@@ -63,6 +63,9 @@ class QPSolution:
     solve_time: float
     solver: str
     backend: str = ""
+    # solver diagnostics (see formulations.solvers.active_set): active_set_changes, cycled,
+    # safeguard, condition_estimate; empty for solvers that report none
+    diagnostics: dict = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -100,6 +103,7 @@ class DiscreteSolution:
     max_h_over_H: float = float("nan")
     backend: str = ""
     extra: dict = field(default_factory=dict)
+    diagnostics: dict = field(default_factory=dict)  # the solver's (QPSolution.diagnostics)
 
     @property
     def ok(self) -> bool:

@@ -19,7 +19,8 @@ class Discretisation:
     """What a formulation's ``discretise`` returns: the assembled QP on the free DOFs and how to
     turn a solver's answer into a ``DiscreteSolution`` (``recover(qp_solution, residuals,
     status, reason)``). ``row_coordinate`` places each constraint row on Gamma_C (the scene's
-    contact coordinate of its segment's middle or its node)."""
+    contact coordinate of its segment's middle or its node). ``multiplier_gram`` (optional)
+    makes the discrete inf-sup constant computable."""
 
     formulation: str
     elasticity: Elasticity
@@ -28,6 +29,9 @@ class Discretisation:
     recover: Callable[[QPSolution, Residuals, str, str], DiscreteSolution]
     row_coordinate: np.ndarray
     transfer: Callable[[DiscreteSolution], np.ndarray] | None = None
+    # diagonal Gram matrix of the mesh-dependent H^-1/2 norm of the multipliers, for
+    # formulations whose constraint rows are a multiplier space (formulations.diagnostics)
+    multiplier_gram: np.ndarray | None = None
 
     def warm_start(self, previous: DiscreteSolution) -> np.ndarray:
         """Initial multipliers for this QP from a solution on another (coarser) mesh: the
@@ -53,7 +57,7 @@ def discrete_solution(formulation: str, elasticity: Elasticity, trace: ContactTr
         u=elasticity.expand(u_free), pressure=pressure, multiplier_breaks=multiplier_breaks,
         residuals=residuals, status=status, reason=reason, iterations=answer.iterations,
         solve_time=answer.solve_time, active_constraints=active_constraints,
-        backend=answer.backend, **specific)
+        backend=answer.backend, diagnostics=dict(answer.diagnostics), **specific)
 
 
 def solve(discretisation: Discretisation, solver: str, **options) -> DiscreteSolution:
@@ -64,7 +68,7 @@ def solve(discretisation: Discretisation, solver: str, **options) -> DiscreteSol
         nan = np.full(discretisation.qp.n, np.nan)
         answer = QPSolution(nan, np.full(discretisation.qp.m, np.nan), answer.status or
                             STATUS_FAILED, answer.reason, answer.iterations, answer.solve_time,
-                            answer.solver, answer.backend)
+                            answer.solver, answer.backend, answer.diagnostics)
         residuals = Residuals(*(4 * [float("nan")]))
         status, reason = judge(answer, None)
     else:

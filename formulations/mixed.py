@@ -30,10 +30,11 @@ from scenes import Scene
 GAP_QUADRATURE_POINTS = 6  # G_i = int g: g is smooth on each facet; 6 Gauss points is plenty
 
 
-def multiplier_segments(lengths: np.ndarray) -> np.ndarray:
+def multiplier_segments(lengths: np.ndarray, h_over_H: float = 0.5) -> np.ndarray:
     """Segment index of every contact facet (facets in order along Gamma_C), see the module
-    docstring: greedy runs of consecutive facets, each closed as soon as its length reaches
-    twice its longest facet; a short remainder is merged backwards until it qualifies.
+    docstring: greedy runs of consecutive facets, each closed as soon as its longest facet is
+    at most ``h_over_H`` times its length (twice for the default 1/2); a short remainder is
+    merged backwards until it qualifies. ``h_over_H = 1`` makes every facet a segment.
 
     A sequential scan over the contact facets only (O(n) with n ~ sqrt(ndofs)); the rule
     depends on the running maximum, which has no closed vectorised form."""
@@ -41,14 +42,14 @@ def multiplier_segments(lengths: np.ndarray) -> np.ndarray:
     ends, run_length, run_max = [], 0.0, 0.0
     for k, h in enumerate(lengths):
         run_length, run_max = run_length + h, max(run_max, h)
-        if run_length >= 2.0 * run_max - tol:
+        if run_length >= run_max / h_over_H - tol:
             ends.append(k + 1)
             run_length, run_max = 0.0, 0.0
     if not ends or ends[-1] != lengths.size:
         ends = ends[:-1] + [lengths.size]  # merge the remainder with the run before it
         while len(ends) > 1:
             tail = lengths[ends[-2]:]
-            if tail.sum() >= 2.0 * tail.max() - tol:
+            if tail.sum() >= tail.max() / h_over_H - tol:
                 break
             del ends[-2]
     starts = np.zeros(lengths.size, dtype=int)
@@ -58,10 +59,15 @@ def multiplier_segments(lengths: np.ndarray) -> np.ndarray:
 
 @register_formulation("mixed", "Haslinger's mixed method: piecewise constant multiplier on a "
                                "coarser contact mesh, h/H <= 1/2 (seed paper, eq. (3))")
-def discretise(scene: Scene, mesh: MeshTri) -> Discretisation:
+def discretise(scene: Scene, mesh: MeshTri, h_over_H: float = 0.5) -> Discretisation:
+    """``h_over_H``: the largest allowed ratio of a facet to its multiplier segment. The
+    paper's 1/2 (default) keeps the pair uniformly inf-sup stable; 1 (multiplier mesh = trace
+    mesh) is not guaranteed to be (a hard case, see ``formulations.diagnostics``)."""
+    if not (isinstance(h_over_H, int | float) and 0.0 < h_over_H <= 1.0):
+        raise ValueError(f"h_over_H={h_over_H!r} is not in (0, 1]")
     elasticity = assemble_elasticity(scene, mesh)
     trace = contact_trace(scene, mesh)
-    segment = multiplier_segments(trace.length)
+    segment = multiplier_segments(trace.length, h_over_H)
     m = int(segment.max()) + 1
     H = np.bincount(segment, weights=trace.length, minlength=m)
     h_over_H = float((trace.length / H[segment]).max())
@@ -91,4 +97,5 @@ def discretise(scene: Scene, mesh: MeshTri) -> Discretisation:
             max_h_over_H=h_over_H, extra={"multipliers": lam, "segment_of_facet": segment})
 
     return Discretisation(formulation="mixed", elasticity=elasticity, trace=trace, qp=qp,
-                          recover=recover, row_coordinate=0.5 * (breaks[:-1] + breaks[1:]))
+                          recover=recover, row_coordinate=0.5 * (breaks[:-1] + breaks[1:]),
+                          multiplier_gram=H**2)  # sum_S H_S ||mu||_{0,S}^2 = sum H_S^2 mu_S^2

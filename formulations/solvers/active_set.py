@@ -14,47 +14,48 @@ Kunisch 2003; a semismooth Newton method):
     A = {i : lambda_i - c y_i > 0};  lambda_I = 0,  S_AA lambda_A = r_A;  repeat until A is fixed.
 
 At termination lambda_A >= 0 and y_I >= 0 hold exactly (up to round-off), so the answer is exact.
-A repeated active set (cycling) or the iteration limit stops it with status ``failed`` and the
-reason. The first active set is {i : r_i > 0} (the constraints the unconstrained solution
-violates) unless ``warm_start`` multipliers are given: then it is {i : warm_start_i > 0}, which is
-how the refinement loop's nested iteration passes the previous level's contact zone.
+The first active set is {i : r_i > 0} (the constraints the unconstrained solution violates)
+unless ``warm_start`` multipliers are given: then it is {i : warm_start_i > 0}, which is how the
+refinement loop's nested iteration passes the previous level's contact zone.
+
+Safeguard. The plain iteration is not globally convergent: it can cycle (``lcp``). When it
+cycles or hits ``max_iter``, the condensed route switches to Murty's least-index principal
+pivoting from the last active set, which terminates for every SPD S; if that also fails, and on
+the augmented (splu) route at once, the problem is handed to the reference solver. The
+``safeguard`` diagnostic names what produced the answer ("" for the plain iteration,
+"least-index pivoting", "reference fallback") and the reason says why it was needed; the answer
+is judged by its own KKT residuals like any other.
+
+Diagnostics (``QPSolution.diagnostics``): the active-set changes of every iteration, the
+cycling flag, the safeguard, and ``condition_estimate``: the 1-norm condition number of the
+last system the iteration solved, in the solver's scaling (rows of B divided by row_scale):
+the active block of the condensed S (cholmod) or the saddle-point matrix (splu, estimated).
 """
 
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 
 import numpy as np
-from scipy import linalg
 
-from formulations.base import STATUS_FAILED, STATUS_OK, ContactQP, QPSolution
+from formulations.base import STATUS_OK, ContactQP, QPSolution
 from formulations.solvers.augmented import initial_active_set, solve_augmented
 from formulations.solvers.backends import check_backend, factorise_condensed
+from formulations.solvers.lcp import condition_1, least_index_pivoting, pdas
+from formulations.solvers.reference import solve_reference
 from formulations.solvers.registry import register_solver
 
 
-def pdas(S: np.ndarray, r: np.ndarray, active: np.ndarray, max_iter: int):
-    """Solve the LCP y = S lam - r >= 0, lam >= 0, lam'y = 0 by primal-dual active sets.
-
-    Returns (lam, iterations, status, reason)."""
-    m = r.size
-    c = 1.0 / max(float(np.mean(np.diag(S))), np.finfo(float).tiny) if m else 1.0
-    seen = set()
-    lam = np.zeros(m)
-    for iteration in range(1, max_iter + 1):
-        key = active.tobytes()
-        if key in seen:
-            return lam, iteration - 1, STATUS_FAILED, "active set cycles (a set repeated)"
-        seen.add(key)
-        lam = np.zeros(m)
-        if active.any():
-            lam[active] = linalg.solve(S[np.ix_(active, active)], r[active], assume_a="pos")
-        y = S @ lam - r
-        new_active = lam - c * y > 0
-        if np.array_equal(new_active, active):
-            return lam, iteration, STATUS_OK, ""
-        active = new_active
-    return lam, max_iter, STATUS_FAILED, f"active set still changing after {max_iter} iterations"
+def _fallback(qp: ContactQP, why: str, diagnostics: dict, start: float) -> QPSolution:
+    """The last resort: the reference solver, with the plain iteration's diagnostics."""
+    answer = solve_reference(qp)
+    reason = f"{why}; answered by the reference solver (safeguard)"
+    if answer.reason:
+        reason += f": {answer.reason}"
+    return replace(answer, solver="active-set", reason=reason,
+                   solve_time=time.perf_counter() - start,
+                   diagnostics={**diagnostics, "safeguard": "reference fallback"})
 
 
 @register_solver("active-set", "primal-dual active set (semismooth Newton): condensed "
@@ -71,17 +72,34 @@ def solve_active_set(qp: ContactQP, warm_start: np.ndarray | None = None,
     if backend == "splu":
         active = (np.asarray(warm_start) > 0) if warm_start is not None else \
             initial_active_set(qp)
-        u, lam, iterations, status, reason = solve_augmented(qp, active, max_iter)
+        u, lam, iterations, status, reason, diagnostics = solve_augmented(qp, active, max_iter)
+        diagnostics["safeguard"] = ""
+        if status != STATUS_OK:
+            return _fallback(qp, f"plain active set failed ({reason})", diagnostics, start)
         return QPSolution(u=u, multipliers=lam, status=status, reason=reason,
                           iterations=iterations, solve_time=time.perf_counter() - start,
-                          solver="active-set", backend="splu")
+                          solver="active-set", backend="splu", diagnostics=diagnostics)
     factor = factorise_condensed(qp.K, np.unique(qp.B.indices), backend)
     u0 = factor.solve(qp.F)
     S = factor.condensed(qp.B)
     r = qp.B @ u0 - qp.G
     active = (np.asarray(warm_start) > 0) if warm_start is not None else (r > 0)
-    lam, iterations, status, reason = pdas(S, r, active, max_iter)
-    u = factor.solve(qp.F - qp.B.T @ lam)
-    return QPSolution(u=u, multipliers=lam, status=status, reason=reason, iterations=iterations,
-                      solve_time=time.perf_counter() - start, solver="active-set",
-                      backend=factor.backend)
+    result = pdas(S, r, active, max_iter)
+    diagnostics = {"active_set_changes": result.changes, "cycled": result.cycled,
+                   "safeguard": "", "condition_estimate": float("nan")}
+    reason, iterations = "", result.iterations
+    if result.status != STATUS_OK:
+        reason = f"plain active set failed ({result.reason})"
+        result = least_index_pivoting(S, r, result.active, 20 * qp.m + 100)
+        iterations += result.iterations
+        diagnostics.update(active_set_changes=diagnostics["active_set_changes"]
+                           + result.changes, safeguard="least-index pivoting")
+        if result.status != STATUS_OK:
+            return _fallback(qp, f"{reason}, then {result.reason}", diagnostics, start)
+        reason += "; answered by least-index pivoting (safeguard)"
+    scaled = S / np.outer(qp.row_scale, qp.row_scale)  # the solver's units, as for splu
+    diagnostics["condition_estimate"] = condition_1(scaled, result.active)
+    u = factor.solve(qp.F - qp.B.T @ result.lam)
+    return QPSolution(u=u, multipliers=result.lam, status=STATUS_OK, reason=reason,
+                      iterations=iterations, solve_time=time.perf_counter() - start,
+                      solver="active-set", backend=factor.backend, diagnostics=diagnostics)

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 from scipy import sparse
-from scipy.sparse.linalg import splu
+from scipy.sparse.linalg import LinearOperator, onenormest, splu
 
 from formulations.base import STATUS_FAILED, STATUS_OK, ContactQP
 
@@ -27,20 +27,38 @@ def initial_active_set(qp: ContactQP) -> np.ndarray:
     return qp.B @ splu(sparse.csc_matrix(qp.K)).solve(qp.F) - qp.G > 0
 
 
+def condition_estimate(system: sparse.csc_matrix, lu) -> float:
+    """1-norm condition estimate ||A||_1 ||A^-1||_1 of a factorised matrix (Higham's block
+    estimator for the inverse: a few solves, never the inverse itself)."""
+    n = system.shape[0]
+    inverse = LinearOperator((n, n), matvec=lu.solve, rmatvec=lambda x: lu.solve(x, trans="T"),
+                             dtype=float)
+    return float(abs(system).sum(axis=0).max() * onenormest(inverse))
+
+
 def solve_augmented(qp: ContactQP, active: np.ndarray, max_iter: int):
-    """Returns (u, lambda, iterations, status, reason)."""
+    """Returns (u, lambda, iterations, status, reason, diagnostics): the diagnostics hold the
+    active-set changes of every iteration, whether a set repeated (``cycled``) and the
+    condition estimate of the last (scaled) saddle-point matrix factorised."""
     n, m = qp.n, qp.m
     # scaled like the reference: K / E, rows of B / row_scale (an O(1) saddle-point matrix)
     K = sparse.csr_matrix(qp.K) / qp.objective_scale
     B = sparse.diags(1.0 / qp.row_scale) @ qp.B
     G = qp.G / qp.row_scale
     F = qp.F / qp.objective_scale
-    seen = set()
+    seen, changes = set(), []
     u, lam = np.zeros(n), np.zeros(m)
+
+    def diagnostics(cycled, system=None, lu=None):
+        return {"active_set_changes": tuple(changes), "cycled": cycled,
+                "condition_estimate": condition_estimate(system, lu) if lu is not None
+                else float("nan")}
+
     for iteration in range(1, max_iter + 1):
         key = active.tobytes()
         if key in seen:
-            return u, lam, iteration - 1, STATUS_FAILED, "active set cycles (a set repeated)"
+            return (u, lam, iteration - 1, STATUS_FAILED, "active set cycles (a set repeated)",
+                    diagnostics(True))
         seen.add(key)
         rows = np.flatnonzero(active)
         B_A = B[rows]
@@ -54,8 +72,9 @@ def solve_augmented(qp: ContactQP, active: np.ndarray, max_iter: int):
         slack = qp.G - qp.B @ u
         scale = max(np.abs(u).max(initial=0.0), qp.gap_scale, np.finfo(float).tiny)
         new_active = np.where(active, lam > 0, slack < -VIOLATION_TOLERANCE * scale)
-        if np.array_equal(new_active, active):
-            return u, lam, iteration, STATUS_OK, ""
+        changes.append(int((new_active != active).sum()))
+        if changes[-1] == 0:
+            return u, lam, iteration, STATUS_OK, "", diagnostics(False, system, lu)
         active = new_active
-    return u, lam, max_iter, STATUS_FAILED, \
-        f"active set still changing after {max_iter} iterations"
+    return (u, lam, max_iter, STATUS_FAILED,
+            f"active set still changing after {max_iter} iterations", diagnostics(False))

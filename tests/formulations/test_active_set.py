@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from formulations import get_formulation, solve
-from formulations.solvers.active_set import pdas
+from formulations.solvers.lcp import pdas
 from formulations.solvers.backends import available_backends
 from scenes import get_scene
 
@@ -12,16 +12,17 @@ from scenes import get_scene
 def test_pdas_solves_a_diagonal_lcp_exactly():
     # S = diag(d): lambda_i = max(r_i, 0) / d_i is the unique solution
     d, r = np.array([1.0, 2.0, 4.0, 0.5]), np.array([1.0, -3.0, 2.0, -0.1])
-    lam, iterations, status, _ = pdas(np.diag(d), r, np.zeros(4, bool), max_iter=10)
-    assert status == "ok" and iterations <= 2
-    assert lam == pytest.approx(np.maximum(r, 0) / d, abs=0)
+    result = pdas(np.diag(d), r, np.zeros(4, bool), max_iter=10)
+    assert result.status == "ok" and result.iterations <= 2
+    assert result.lam == pytest.approx(np.maximum(r, 0) / d, abs=0)
 
 
 def test_pdas_reports_non_convergence_instead_of_looping():
     S = np.array([[2.0, -1.0, 0.0], [-1.0, 2.0, -1.0], [0.0, -1.0, 2.0]])
     r = np.array([1.0, -5.0, 1.0])
-    _, iterations, status, reason = pdas(S, r, np.ones(3, bool), max_iter=1)
-    assert status == "failed" and iterations == 1 and "still changing" in reason
+    result = pdas(S, r, np.ones(3, bool), max_iter=1)
+    assert result.status == "failed" and result.iterations == 1
+    assert "still changing" in result.reason
 
 
 def paper_meshes():
