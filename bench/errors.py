@@ -24,6 +24,7 @@ from skfem import Basis, ElementTriP1, ElementVector
 from formulations import DiscreteSolution
 from formulations.contact import gauss_legendre
 from formulations.elasticity import stress_from_gradient
+from formulations.kkt import ACTIVE_FRACTION
 
 TOO_COARSE = 0.1  # a reference whose own error exceeds 10 % of the measured error is too coarse
 EXACT_INTORDER = 6
@@ -41,13 +42,21 @@ class Errors:
 
 def solution_difference(discretisation, solution, judge) -> tuple[float, float]:
     """Two solutions of the same discrete problem compared: relative energy-norm difference of
-    u_h and max pressure difference (at 5 points per contact facet) relative to max lambda_h."""
+    u_h and max pressure difference (at 5 points per contact facet) relative to max lambda_h.
+    The energy norm is relative to max(||u_judge||, sqrt(E) d) and the pressure to
+    max(max lambda_judge, E d / |Gamma_C|), d the QP's gap scale, so that a vanishing solution
+    or pressure (nothing touches) is not divided by zero."""
     K = discretisation.elasticity.K
     du = solution.u - judge.u
     t = np.linspace(0.0, 1.0, 5)
     lam, lam_ref = solution.pressure(t), judge.pressure(t)
-    return (float(np.sqrt(du @ K @ du) / max(np.sqrt(judge.u @ K @ judge.u), 1e-300)),
-            float(np.abs(lam - lam_ref).max() / max(np.abs(lam_ref).max(), 1e-300)))
+    qp = discretisation.qp
+    scale = max(np.sqrt(judge.u @ K @ judge.u), np.sqrt(qp.objective_scale) * qp.gap_scale,
+                1e-300)
+    return (float(np.sqrt(du @ K @ du) / scale),
+            float(np.abs(lam - lam_ref).max()
+                  / max(np.abs(lam_ref).max(), qp.objective_scale * qp.gap_scale
+                        / discretisation.trace.length.sum(), 1e-300)))
 
 
 def energy_density(grad: np.ndarray, lam: float, mu: float) -> np.ndarray:
@@ -62,8 +71,11 @@ def element_gradients(solution: DiscreteSolution) -> np.ndarray:
 
 
 def contact_zone(solution: DiscreteSolution) -> tuple[float, float]:
-    """End points (contact coordinates) of the union of contact facets where lambda_h > 0."""
-    pressed = (solution.pressure(np.array([0.25, 0.5, 0.75])) > 0).any(axis=1)
+    """End points (contact coordinates) of the union of contact facets where lambda_h > 0,
+    i.e. above ACTIVE_FRACTION x max lambda_h: an interior-point solution leaves multipliers
+    of ~1e-9 relative on every facet, which are not contact."""
+    values = solution.pressure(np.array([0.25, 0.5, 0.75]))
+    pressed = (values > ACTIVE_FRACTION * values.max(initial=0.0)).any(axis=1)
     if not pressed.any():
         return float("nan"), float("nan")
     s0, s1 = solution.trace.coordinate

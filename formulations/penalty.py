@@ -16,6 +16,11 @@ any quadrature points, and lambda_h = (u_hn - g)_+ / eps would be O(E h g'' / ep
 i.e. garbage for small eps_0 (measured: 4e5 against a true peak of 2e4 on the paper scene). The
 geometric error g - g_h is left to the estimators' contact terms, which use the exact g.
 
+Self-check: at the minimiser the pressure (u_hn - g_h)_+ / eps at a Gauss point equals the
+multiplier of its row per unit length; the two are compared on every solve and a mismatch above
+``PRESSURE_CONSISTENCY`` turns status "ok" into "inaccurate" (the formula divides u's error by
+eps, so an interior-point answer that is fine in energy can carry a wrong pressure).
+
 The integral uses Gauss points per facet. As a QP (so that the reference and the active-set
 solvers apply unchanged), (x)_+^2 = min {s^2 : s >= x, s >= 0} gives slack unknowns s_q, one per
 quadrature point:
@@ -33,7 +38,14 @@ import numpy as np
 from scipy import sparse
 from skfem import MeshTri
 
-from formulations.base import ContactQP, DiscreteSolution, QPSolution, Residuals
+from formulations.base import (
+    STATUS_INACCURATE,
+    STATUS_OK,
+    ContactQP,
+    DiscreteSolution,
+    QPSolution,
+    Residuals,
+)
 from formulations.contact import contact_trace, gauss_legendre
 from formulations.discretisation import Discretisation, discrete_solution
 from formulations.elasticity import assemble_elasticity
@@ -42,6 +54,10 @@ from scenes import Scene
 
 DEFAULT_EPSILON_0 = 1e-3
 QUADRATURE_POINTS = 2  # per contact facet
+# the largest relative mismatch between the two readings of the pressure (see recover) for
+# status "ok": measured ~1e-15 for the active-set solver, ~1e-5 for the reference at the
+# default eps_0 and O(1) once it loses the penetration (eps_0 <= 1e-8)
+PRESSURE_CONSISTENCY = 1e-4
 
 
 @register_formulation("penalty", "primal penalty, eps = eps_0 h_e / E (eps_0 = 1e-3), "
@@ -83,6 +99,22 @@ def discretise(scene: Scene, mesh: MeshTri,
                    G=np.concatenate([gap.ravel(), np.zeros(ns)]), row_scale=np.ones(2 * ns),
                    objective_scale=young)
     epsilon = epsilon_0 * trace.length / young
+
+    def pressure_mismatch(u_free, multipliers) -> float:
+        """Max difference at the Gauss points between the formula's pressure and the multiplier
+        of each row u_n - s <= g per unit length (equal at an exact minimiser: D s = mu),
+        relative to the larger pressure, or to E max|g| / |Gamma_C| when both vanish. The
+        formula divides u's error by eps, the multiplier does not: a large mismatch means u is
+        too inaccurate for this eps."""
+        if not np.isfinite(multipliers).all() or not np.isfinite(u_free).all():
+            return float("nan")
+        formula = np.maximum(P @ u_free - gap.ravel(), 0.0) / np.repeat(epsilon, nq)
+        from_multiplier = np.maximum(multipliers, 0.0) / (np.tile(w, nf)
+                                                          * np.repeat(trace.length, nq))
+        scale = max(formula.max(initial=0.0), from_multiplier.max(initial=0.0),
+                    young * np.abs(gap).max(initial=0.0) / trace.length.sum())
+        return float(np.abs(formula - from_multiplier).max(initial=0.0) / scale) if scale \
+            else 0.0
     s_points = trace.coordinate[0][:, None] + np.diff(trace.coordinate, axis=0).T * t[None, :]
 
     def transfer(previous: DiscreteSolution) -> np.ndarray:
@@ -92,6 +124,11 @@ def discretise(scene: Scene, mesh: MeshTri,
     def recover(answer: QPSolution, residuals: Residuals, status: str,
                 reason: str) -> DiscreteSolution:
         u_free = answer.u[:n]
+        mismatch = pressure_mismatch(answer.u[:n], answer.multipliers[:ns])
+        if status == STATUS_OK and mismatch > PRESSURE_CONSISTENCY:
+            status, reason = STATUS_INACCURATE, (
+                f"penalty pressure (u_hn - g_h)_+/eps disagrees with the QP multipliers by "
+                f"{mismatch:.1e} (relative): u is not accurate enough for eps_0={epsilon_0:g}")
         u_nodal = elasticity.nodal(elasticity.expand(u_free))
 
         def pressure(tt):
@@ -105,7 +142,8 @@ def discretise(scene: Scene, mesh: MeshTri,
             pressure=pressure, multiplier_breaks=np.append(trace.coordinate[0],
                                                            trace.coordinate[1, -1]),
             active_constraints=penetrating,
-            extra={"epsilon_0": epsilon_0, "epsilon": epsilon, "slacks": answer.u[n:]})
+            extra={"epsilon_0": epsilon_0, "epsilon": epsilon, "slacks": answer.u[n:],
+                   "pressure_mismatch": mismatch})
 
     return Discretisation(formulation="penalty", elasticity=elasticity, trace=trace, qp=qp,
                           recover=recover, row_coordinate=np.tile(s_points.ravel(), 2),

@@ -17,15 +17,16 @@ _TOL = 1e-10
 
 
 def _block(name, description, gap, *, width=2.0, height=2.0, nx=4, ny=4, poisson_ratio=0.3,
-           plane="stress", young_modulus=70000.0, body_force=None, parameters=None) -> Scene:
+           plane="stress", young_modulus=70000.0, body_force=None, traction=None, ys=None,
+           is_dirichlet=None, parameters=None) -> Scene:
     xs = np.linspace(-width / 2, width / 2, nx + 1)
-    ys = np.linspace(-height / 2, height / 2, ny + 1)
+    ys = np.linspace(-height / 2, height / 2, ny + 1) if ys is None else ys
     return Scene(name=name, description=description, mesh=MeshTri.init_tensor(xs, ys),
                  material=Material(young_modulus, poisson_ratio, plane),
-                 is_dirichlet=lambda x: np.abs(x[1] - height / 2) < _TOL,
+                 is_dirichlet=is_dirichlet or (lambda x: np.abs(x[1] - height / 2) < _TOL),
                  is_contact=lambda x: np.abs(x[1] + height / 2) < _TOL,
                  gap=gap, contact_coordinate=lambda x: x[0], body_force=body_force,
-                 parameters=parameters or {}, tags=("hard",))
+                 traction=traction, parameters=parameters or {}, tags=("hard",))
 
 
 @register_scene("no-contact", "hard: a body pulled down by its weight, the obstacle 1.0 away "
@@ -60,3 +61,55 @@ def wedge() -> Scene:
 def thin() -> Scene:
     return _block("thin", "strip (-1,1) x (-0.02,0.02), g = x^2 - 0.001",
                   lambda x: x[0] ** 2 - 0.001, height=0.04, nx=50, ny=1)
+
+
+@register_scene("grazing", "hard: a block hanging under its weight (nu = 0) just touching a flat "
+                           "obstacle: u_n = g and p = 0 on all of Gamma_C (no strict "
+                           "complementarity)")
+def grazing(density: float = 1000.0) -> Scene:
+    """With nu = 0 and traction-free sides the hanging block is one-dimensional:
+    sigma_yy = rho (y + 1), u_y = rho ((y + 1)^2 - 4) / (2E), so the bottom moves down by
+    u_n = 2 rho / E. The obstacle is put exactly there: g = 2 rho / E, the body rests on it
+    with zero pressure everywhere -- every contact constraint is degenerate (tight, with a zero
+    multiplier). P1 is not exact for the quadratic u_y, so the discrete body presses with a
+    small force of order h^2 (a tiny, sign-indefinite residue the solvers must get right)."""
+    rho, E = float(density), 70000.0
+    return _block("grazing", f"hanging block, nu = 0, flat obstacle at g = 2 rho / E, "
+                  f"rho = {rho:g}", lambda x: np.full(x.shape[1:], 2.0 * rho / E),
+                  poisson_ratio=0.0, young_modulus=E,
+                  body_force=lambda x: np.array([0.0 * x[0], -rho + 0.0 * x[0]]),
+                  parameters={"density": rho})
+
+
+@register_scene("traction", "hard: load-driven contact: a cantilever (clamped left side) "
+                            "pressed by a traction on its top onto a flat obstacle 0.002 below")
+def traction(pressure: float = 400.0) -> Scene:
+    """No obstacle penetrates the initial configuration (g = 0.002 > 0): contact is made by
+    the load alone, near the free end, and the contact zone ends at the corner (1, -1)."""
+    q = float(pressure)
+    return _block("traction", f"cantilever, top traction (0, -{q:g}), flat obstacle g = 0.002",
+                  lambda x: np.full(x.shape[1:], 0.002),
+                  traction=lambda x: np.array([0.0 * x[0],
+                                               np.where(x[1] > 1.0 - _TOL, -q, 0.0)]),
+                  is_dirichlet=lambda x: np.abs(x[0] + 1.0) < _TOL,
+                  parameters={"pressure": q})
+
+
+@register_scene("corner", "hard: a tilted flat obstacle pushes the left end up; the contact "
+                          "zone ends at the corner (-1, -1) of the domain")
+def corner() -> Scene:
+    return _block("corner", "tilted flat obstacle g = 0.02 (x + 0.2)",
+                  lambda x: 0.02 * (x[0] + 0.2))
+
+
+@register_scene("graded", "hard: the paper's obstacle on a strongly graded initial mesh "
+                          "(geometric layers towards Gamma_C, aspect ratios up to ~250)")
+def graded(ratio: float = 0.5, layers: int = 9) -> Scene:
+    """y-spacing shrinks by ``ratio`` towards the contact edge: the first layer is
+    2 ratio^(layers-1) / (1 + ...) thin against elements 0.5 wide."""
+    widths = ratio ** np.arange(layers)  # bottom layer last
+    ys = 1.0 - 2.0 * np.concatenate([[0.0], np.cumsum(widths)]) / widths.sum()
+    return _block("graded", f"paper gap, {layers} geometric layers, ratio {ratio:g}",
+                  lambda x: 0.85 - np.sqrt(np.clip(1.0 - x[0] ** 2, 0.0, None)),
+                  ys=np.sort(ys), poisson_ratio=0.33,
+                  parameters={"ratio": ratio, "layers": layers})

@@ -21,8 +21,8 @@ def test_help_documents_every_option():
 
 
 @pytest.mark.parametrize("option, value, listed", [
-    ("--scene", "papr", "valid scenes: free-boundary, full-contact, hertz, incompressible, "
-                        "no-contact, paper, thin, wedge"),
+    ("--scene", "papr", "valid scenes: corner, free-boundary, full-contact, graded, grazing, "
+                        "hertz, incompressible, no-contact, paper, thin, traction, wedge"),
     ("--formulation", "mortar", "valid formulations: mixed, penalty, vi"),
     ("--solver", "gurobi", "valid solvers: active-set, reference"),
     ("--estimator", "dwr", "valid estimators: averaging, residual"),

@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 from formulations import get_formulation, solve
-from formulations.solvers.lcp import pdas
 from formulations.solvers.backends import available_backends
+from formulations.solvers.lcp import pdas
 from scenes import get_scene
 
 

@@ -68,8 +68,9 @@ def test_paper_scene_matches_design():
 
 
 def test_unknown_scene_lists_valid_ones():
-    with pytest.raises(KeyError, match="valid scenes: free-boundary, full-contact, hertz, "
-                       "incompressible, no-contact, paper, thin, wedge"):
+    with pytest.raises(KeyError, match="valid scenes: corner, free-boundary, full-contact, "
+                       "graded, grazing, hertz, incompressible, no-contact, paper, thin, "
+                       "traction, wedge"):
         get_scene("hertzz")
 
 
