@@ -9,6 +9,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from bench.hard import CASES as HARD_CASES
 from bench.loop import STRATEGIES, LevelResult, LoopConfig
 from bench.marking import MARKINGS
 from bench.matrix import run_matrix
@@ -171,6 +172,15 @@ def build_parser() -> argparse.ArgumentParser:
                             "every gate of bench/expected.toml. Exit status 1 if any fails.")
     verify.add_argument("--out", default="results-verify",
                         help="folder for the gate runs' results (default: results-verify)")
+    hard = sub.add_parser(
+        "hard", help="run the hard cases and print their verdicts",
+        description="Run every hard case (bench/hard.py) with every formulation and both "
+        "solvers, write OUT/hard.{csv,md}, and check each verdict against bench/expected.toml. "
+        "Exit status 1 if a verdict differs from the expected one.")
+    hard.add_argument("--case", type=_names("hard case", list(HARD_CASES)), default=None,
+                      help=f"case(s), comma-separated: {', '.join(HARD_CASES)} (default: all)")
+    hard.add_argument("--out", default="results-hard",
+                      help="folder for hard.csv and hard.md (default: results-hard)")
     sub.add_parser("list", help="list registered scenes, formulations, solvers, estimators",
                    description="List everything registered, with one line of description.")
     return parser
@@ -211,6 +221,8 @@ def main(argv: list[str] | None = None) -> int:
         frame = run_scaling(args.sizes, args.backend, args.reference_max_dofs, on_row=show)
         print(f"wrote {write_scaling(frame, args.out, args.readme)}")
         return 0
+    if args.command == "hard":
+        return _hard(args.case, args.out)
     if args.command == "verify":
         from bench.verify import verdict_table
         from bench.verify import verify as run_verify
@@ -233,6 +245,27 @@ def main(argv: list[str] | None = None) -> int:
         return _compare(args)
     return _run(args, " ".join(["python -m bench", *(argv if argv is not None else
                                                        sys.argv[1:])]))
+
+
+def _hard(cases, out) -> int:
+    from bench.hard import check_expected, hard_markdown, run_hard, write_hard
+    from bench.verify import load_expected
+
+    def show(name, frame):
+        print(f"hard case {name}: {len(frame)} rows, verdicts "
+              + ", ".join(f"{v} {n}" for v, n in frame["verdict"].value_counts().items()),
+              flush=True)
+
+    table = run_hard(cases, on_case=show)
+    print(f"wrote {write_hard(table, out)}\n")
+    print(hard_markdown(table))
+    checks = check_expected(table, load_expected().get("hard", []))
+    wrong = [c for c in checks if not c["passed"]]
+    for c in wrong:
+        print(f"UNEXPECTED: {c['case']}/{c['formulation']}/{c['solver']}/{c['variant']}: "
+              f"{c['verdict']}, expected {c['expected']}")
+    print(f"\n{len(checks) - len(wrong)} of {len(checks)} hard verdicts as expected")
+    return 1 if wrong else 0
 
 
 def _compare(args) -> int:

@@ -26,6 +26,7 @@ from __future__ import annotations
 import fnmatch
 from collections.abc import Callable
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -69,7 +70,8 @@ def _record(case, scene, disc, sol, variant, level) -> dict:
     residual = max(vars(sol.residuals).values())
     return dict(case=case, scene=scene.name, formulation=disc.formulation, solver=sol.solver,
                 variant=variant, level=level, ndofs=disc.ndofs, status=sol.status,
-                reason=sol.reason, safeguard=sol.diagnostics.get("safeguard", ""),
+                reason=sol.reason, backend=sol.backend,
+                safeguard=sol.diagnostics.get("safeguard", ""),
                 iterations=sol.iterations, max_residual=residual,
                 condition_estimate=sol.diagnostics.get("condition_estimate", np.nan),
                 inf_sup=np.nan, pressure_oscillation=pressure_oscillation(sol),
@@ -99,8 +101,10 @@ def solve_both(case: str, scene: Scene, formulation: str, mesh, variant: str = "
         differences = (0.0, 0.0)
         if sol is not solutions[best] and sol.status != STATUS_FAILED:
             differences = solution_difference(disc, sol, solutions[best])
+        # the penalty's own pressure self-check is a measured pressure loss too
+        mismatch = sol.extra.get("pressure_mismatch", 0.0)
         record.update(loss=max(record["max_residual"], differences[0]),
-                      pressure_loss=differences[1], inf_sup=beta)
+                      pressure_loss=max(differences[1], mismatch), inf_sup=beta)
         record["verdict"] = verdict(record["status"], record["loss"], record["pressure_loss"])
     return records, solutions
 
@@ -187,8 +191,9 @@ def penalty_sweep() -> list[dict]:
         rows, _ = solve_both("penalty-eps", scene, "penalty", mesh, variant=f"eps_0={eps:g}",
                              level=3, epsilon_0=eps)
         for row in rows:
-            row["finding"] = (f"penetration {row['penetration']:.2e}, condition "
-                              f"{row['condition_estimate']:.2e}")
+            row["finding"] = f"penetration {row['penetration']:.2e}" + (
+                f", condition {row['condition_estimate']:.2e}"
+                if np.isfinite(row["condition_estimate"]) else "")
         records += rows
     return records
 
@@ -254,17 +259,44 @@ def run_hard(cases: list[str] | None = None, on_case=None) -> pd.DataFrame:
 
 
 def check_expected(table: pd.DataFrame, expected: list[dict]) -> list[dict]:
-    """Each row's verdict against the first matching [[hard]] entry (default: accurate)."""
+    """Each row's verdict against the first matching [[hard]] entry (default: accurate); an
+    entry's verdict may list alternatives, "accurate|inaccurate", for a borderline case."""
     out = []
     for _, row in table.iterrows():
         want, source = "accurate", "default: every solve accurate"
         for entry in expected:
-            if all(fnmatch.fnmatch(str(row[k]), str(entry.get(k, "*")))
+            if all(fnmatch.fnmatch("" if pd.isna(row[k]) else str(row[k]),
+                                   str(entry.get(k, "*")))
                    for k in ("case", "formulation", "solver", "variant")):
                 want, source = entry["verdict"], entry["source"]
                 break
         out.append({"case": row["case"], "formulation": row["formulation"],
                     "solver": row["solver"], "variant": row["variant"],
                     "verdict": row["verdict"], "expected": want,
-                    "passed": row["verdict"] == want, "source": source})
+                    "passed": row["verdict"] in want.split("|"), "source": source})
     return out
+
+
+SUMMARY = ["case", "formulation", "solver", "variant", "ndofs", "status", "safeguard",
+           "iterations", "loss", "pressure_loss", "condition_estimate", "inf_sup",
+           "pressure_oscillation", "discretisation", "verdict", "finding"]
+
+
+def hard_markdown(table: pd.DataFrame) -> str:
+    """The verdict table (the report's and the CLI's), numbers at 3 significant digits."""
+    shown = table.reindex(columns=SUMMARY).copy()
+    for column in ("loss", "pressure_loss", "condition_estimate", "inf_sup",
+                   "pressure_oscillation"):
+        shown[column] = shown[column].map(lambda v: "" if pd.isna(v) else f"{v:.3g}")
+    shown["ndofs"] = shown["ndofs"].map(lambda v: "" if pd.isna(v) else f"{int(v)}")
+    shown["iterations"] = shown["iterations"].map(lambda v: "" if pd.isna(v) else f"{int(v)}")
+    return shown.fillna("").to_markdown(index=False)
+
+
+def write_hard(table: pd.DataFrame, out) -> Path:
+    """``out/hard.csv`` (every column) and ``out/hard.md`` (the verdict table)."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    table.to_csv(out / "hard.csv", index=False)
+    (out / "hard.md").write_text(hard_markdown(table) + "\n")
+    return out / "hard.csv"

@@ -15,6 +15,7 @@ import numpy as np
 import pandas as pd
 
 from bench.errors import contact_zone
+from bench.hard import check_expected, run_hard, write_hard
 from bench.loop import LoopConfig, run_sequence
 from bench.matrix import run_matrix
 from bench.rates import KEYS, rates_table
@@ -39,6 +40,7 @@ class Verdict:
     high: float
     passed: bool
     source: str
+    expected: str = ""  # a verdict gate's expected verdict (instead of a [low, high] band)
 
 
 def run_gate_matrices(expected: dict, out: str | Path, on_level=None) -> pd.DataFrame:
@@ -96,19 +98,39 @@ def judge(expected: dict, rates: pd.DataFrame, hertz: pd.DataFrame) -> list[Verd
     return verdicts
 
 
+def hard_verdicts(expected: dict, hard: pd.DataFrame) -> list[Verdict]:
+    """The hard cases' verdicts (bench.hard) against their [[hard]] entries."""
+    out = []
+    for check, (_, row) in zip(check_expected(hard, expected.get("hard", [])), hard.iterrows(),
+                               strict=True):
+        label = "/".join(str(check[k]) for k in ("formulation", "solver", "variant")
+                         if str(check[k]) not in ("", "nan"))
+        out.append(Verdict(f"hard case {check['case']}", label, float(row.get("loss", np.nan)),
+                           np.nan, np.nan, check["passed"],
+                           f"got {check['verdict']}; {check['source']}", check["expected"]))
+    return out
+
+
 def verify(out: str | Path = "results-verify", expected_path: str | Path = EXPECTED,
-           on_level=None) -> tuple[list[Verdict], pd.DataFrame, pd.DataFrame]:
+           on_level=None, hard: bool = True) -> tuple[list[Verdict], pd.DataFrame, pd.DataFrame]:
+    """Every gate; with ``hard`` also the hard cases' verdicts (written to out/hard.csv)."""
     expected = load_expected(expected_path)
     rows = run_gate_matrices(expected, out, on_level)
     rates = rates_table(rows)
     hertz = hertz_table(expected)
     rates.to_csv(Path(out) / "rates.csv", index=False)
     hertz.to_csv(Path(out) / "hertz.csv", index=False)
-    return judge(expected, rates, hertz), rates, hertz
+    verdicts = judge(expected, rates, hertz)
+    if hard:
+        table = run_hard()
+        write_hard(table, out)
+        verdicts += hard_verdicts(expected, table)
+    return verdicts, rates, hertz
 
 
 def verdict_table(verdicts: list[Verdict]) -> str:
     frame = pd.DataFrame([{"gate": v.gate, "combination": v.combination,
-                           "value": f"{v.value:.4g}", "allowed": f"[{v.low:g}, {v.high:g}]",
+                           "value": f"{v.value:.4g}",
+                           "allowed": v.expected or f"[{v.low:g}, {v.high:g}]",
                            "verdict": "pass" if v.passed else "FAIL"} for v in verdicts])
     return frame.to_markdown(index=False)
