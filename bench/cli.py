@@ -277,11 +277,13 @@ def _compare(args) -> int:
             ",".join(estimator_names()), "--strategy", "uniform,adaptive", "--max-dofs",
             str(args.max_dofs), "--reference-dofs", str(args.reference_dofs),
             "--crosscheck-dofs", str(args.crosscheck_dofs), "--out", args.out, "--overwrite"]
-    command = "python -m bench compare (= python -m bench " + " ".join(argv) + ")"
+    command = ("python -m bench compare (= python -m bench " + " ".join(argv)
+               + f", then python -m bench hard --out {args.out})")
     status = _run(build_parser().parse_args(argv), command)
+    hard_status = _hard(None, args.out)
     source = Path(args.out) / "results.parquet"
     print(f"wrote {write_report(pd.read_parquet(source), args.reports, args.out, command)}")
-    return status
+    return status or hard_status
 
 
 def _run(args, command: str) -> int:

@@ -282,15 +282,19 @@ SUMMARY = ["case", "formulation", "solver", "variant", "ndofs", "status", "safeg
            "pressure_oscillation", "discretisation", "verdict", "finding"]
 
 
-def hard_markdown(table: pd.DataFrame) -> str:
-    """The verdict table (the report's and the CLI's), numbers at 3 significant digits."""
+def hard_display(table: pd.DataFrame) -> pd.DataFrame:
+    """The verdict table as strings (the report's and the CLI's), numbers to 3 digits."""
     shown = table.reindex(columns=SUMMARY).copy()
     for column in ("loss", "pressure_loss", "condition_estimate", "inf_sup",
                    "pressure_oscillation"):
         shown[column] = shown[column].map(lambda v: "" if pd.isna(v) else f"{v:.3g}")
-    shown["ndofs"] = shown["ndofs"].map(lambda v: "" if pd.isna(v) else f"{int(v)}")
-    shown["iterations"] = shown["iterations"].map(lambda v: "" if pd.isna(v) else f"{int(v)}")
-    return shown.fillna("").to_markdown(index=False)
+    for column in ("ndofs", "iterations"):
+        shown[column] = shown[column].map(lambda v: "" if pd.isna(v) else f"{int(v)}")
+    return shown.astype(object).where(shown.notna(), "").astype(str)
+
+
+def hard_markdown(table: pd.DataFrame) -> str:
+    return hard_display(table).to_markdown(index=False)
 
 
 def write_hard(table: pd.DataFrame, out) -> Path:

@@ -16,6 +16,7 @@ import pandas as pd
 
 from bench import figures
 from bench.artifacts import artifact_path, load_artifact
+from bench.hard import LOSS_TOLERANCE, PRESSURE_TOLERANCE, hard_display
 from bench.rates import RATE_LEVELS, rates_table
 from bench.report_tables import (
     accuracy_table,
@@ -149,6 +150,9 @@ def write_report(table: pd.DataFrame, out: str | Path, results: str | Path | Non
     truth = {}
     if results is not None and (results / "truth.json").exists():
         truth = json.loads((results / "truth.json").read_text())
+    hard = None
+    if results is not None and (results / "hard.csv").exists():
+        hard = hard_display(pd.read_csv(results / "hard.csv", keep_default_na=True))
     figs = Figures(out)
     scenes = [scene_section(name, group, results, figs, truth)
               for name, group in rows.groupby("scene", sort=True)]
@@ -159,11 +163,14 @@ def write_report(table: pd.DataFrame, out: str | Path, results: str | Path | Non
         "configuration": run_info.get("configuration", {}),
         "commit": head.get("commit", ""), "versions": head.get("versions", ""),
         "machine": head.get("machine", ""), "python": head.get("python", ""),
-        "rate_levels": RATE_LEVELS, "missing_columns": missing, "scenes": scenes,
+        "rate_levels": RATE_LEVELS, "loss_tolerance": LOSS_TOLERANCE,
+        "pressure_tolerance": PRESSURE_TOLERANCE, "missing_columns": missing, "scenes": scenes,
         "tables": {
             "rates": rate_verdicts(rates), "effectivity": effectivity_table(rates),
             "accuracy": accuracy_table(rows), "timing": timing_table(rows),
-            "agreement": agreement_table(rows), "failures": failure_table(everything)},
+            "agreement": agreement_table(rows), "failures": failure_table(everything),
+            "hard": hard if hard is not None else pd.DataFrame()},
+        "hard_run": hard is not None,
         "n_rows": len(everything), "n_too_coarse": int(rows["reference_too_coarse"]
                                                         .fillna(False).astype(bool).sum()),
     }

@@ -107,3 +107,29 @@ def test_store_adds_new_columns_to_results_of_an_older_version(tmp_path):
     store = ResultStore(tmp_path)
     assert list(store.previous.columns) == COLUMNS
     assert list(pd.read_csv(tmp_path / "results.csv").columns) == COLUMNS
+
+
+def test_every_row_carries_the_stability_diagnostics(tmp_path):
+    config = LoopConfig(strategy="uniform", max_dofs=9000)
+    rows = {f: [r.row for r in run_sequence(get_scene("paper"), f, "active-set", "residual",
+                                            config)] for f in ("mixed", "vi")}
+    for formulation, sequence in rows.items():
+        for row in sequence[1:]:  # level 0 has no contact on the paper scene
+            assert row.status == "ok" and not row.cycled and row.safeguard == ""
+            changes = [int(c) for c in row.active_set_changes.split(",")]
+            assert changes[-1] == 0 and len(changes) == row.iterations
+            assert row.condition_estimate >= 1.0
+            # one hump of pressure: TV / (2 max) = 1 (up to the P0 staircase's overshoot)
+            assert 1.0 <= row.pressure_oscillation < 1.05
+            assert np.isnan(row.inf_sup) == (formulation != "mixed")
+    # the mixed method at h/H = 1/2 is inf-sup stable: beta_h bounded below, settling (the
+    # hard case mixed-h/H measures the same against h/H = 1, where it decays like h)
+    beta = np.array([r.inf_sup for r in rows["mixed"]])
+    assert beta.min() > 0.5 and abs(beta[-1] - beta[-2]) < 0.02
+    # every column survives the store
+    store = ResultStore(tmp_path)
+    for row in rows["mixed"]:
+        store.append(row)
+    table = pd.read_parquet(store.parquet)
+    assert table["active_set_changes"].iloc[-1] == rows["mixed"][-1].active_set_changes
+    assert table["inf_sup"].notna().all()

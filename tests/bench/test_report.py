@@ -10,13 +10,14 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from bench.hard import run_hard, write_hard
 from bench.loop import LoopConfig
 from bench.matrix import run_matrix
 from bench.report import write_report
 from bench.store import ResultStore
 
 SECTIONS = ["contents", "what-was-run", "scenes", "results-per-scene", "summary-across-scenes",
-            "failures-and-skips", "known-limitations"]
+            "failures-and-skips", "hard-cases", "known-limitations"]
 PNG = b"\x89PNG\r\n\x1a\n"
 
 
@@ -42,6 +43,7 @@ def results(tmp_path_factory):
     store = ResultStore(out)
     run_matrix(["paper", "free-boundary"], ["mixed", "vi"], ["active-set"], ["residual"],
                ["uniform", "adaptive"], store, LoopConfig(max_dofs=600), crosscheck_dofs=600)
+    write_hard(run_hard(["no-contact", "invalid"]), out)
     return out
 
 
@@ -70,8 +72,12 @@ def test_html_is_self_contained_with_every_section_and_figure(report):
 def test_markdown_links_every_figure_file(report):
     text = (report / "README.md").read_text()
     for title in ("## Contents", "## What was run", "## Scenes", "## Results per scene",
-                  "## Summary across scenes", "## Failures and skips", "## Known limitations"):
+                  "## Summary across scenes", "## Failures and skips", "## Hard cases",
+                  "## Known limitations"):
         assert title in text
+    hard = text.split("## Hard cases")[1].split("## Known limitations")[0]
+    assert "poisson_ratio=0.5 is not < 0.5" in hard and "| refused " in hard
+    assert hard.count("| no-contact ") == 6  # 3 formulations x 2 solvers
     figures = sorted(p.name for p in (report / "figures").glob("*.png"))
     assert len(figures) == 13
     for name in figures:
@@ -97,7 +103,9 @@ def test_report_of_only_failed_rows_still_renders(tmp_path):
                            "estimator": "residual", "strategy": "uniform", "level": -1,
                            "status": "failed", "reason": "RuntimeError: boom", "run_id": "1"}])
     write_report(table, tmp_path)
-    assert "RuntimeError: boom" in (tmp_path / "README.md").read_text()
+    text = (tmp_path / "README.md").read_text()
+    assert "RuntimeError: boom" in text
+    assert "Not run for these results (no `hard.csv`" in text
 
 
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
