@@ -248,7 +248,8 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _hard(cases, out) -> int:
-    from bench.hard import check_expected, hard_markdown, run_hard, write_hard
+    from bench.hard import run_hard
+    from bench.hard_verdicts import check_expected, hard_markdown, write_hard
     from bench.verify import load_expected
 
     def show(name, frame):

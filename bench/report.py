@@ -16,7 +16,7 @@ import pandas as pd
 
 from bench import figures
 from bench.artifacts import artifact_path, load_artifact
-from bench.hard import LOSS_TOLERANCE, PRESSURE_TOLERANCE, hard_display
+from bench.hard_verdicts import LOSS_TOLERANCE, PRESSURE_TOLERANCE, hard_display
 from bench.rates import RATE_LEVELS, rates_table
 from bench.report_tables import (
     accuracy_table,

@@ -15,7 +15,8 @@ import numpy as np
 import pandas as pd
 
 from bench.errors import contact_zone
-from bench.hard import check_expected, run_hard, write_hard
+from bench.hard import run_hard
+from bench.hard_verdicts import check_expected, write_hard
 from bench.loop import LoopConfig, run_sequence
 from bench.matrix import run_matrix
 from bench.rates import KEYS, rates_table

@@ -38,11 +38,12 @@ import time
 from dataclasses import replace
 
 import numpy as np
+from scipy import sparse
 
 from formulations.base import STATUS_OK, ContactQP, QPSolution
 from formulations.solvers.augmented import initial_active_set, solve_augmented
 from formulations.solvers.backends import check_backend, factorise_condensed
-from formulations.solvers.lcp import condition_1, least_index_pivoting, pdas
+from formulations.solvers.lcp import CYCLING_EXAMPLE, condition_1, least_index_pivoting, pdas
 from formulations.solvers.reference import solve_reference
 from formulations.solvers.registry import register_solver
 
@@ -103,3 +104,13 @@ def solve_active_set(qp: ContactQP, warm_start: np.ndarray | None = None,
     return QPSolution(u=u, multipliers=result.lam, status=STATUS_OK, reason=reason,
                       iterations=iterations, solve_time=time.perf_counter() - start,
                       solver="active-set", backend=factor.backend, diagnostics=diagnostics)
+
+
+def cycling_qp() -> ContactQP:
+    """A contact QP whose condensed system is ``lcp.CYCLING_EXAMPLE``: K = S^-1, B = I, F = 0,
+    G = -r (so B K^-1 B' = S and B u0 - G = r); start it from the example's active set
+    (``warm_start``) to make the plain iteration cycle."""
+    S, r, _ = CYCLING_EXAMPLE
+    return ContactQP(K=sparse.csr_matrix(np.linalg.inv(S)), F=np.zeros(r.size),
+                     B=sparse.identity(r.size, format="csr"), G=-r, row_scale=np.ones(r.size),
+                     objective_scale=1.0)

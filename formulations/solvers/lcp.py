@@ -4,8 +4,8 @@ symmetric positive definite (the condensed contact system B K^-1 B', see ``activ
 * ``pdas``: the primal-dual active set method (Hintermueller, Ito, Kunisch 2003; the semismooth
   Newton method on lam = max(0, lam - c y)). Fast -- a handful of iterations, and 1-3 with
   nested iteration -- but not globally convergent for every SPD S: it can cycle (a random
-  search over 3x3..5x5 SPD matrices finds such cases, tests/formulations/test_lcp.py keeps
-  one; Ben Gharbia and Gilbert 2012 show it for P-matrices in general).
+  search over 3x3..5x5 SPD matrices finds such cases; ``CYCLING_EXAMPLE`` keeps one; Ben
+  Gharbia and Gilbert 2012 show it for P-matrices in general).
 * ``least_index_pivoting``: Murty's principal pivoting with the least-index rule (Murty 1974):
   flip only the smallest infeasible index of the current complementary basis. It terminates
   in finitely many steps for every P-matrix, so it is the safeguard the active-set solver
@@ -26,6 +26,18 @@ from formulations.base import STATUS_FAILED, STATUS_OK
 # a multiplier or slack counts as negative below -ROUNDOFF x its natural scale: without it the
 # pivoting rule chases the signs of round-off on degenerate (grazing) problems
 ROUNDOFF = 1e-12
+
+
+# (S, r, initial active set) on which plain PDAS cycles: found by a random search over SPD
+# matrices (numpy seed 0, trial 2392); from this start it revisits an active set after 5 steps
+CYCLING_EXAMPLE = (
+    np.array([[3.33914076, -1.96172517, -0.00715703, -1.06847366, 1.66118594],
+              [-1.96172517, 3.25846728, 0.04343212, -0.39452142, -1.75831306],
+              [-0.00715703, 0.04343212, 6.52869201, -1.95694266, -1.46103878],
+              [-1.06847366, -0.39452142, -1.95694266, 2.59830682, 1.04405007],
+              [1.66118594, -1.75831306, -1.46103878, 1.04405007, 1.9634999]]),
+    np.array([0.02812848, -2.17454055, 1.15602742, -0.07672046, 0.86086229]),
+    np.array([False, True, False, True, False]))
 
 
 @dataclass(frozen=True)

@@ -10,7 +10,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from bench.hard import run_hard, write_hard
+from bench.hard import run_hard
+from bench.hard_verdicts import write_hard
 from bench.loop import LoopConfig
 from bench.matrix import run_matrix
 from bench.report import write_report

@@ -2,24 +2,14 @@
 
 import numpy as np
 import pytest
-from scipy import sparse
 
 from formulations.base import ContactQP
 from formulations.kkt import qp_residuals
-from formulations.solvers.active_set import solve_active_set
+from formulations.solvers.active_set import cycling_qp, solve_active_set
 from formulations.solvers.backends import available_backends
-from formulations.solvers.lcp import least_index_pivoting, pdas
+from formulations.solvers.lcp import CYCLING_EXAMPLE, least_index_pivoting, pdas
 
-# found by a random search over SPD matrices (seed 0, trial 2392): from this start the plain
-# primal-dual active set method revisits an active set after 5 iterations
-CYCLING_S = np.array([
-    [3.33914076, -1.96172517, -0.00715703, -1.06847366, 1.66118594],
-    [-1.96172517, 3.25846728, 0.04343212, -0.39452142, -1.75831306],
-    [-0.00715703, 0.04343212, 6.52869201, -1.95694266, -1.46103878],
-    [-1.06847366, -0.39452142, -1.95694266, 2.59830682, 1.04405007],
-    [1.66118594, -1.75831306, -1.46103878, 1.04405007, 1.9634999]])
-CYCLING_R = np.array([0.02812848, -2.17454055, 1.15602742, -0.07672046, 0.86086229])
-CYCLING_START = np.array([False, True, False, True, False])
+CYCLING_S, CYCLING_R, CYCLING_START = CYCLING_EXAMPLE
 
 
 def assert_solves_lcp(S, r, lam, tol=1e-12):
@@ -50,10 +40,7 @@ def test_least_index_pivoting_solves_it_and_random_spd_lcps():
 
 
 def _cycling_qp() -> ContactQP:
-    # K = S^-1, B = I, F = 0, G = -r: the condensed system B K^-1 B' is exactly CYCLING_S
-    K = sparse.csr_matrix(np.linalg.inv(CYCLING_S))
-    return ContactQP(K=K, F=np.zeros(5), B=sparse.identity(5, format="csr"), G=-CYCLING_R,
-                     row_scale=np.ones(5), objective_scale=1.0)
+    return cycling_qp()
 
 
 @pytest.mark.parametrize("backend", available_backends())
