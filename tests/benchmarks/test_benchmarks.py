@@ -17,6 +17,7 @@ import pytest
 from bench.scaling import linear_rhs, paper_problem
 from estimators import get_estimator
 from formulations import get_formulation, solve
+from formulations.diagnostics import inf_sup_constant, pressure_oscillation
 from formulations.solvers.backends import default_backend, factorise
 
 SIZES = ["1e4", pytest.param("1e5", marks=pytest.mark.slow),
@@ -80,6 +81,19 @@ def test_estimator(benchmark, problem, solution):
                              rounds=ROUNDS[size], iterations=1)
     assert np.isfinite(est.eta) and est.eta > 0
     _info(benchmark, disc, eta=float(est.eta))
+
+
+def test_stability_diagnostics(benchmark, problem, solution):
+    # the loop's diagnostic columns: the inf-sup constant (one factorisation of K and one solve
+    # per multiplier segment) and the pressure oscillation
+    size, _, _, disc = problem
+
+    def diagnose():
+        return inf_sup_constant(disc), pressure_oscillation(solution)
+
+    beta, oscillation = benchmark.pedantic(diagnose, rounds=ROUNDS[size], iterations=1)
+    assert beta > 0.5 and oscillation >= 1.0  # h/H = 1/2 on uniform meshes: beta ~ 0.53
+    _info(benchmark, disc, inf_sup=beta, pressure_oscillation=oscillation)
 
 
 @pytest.mark.parametrize("size", ["1e4", pytest.param("1e5", marks=pytest.mark.slow)])
