@@ -77,6 +77,8 @@ def accuracy_table(rows: pd.DataFrame) -> pd.DataFrame:
                     "zone": f"[{_fmt(last['contact_zone_start'], '.4g')}, "
                             f"{_fmt(last['contact_zone_end'], '.4g')}]",
                     "iterations": int(last["iterations"]),
+                    "pressure oscillation": _fmt(last.get("pressure_oscillation")),
+                    "inf-sup": _fmt(last.get("inf_sup")),
                     "total time [s]": _fmt(_total_time(group), ".3g"), "status": last["status"]})
     return pd.DataFrame(out)
 
