@@ -150,10 +150,17 @@ def write_report(table: pd.DataFrame, out: str | Path, results: str | Path | Non
     truth = {}
     if results is not None and (results / "truth.json").exists():
         truth = json.loads((results / "truth.json").read_text())
-    hard = None
-    if results is not None and (results / "hard.csv").exists():
-        hard = hard_display(pd.read_csv(results / "hard.csv", keep_default_na=True))
+    hard, hard_figures = None, []
     figs = Figures(out)
+    if results is not None and (results / "hard.csv").exists():
+        raw = pd.read_csv(results / "hard.csv")
+        hard = hard_display(raw)
+        item = figs.add(figures.hard_stability(raw, PRESSURE_TOLERANCE), "hard-stability",
+                        "Hard cases: the mixed method's inf-sup constant beta_h against ndofs "
+                        "for h/H = 1, 1/2, 1/4 (bounded below only for h/H <= 1/2); the "
+                        "penalty's penetration and condition estimate against eps_0; and each "
+                        "solver's pressure loss against eps_0, with the bar for 'accurate'.")
+        hard_figures = [item] if item is not None else []
     scenes = [scene_section(name, group, results, figs, truth)
               for name, group in rows.groupby("scene", sort=True)]
     rates = rates_table(rows) if len(rows) else pd.DataFrame()
@@ -170,7 +177,7 @@ def write_report(table: pd.DataFrame, out: str | Path, results: str | Path | Non
             "accuracy": accuracy_table(rows), "timing": timing_table(rows),
             "agreement": agreement_table(rows), "failures": failure_table(everything),
             "hard": hard if hard is not None else pd.DataFrame()},
-        "hard_run": hard is not None,
+        "hard_run": hard is not None, "hard_figures": hard_figures,
         "n_rows": len(everything), "n_too_coarse": int(rows["reference_too_coarse"]
                                                         .fillna(False).astype(bool).sum()),
     }

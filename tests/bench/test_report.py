@@ -44,7 +44,7 @@ def results(tmp_path_factory):
     store = ResultStore(out)
     run_matrix(["paper", "free-boundary"], ["mixed", "vi"], ["active-set"], ["residual"],
                ["uniform", "adaptive"], store, LoopConfig(max_dofs=600), crosscheck_dofs=600)
-    write_hard(run_hard(["no-contact", "invalid"]), out)
+    write_hard(run_hard(["no-contact", "penalty-eps", "invalid"]), out)
     return out
 
 
@@ -62,8 +62,9 @@ def test_html_is_self_contained_with_every_section_and_figure(report):
     assert [s for s in SECTIONS if s not in parser.ids] == []
     assert parser.external == []  # no scripts, stylesheets or linked images
     # 2 scenes x (scene, convergence, effectivity, work-precision, meshes, deformed, pressure),
-    # less the paper's effectivity: without --reference-dofs it has no error to divide by
-    assert len(parser.images) == 13
+    # less the paper's effectivity: without --reference-dofs it has no error to divide by;
+    # plus the hard cases' figure
+    assert len(parser.images) == 14
     for src in parser.images:
         assert src.startswith("data:image/png;base64,")
         data = base64.b64decode(src.split(",", 1)[1])
@@ -80,7 +81,7 @@ def test_markdown_links_every_figure_file(report):
     assert "poisson_ratio=0.5 is not < 0.5" in hard and "| refused " in hard
     assert hard.count("| no-contact ") == 6  # 3 formulations x 2 solvers
     figures = sorted(p.name for p in (report / "figures").glob("*.png"))
-    assert len(figures) == 13
+    assert len(figures) == 14 and "hard-stability.png" in figures
     for name in figures:
         assert f"figures/{name}" in text
     assert "test command" in text and "agrees" in text  # rates verdicts against the claims
