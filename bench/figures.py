@@ -249,7 +249,8 @@ def hard_stability(hard: pd.DataFrame, pressure_bar: float):
     axes[2].set(xlabel="eps_0", title="penalty: pressure loss")
     for ax in axes:
         ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=7)
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(fontsize=7)
         ax.title.set_fontsize(10)
     for ax in axes[1:]:
         ax.invert_xaxis()
