@@ -57,3 +57,20 @@ def test_list_prints_registered_names():
     out = run("list").stdout
     for name in ("paper", "mixed", "reference", "residual"):
         assert name in out
+
+
+def test_hard_runs_the_named_cases_and_checks_their_verdicts(tmp_path):
+    result = run("hard", "--case", "invalid,cycling", "--out", str(tmp_path))
+    assert result.returncode == 0, result.stderr
+    assert "poisson_ratio=0.5 is not < 0.5" in result.stdout
+    assert "hard verdicts as expected" in result.stdout
+    table = pd.read_csv(tmp_path / "hard.csv")
+    assert set(table["case"]) == {"invalid", "cycling"}
+    assert (tmp_path / "hard.md").read_text().startswith("| case")
+
+
+def test_hard_refuses_an_unknown_case(capsys):
+    with pytest.raises(SystemExit) as exit_:
+        main(["hard", "--case", "wobbly"])
+    assert exit_.value.code == 2
+    assert "unknown hard case 'wobbly'; valid hard cases: no-contact" in capsys.readouterr().err
