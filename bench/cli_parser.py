@@ -27,28 +27,25 @@ def _names(kind: str, valid: list[str]):
     return parse
 
 
-def _positive_int(name: str):
+def _integer(name: str, minimum: int, allowed: str):
+    """An int option >= ``minimum``, refused as "name='text' is not <allowed>"."""
     def parse(text: str) -> int:
         try:
             value = int(text)
         except ValueError:
-            value = None
-        if value is None or value <= 0:
-            raise argparse.ArgumentTypeError(f"{name}={text!r} is not a positive integer")
+            value = minimum - 1
+        if value < minimum:
+            raise argparse.ArgumentTypeError(f"{name}={text!r} is not {allowed}")
         return value
     return parse
+
+
+def _positive_int(name: str):
+    return _integer(name, 1, "a positive integer")
 
 
 def _non_negative_int(name: str):
-    def parse(text: str) -> int:
-        try:
-            value = int(text)
-        except ValueError:
-            value = -1
-        if value < 0:
-            raise argparse.ArgumentTypeError(f"{name}={text!r} is not an integer >= 0")
-        return value
-    return parse
+    return _integer(name, 0, "an integer >= 0")
 
 
 def _theta(text: str) -> float:
