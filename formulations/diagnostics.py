@@ -12,8 +12,9 @@ arrays and the returned solution, never taken from a solver.
   Necas 1996). Since (mu, v_n) = mu'Bv, the sup over v is (mu' B K^-1 B' mu)^(1/2), so beta_h^2
   is the smallest eigenvalue of the pencil (E B K^-1 B', M) with M the Gram matrix of the
   multiplier norm (``Discretisation.multiplier_gram``). Dimensionless; bounded below under
-  refinement exactly when the pair is uniformly stable. K^-1 B' costs one factorisation of K
-  and m solves.
+  refinement exactly when the pair is uniformly stable. B K^-1 B' is the active-set solver's
+  condensed system on its cholmod route (passed as ``condensed``); otherwise it costs one
+  factorisation of K and m solves.
 * ``pressure_oscillation``: TV(lambda_h) / (2 max lambda_h) along Gamma_C, with lambda_h taken
   as 0 beyond the ends of Gamma_C: 1 for any single-hump (or constant) pressure, larger for every
   extra wiggle; a checkerboard multiplier drives it up with the number of segments. 0 when
@@ -31,16 +32,20 @@ from formulations.solvers.backends import factorise
 SOLVE_BLOCK = 8  # right-hand sides per solve (SuperLU slows down with many at once)
 
 
-def inf_sup_constant(discretisation, backend: str | None = None) -> float:
-    """beta_h (see the module docstring); NaN for a formulation without a multiplier space."""
+def inf_sup_constant(discretisation, backend: str | None = None,
+                     condensed: np.ndarray | None = None) -> float:
+    """beta_h (see the module docstring); NaN for a formulation without a multiplier space.
+    ``condensed``: B K^-1 B' if the caller already has it (else computed here)."""
     qp, multiplier_gram = discretisation.qp, discretisation.multiplier_gram
     if multiplier_gram is None or qp.m == 0:
         return float("nan")
-    solve = factorise(qp.K, backend)
-    Bt = qp.B.T.tocsc()
-    X = np.column_stack([solve(Bt[:, k:k + SOLVE_BLOCK].toarray())
-                         for k in range(0, qp.m, SOLVE_BLOCK)])
-    S = qp.objective_scale * (qp.B @ X)
+    if condensed is None:
+        solve = factorise(qp.K, backend)
+        Bt = qp.B.T.tocsc()
+        X = np.column_stack([solve(Bt[:, k:k + SOLVE_BLOCK].toarray())
+                             for k in range(0, qp.m, SOLVE_BLOCK)])
+        condensed = qp.B @ X
+    S = qp.objective_scale * np.asarray(condensed)
     S = 0.5 * (S + S.T)
     smallest = linalg.eigh(S, np.diag(multiplier_gram), eigvals_only=True,
                            subset_by_index=[0, 0])[0]

@@ -100,6 +100,7 @@ def solve_active_set(qp: ContactQP, warm_start: np.ndarray | None = None,
         reason += "; answered by least-index pivoting (safeguard)"
     scaled = S / np.outer(qp.row_scale, qp.row_scale)  # the solver's units, as for splu
     diagnostics["condition_estimate"] = condition_1(scaled, result.active)
+    diagnostics["condensed"] = S  # B K^-1 B', reused by formulations.diagnostics
     u = factor.solve(qp.F - qp.B.T @ result.lam)
     return QPSolution(u=u, multipliers=result.lam, status=STATUS_OK, reason=reason,
                       iterations=iterations, solve_time=time.perf_counter() - start,
