@@ -72,7 +72,8 @@ def grazing(density: float = 1000.0) -> Scene:
     u_n = 2 rho / E. The obstacle is put exactly there: g = 2 rho / E, the body rests on it
     with zero pressure everywhere -- every contact constraint is degenerate (tight, with a zero
     multiplier). P1 is not exact for the quadratic u_y, so the discrete body presses with a
-    small force of order h^2 (a tiny, sign-indefinite residue the solvers must get right)."""
+    small residual force of order h^2, which the solvers must get right with every constraint
+    nearly degenerate."""
     rho, E = float(density), 70000.0
     return _block("grazing", f"hanging block, nu = 0, flat obstacle at g = 2 rho / E, "
                   f"rho = {rho:g}", lambda x: np.full(x.shape[1:], 2.0 * rho / E),
@@ -103,10 +104,11 @@ def corner() -> Scene:
 
 
 @register_scene("graded", "hard: the paper's obstacle on a strongly graded initial mesh "
-                          "(geometric layers towards Gamma_C, aspect ratios up to ~250)")
+                          "(geometric layers towards Gamma_C, aspect ratios up to ~130)")
 def graded(ratio: float = 0.5, layers: int = 9) -> Scene:
-    """y-spacing shrinks by ``ratio`` towards the contact edge: the first layer is
-    2 ratio^(layers-1) / (1 + ...) thin against elements 0.5 wide."""
+    """y-spacing shrinks by ``ratio`` towards the contact edge: with the defaults the bottom
+    layer is 2 ratio^(layers-1) / sum_k ratio^k = 0.0039 thin against elements 0.5 wide
+    (aspect ratio 128)."""
     widths = ratio ** np.arange(layers)  # bottom layer last
     ys = 1.0 - 2.0 * np.concatenate([[0.0], np.cumsum(widths)]) / widths.sum()
     return _block("graded", f"paper gap, {layers} geometric layers, ratio {ratio:g}",

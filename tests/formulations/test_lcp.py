@@ -3,7 +3,6 @@
 import numpy as np
 import pytest
 
-from formulations.base import ContactQP
 from formulations.kkt import qp_residuals
 from formulations.solvers.active_set import cycling_qp, solve_active_set
 from formulations.solvers.backends import available_backends
@@ -39,13 +38,9 @@ def test_least_index_pivoting_solves_it_and_random_spd_lcps():
         assert_solves_lcp(S, r, result.lam, tol=1e-9)
 
 
-def _cycling_qp() -> ContactQP:
-    return cycling_qp()
-
-
 @pytest.mark.parametrize("backend", available_backends())
 def test_the_solver_safeguards_a_cycling_iteration(backend):
-    qp = _cycling_qp()
+    qp = cycling_qp()
     answer = solve_active_set(qp, warm_start=CYCLING_START.astype(float), backend=backend)
     assert answer.status == "ok"
     residuals = qp_residuals(qp, answer.u, answer.multipliers)
@@ -61,7 +56,7 @@ def test_the_solver_safeguards_a_cycling_iteration(backend):
 
 @pytest.mark.parametrize("backend", available_backends())
 def test_an_exhausted_iteration_is_safeguarded_and_says_so(backend):
-    qp = _cycling_qp()
+    qp = cycling_qp()
     answer = solve_active_set(qp, warm_start=CYCLING_START.astype(float), backend=backend,
                               max_iter=1)
     assert answer.status == "ok" and "still changing" in answer.reason
