@@ -14,12 +14,13 @@ from formulations.base import (
     DiscreteSolution,
     QPSolution,
     Residuals,
+    SolverDiagnostics,
 )
 from formulations.discretisation import Discretisation, solve
 from formulations.registry import formulation_descriptions, formulation_names, get_formulation
 from formulations.solvers import get_solver, solver_descriptions, solver_names
 
 __all__ = ["STATUS_FAILED", "STATUS_INACCURATE", "STATUS_OK", "STATUS_SKIPPED", "ContactQP",
-           "DiscreteSolution", "Discretisation", "QPSolution", "Residuals",
+           "DiscreteSolution", "Discretisation", "QPSolution", "Residuals", "SolverDiagnostics",
            "formulation_descriptions", "formulation_names", "get_formulation", "get_solver",
            "solve", "solver_descriptions", "solver_names"]

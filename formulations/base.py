@@ -1,7 +1,8 @@
-"""Data passed between formulations, solvers and estimators (DESIGN.md section 3).
+"""Data passed between formulations, solvers and estimators (docs/theory.md, section 3).
 
 * ``ContactQP``: the discrete problem min 1/2 u'Ku - F'u s.t. Bu <= G over the free DOFs.
-* ``QPSolution``: what a solver returns (arrays plus the solver's own status).
+* ``QPSolution``: what a solver returns (arrays plus the solver's own status and its
+  ``SolverDiagnostics``).
 * ``DiscreteSolution``: u_h and lambda_h on Gamma_C with residuals computed from the arrays,
   the same object for every formulation so that estimators never branch on its name.
 """
@@ -52,6 +53,18 @@ class ContactQP:
 
 
 @dataclass(frozen=True, eq=False)
+class SolverDiagnostics:
+    """What a solver reports about its own run (``formulations.solvers.active_set``); the
+    defaults are what a solver that reports nothing (the reference) gets."""
+
+    active_set_changes: tuple[int, ...] = ()  # constraints entering or leaving, per iteration
+    cycled: bool = False  # the plain active-set iteration repeated a set
+    safeguard: str = ""  # what answered instead of the plain iteration ("" if nothing did)
+    condition_estimate: float = float("nan")  # of the last linear system, solver's scaling
+    condensed: np.ndarray | None = None  # B K^-1 B' when the solver formed it (cholmod)
+
+
+@dataclass(frozen=True, eq=False)
 class QPSolution:
     """A solver's answer: primal u (free DOFs), multipliers of Bu <= G, and its own report."""
 
@@ -63,9 +76,7 @@ class QPSolution:
     solve_time: float
     solver: str
     backend: str = ""
-    # solver diagnostics (see formulations.solvers.active_set): active_set_changes, cycled,
-    # safeguard, condition_estimate; empty for solvers that report none
-    diagnostics: dict = field(default_factory=dict)
+    diagnostics: SolverDiagnostics = field(default_factory=SolverDiagnostics)
 
 
 @dataclass(frozen=True)
@@ -102,8 +113,14 @@ class DiscreteSolution:
     active_constraints: int
     max_h_over_H: float = float("nan")
     backend: str = ""
-    extra: dict = field(default_factory=dict)
-    diagnostics: dict = field(default_factory=dict)  # the solver's (QPSolution.diagnostics)
+    # the QP multipliers (clipped at 0) and the formulation's own arrays (a frozen dataclass
+    # of the formulation module, e.g. ``formulations.mixed.MixedDetails``)
+    multipliers: np.ndarray | None = None
+    details: object | None = None
+    # relative disagreement of the formulation's pressure with its QP multipliers, where the
+    # formulation can check it (penalty); 0 where lambda_h is the multiplier itself
+    pressure_mismatch: float = 0.0
+    diagnostics: SolverDiagnostics = field(default_factory=SolverDiagnostics)
 
     @property
     def ok(self) -> bool:

@@ -10,7 +10,7 @@ import numpy as np
 from formulations.base import STATUS_FAILED, ContactQP, DiscreteSolution, QPSolution, Residuals
 from formulations.contact import ContactTrace
 from formulations.elasticity import Elasticity
-from formulations.kkt import judge, qp_residuals
+from formulations.kkt import final_status, qp_residuals
 from formulations.solvers import get_solver
 
 
@@ -57,12 +57,14 @@ def discrete_solution(formulation: str, elasticity: Elasticity, trace: ContactTr
         u=elasticity.expand(u_free), pressure=pressure, multiplier_breaks=multiplier_breaks,
         residuals=residuals, status=status, reason=reason, iterations=answer.iterations,
         solve_time=answer.solve_time, active_constraints=active_constraints,
-        backend=answer.backend, diagnostics=dict(answer.diagnostics), **specific)
+        backend=answer.backend, diagnostics=answer.diagnostics,
+        multipliers=np.maximum(answer.multipliers, 0.0), **specific)
 
 
 def solve(discretisation: Discretisation, solver: str, **options) -> DiscreteSolution:
     """Solve with the named solver, compute the KKT residuals from the returned arrays, and
-    judge the result. A failed solve carries status ``failed`` and NaN arrays (never silently)."""
+    give the final status. A failed solve carries status ``failed`` and NaN arrays (never
+    silently)."""
     answer = get_solver(solver)(discretisation.qp, **options)
     if answer.u is None or answer.multipliers is None:
         nan = np.full(discretisation.qp.n, np.nan)
@@ -70,8 +72,8 @@ def solve(discretisation: Discretisation, solver: str, **options) -> DiscreteSol
                             STATUS_FAILED, answer.reason, answer.iterations, answer.solve_time,
                             answer.solver, answer.backend, answer.diagnostics)
         residuals = Residuals(*(4 * [float("nan")]))
-        status, reason = judge(answer, None)
+        status, reason = final_status(answer, None)
     else:
         residuals = qp_residuals(discretisation.qp, answer.u, answer.multipliers)
-        status, reason = judge(answer, residuals)
+        status, reason = final_status(answer, residuals)
     return discretisation.recover(answer, residuals, status, reason)

@@ -56,7 +56,7 @@ def qp_residuals(qp: ContactQP, u: np.ndarray, multipliers: np.ndarray) -> Resid
     )
 
 
-def judge(solution: QPSolution, residuals: Residuals | None) -> tuple[str, str]:
+def final_status(solution: QPSolution, residuals: Residuals | None) -> tuple[str, str]:
     """Final (status, reason): the solver's verdict, overruled by residuals that are too large."""
     if solution.status != STATUS_OK or residuals is None:
         return (solution.status if solution.status != STATUS_OK else STATUS_FAILED,

@@ -15,6 +15,8 @@ multiplier mesh then lagged the refinement by a dozen levels.)
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from scipy import sparse
 from skfem import MeshTri
@@ -28,6 +30,13 @@ from formulations.registry import register_formulation
 from scenes import Scene
 
 GAP_QUADRATURE_POINTS = 6  # G_i = int g: g is smooth on each facet; 6 Gauss points is plenty
+
+
+@dataclass(frozen=True, eq=False)
+class MixedDetails:
+    """The mixed method's own arrays: the multiplier segment of every contact facet."""
+
+    segment_of_facet: np.ndarray
 
 
 def multiplier_segments(lengths: np.ndarray, h_over_H: float = 0.5) -> np.ndarray:
@@ -94,7 +103,7 @@ def discretise(scene: Scene, mesh: MeshTri, h_over_H: float = 0.5) -> Discretisa
             "mixed", elasticity, trace, answer, residuals, status, reason, u_free=answer.u,
             pressure=lambda tt: np.repeat(lam[segment][:, None], len(tt), axis=1),
             multiplier_breaks=breaks, active_constraints=count_active(qp, answer.u, lam),
-            max_h_over_H=h_over_H, extra={"multipliers": lam, "segment_of_facet": segment})
+            max_h_over_H=h_over_H, details=MixedDetails(segment_of_facet=segment))
 
     return Discretisation(formulation="mixed", elasticity=elasticity, trace=trace, qp=qp,
                           recover=recover, row_coordinate=0.5 * (breaks[:-1] + breaks[1:]),

@@ -34,6 +34,8 @@ K u + P' D (P u - g)_+ = F (Hintermueller, Ito, Kunisch 2003).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from scipy import sparse
 from skfem import MeshTri
@@ -60,6 +62,15 @@ QUADRATURE_POINTS = 2  # per contact facet
 # DOFs) to 4.3e-4 (adaptive, 1002 DOFs) at the default, 1e-2 at 1e-6 and O(1) once it loses the
 # penetration (eps_0 <= 1e-8). 0.1 % keeps the usable answers and flags the wrong ones.
 PRESSURE_CONSISTENCY = 1e-3
+
+
+@dataclass(frozen=True, eq=False)
+class PenaltyDetails:
+    """The penalty's own numbers: eps_0, eps per contact facet and the slacks of the QP."""
+
+    epsilon_0: float
+    epsilon: np.ndarray
+    slacks: np.ndarray
 
 
 @register_formulation("penalty", "primal penalty, eps = eps_0 h_e / E (eps_0 = 1e-3), "
@@ -144,8 +155,8 @@ def discretise(scene: Scene, mesh: MeshTri,
             pressure=pressure, multiplier_breaks=np.append(trace.coordinate[0],
                                                            trace.coordinate[1, -1]),
             active_constraints=penetrating,
-            extra={"epsilon_0": epsilon_0, "epsilon": epsilon, "slacks": answer.u[n:],
-                   "pressure_mismatch": mismatch})
+            pressure_mismatch=mismatch,
+            details=PenaltyDetails(epsilon_0=epsilon_0, epsilon=epsilon, slacks=answer.u[n:]))
 
     return Discretisation(formulation="penalty", elasticity=elasticity, trace=trace, qp=qp,
                           recover=recover, row_coordinate=np.tile(s_points.ravel(), 2),

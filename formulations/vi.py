@@ -14,6 +14,8 @@ end); both are exact for a constant pressure, and on uniform meshes for a linear
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from scipy import sparse
 from skfem import MeshTri
@@ -25,6 +27,16 @@ from formulations.elasticity import assemble_elasticity
 from formulations.kkt import count_active
 from formulations.registry import register_formulation
 from scenes import Scene
+
+
+@dataclass(frozen=True, eq=False)
+class NodalDetails:
+    """The nodal VI's own arrays: contact reactions (forces), lambda_h at the contact nodes
+    (reactions through the lumped boundary mass) and the contact nodes."""
+
+    reactions: np.ndarray
+    nodal_pressure: np.ndarray
+    contact_nodes: np.ndarray
 
 
 @register_formulation("vi", "primal variational inequality: nodal constraints "
@@ -61,7 +73,7 @@ def discretise(scene: Scene, mesh: MeshTri) -> Discretisation:
             pressure=lambda t: a + (b - a) * np.asarray(t)[None, :],
             multiplier_breaks=np.sort(coordinate),
             active_constraints=count_active(qp, answer.u, reaction),
-            extra={"reactions": reaction, "nodal_pressure": lam, "contact_nodes": nodes})
+            details=NodalDetails(reactions=reaction, nodal_pressure=lam, contact_nodes=nodes))
 
     return Discretisation(formulation="vi", elasticity=elasticity, trace=trace, qp=qp,
                           recover=recover, row_coordinate=coordinate)

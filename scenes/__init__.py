@@ -5,8 +5,8 @@ module with a ``@register_scene`` factory and one import line here.
 """
 
 from scenes import free_boundary, hard, hertz, paper  # noqa: F401  (register themselves)
-from scenes.base import ExactSolution, Material, Scene, SceneError
+from scenes.base import ContactPrediction, ExactSolution, Material, Scene, SceneError
 from scenes.registry import get_scene, register_scene, scene_descriptions, scene_names
 
-__all__ = ["ExactSolution", "Material", "Scene", "SceneError", "get_scene", "register_scene",
-           "scene_descriptions", "scene_names"]
+__all__ = ["ContactPrediction", "ExactSolution", "Material", "Scene", "SceneError", "get_scene",
+           "register_scene", "scene_descriptions", "scene_names"]

@@ -70,6 +70,21 @@ class ExactSolution:
     source: str = ""
 
 
+@dataclass(frozen=True)
+class ContactPrediction:
+    """A closed-form contact pressure of elliptic shape at a given contact force (Hertz's):
+    p(s) = p0 sqrt(1 - ((s - centre) / b)^2)_+ with half-width b and peak p0."""
+
+    half_width: float
+    peak_pressure: float
+    centre: float = 0.0
+    label: str = ""
+
+    def pressure(self, s: np.ndarray) -> np.ndarray:
+        r = (np.asarray(s, dtype=float) - self.centre) / self.half_width
+        return self.peak_pressure * np.sqrt(np.clip(1.0 - r**2, 0.0, None))
+
+
 @dataclass(frozen=True, eq=False)
 class Scene:
     """A Signorini problem on a 2D body (DESIGN.md section 2).
@@ -93,6 +108,8 @@ class Scene:
     parameters: dict = field(default_factory=dict)
     tags: tuple[str, ...] = ()
     exact: ExactSolution | None = None
+    # a closed-form contact pressure for the computed contact force, where theory has one
+    predict_contact: Callable[[float], ContactPrediction] | None = None
 
     def __post_init__(self):
         _check(isinstance(self.material, Material), "material", self.material,

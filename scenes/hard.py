@@ -11,6 +11,7 @@ import numpy as np
 from skfem import MeshTri
 
 from scenes.base import Material, Scene
+from scenes.paper import paper_gap
 from scenes.registry import register_scene
 
 _TOL = 1e-10
@@ -47,7 +48,7 @@ def full_contact() -> Scene:
                                   "(plane strain, nu = 0.4999; P1 locking)")
 def incompressible(poisson_ratio: float = 0.4999) -> Scene:
     return _block("incompressible", f"paper geometry, plane strain, nu = {poisson_ratio}",
-                  lambda x: 0.85 - np.sqrt(np.clip(1.0 - x[0] ** 2, 0.0, None)),
+                  paper_gap,
                   poisson_ratio=poisson_ratio, plane="strain",
                   parameters={"poisson_ratio": poisson_ratio})
 
@@ -112,6 +113,6 @@ def graded(ratio: float = 0.5, layers: int = 9) -> Scene:
     widths = ratio ** np.arange(layers)  # bottom layer last
     ys = 1.0 - 2.0 * np.concatenate([[0.0], np.cumsum(widths)]) / widths.sum()
     return _block("graded", f"paper gap, {layers} geometric layers, ratio {ratio:g}",
-                  lambda x: 0.85 - np.sqrt(np.clip(1.0 - x[0] ** 2, 0.0, None)),
+                  paper_gap,
                   ys=np.sort(ys), poisson_ratio=0.33,
                   parameters={"ratio": ratio, "layers": layers})

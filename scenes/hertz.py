@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 from skfem import MeshTri
 
-from scenes.base import Material, Scene
+from scenes.base import ContactPrediction, Material, Scene
 from scenes.registry import register_scene
 
 _TOL = 1e-10
@@ -28,10 +28,18 @@ _TOL = 1e-10
 def hertz_prediction(scene: Scene, contact_force: float) -> dict:
     """Hertz's half-width and peak pressure for the force ``contact_force`` (per thickness)."""
     E, nu = scene.material.young_modulus, scene.material.poisson_ratio
-    e_star = E / (1 - nu**2)
-    b = np.sqrt(4 * contact_force * scene.parameters["radius"] / (np.pi * e_star))
-    return {"half_width": float(b), "peak_pressure": float(2 * contact_force / (np.pi * b)),
-            "e_star": float(e_star)}
+    contact = hertz_contact(E, nu, scene.parameters["radius"], contact_force)
+    return {"half_width": contact.half_width, "peak_pressure": contact.peak_pressure,
+            "e_star": float(E / (1 - nu**2))}
+
+
+def hertz_contact(young_modulus: float, poisson_ratio: float, radius: float,
+                  contact_force: float) -> ContactPrediction:
+    """Hertz's pressure p0 sqrt(1 - (x/b)^2) at the force ``contact_force``."""
+    e_star = young_modulus / (1 - poisson_ratio**2)
+    b = float(np.sqrt(4 * contact_force * radius / (np.pi * e_star)))
+    p0 = float(2 * contact_force / (np.pi * b))
+    return ContactPrediction(b, p0, label=f"Hertz, b = {b:.4g}, p0 = {p0:.4g}")
 
 
 @register_scene("hertz", "Hertz line contact: a block pressed by a rigid parabola of radius R "
@@ -54,4 +62,5 @@ def hertz(young_modulus: float = 1000.0, poisson_ratio: float = 0.3, radius: flo
                     "radius": radius, "approach": approach, "half_size": half_size,
                     "initial_divisions": initial_divisions},
         tags=("exact", "hertz"),
+        predict_contact=lambda force: hertz_contact(young_modulus, poisson_ratio, radius, force),
     )

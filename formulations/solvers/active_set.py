@@ -40,7 +40,7 @@ from dataclasses import replace
 import numpy as np
 from scipy import sparse
 
-from formulations.base import STATUS_OK, ContactQP, QPSolution
+from formulations.base import STATUS_OK, ContactQP, QPSolution, SolverDiagnostics
 from formulations.solvers.augmented import initial_active_set, solve_augmented
 from formulations.solvers.backends import check_backend, factorise_condensed
 from formulations.solvers.lcp import CYCLING_EXAMPLE, condition_1, least_index_pivoting, pdas
@@ -48,7 +48,8 @@ from formulations.solvers.reference import solve_reference
 from formulations.solvers.registry import register_solver
 
 
-def _fallback(qp: ContactQP, why: str, diagnostics: dict, start: float) -> QPSolution:
+def _fallback(qp: ContactQP, why: str, diagnostics: SolverDiagnostics,
+              start: float) -> QPSolution:
     """The last resort: the reference solver, with the plain iteration's diagnostics."""
     answer = solve_reference(qp)
     reason = f"{why}; answered by the reference solver (safeguard)"
@@ -56,7 +57,7 @@ def _fallback(qp: ContactQP, why: str, diagnostics: dict, start: float) -> QPSol
         reason += f": {answer.reason}"
     return replace(answer, solver="active-set", reason=reason,
                    solve_time=time.perf_counter() - start,
-                   diagnostics={**diagnostics, "safeguard": "reference fallback"})
+                   diagnostics=replace(diagnostics, safeguard="reference fallback"))
 
 
 @register_solver("active-set", "primal-dual active set (semismooth Newton): condensed "
@@ -74,7 +75,6 @@ def solve_active_set(qp: ContactQP, warm_start: np.ndarray | None = None,
         active = (np.asarray(warm_start) > 0) if warm_start is not None else \
             initial_active_set(qp)
         u, lam, iterations, status, reason, diagnostics = solve_augmented(qp, active, max_iter)
-        diagnostics["safeguard"] = ""
         if status != STATUS_OK:
             return _fallback(qp, f"plain active set failed ({reason})", diagnostics, start)
         return QPSolution(u=u, multipliers=lam, status=status, reason=reason,
@@ -86,21 +86,23 @@ def solve_active_set(qp: ContactQP, warm_start: np.ndarray | None = None,
     r = qp.B @ u0 - qp.G
     active = (np.asarray(warm_start) > 0) if warm_start is not None else (r > 0)
     result = pdas(S, r, active, max_iter)
-    diagnostics = {"active_set_changes": result.changes, "cycled": result.cycled,
-                   "safeguard": "", "condition_estimate": float("nan")}
+    diagnostics = SolverDiagnostics(active_set_changes=tuple(result.changes),
+                                    cycled=result.cycled)
     reason, iterations = "", result.iterations
     if result.status != STATUS_OK:
         reason = f"plain active set failed ({result.reason})"
         result = least_index_pivoting(S, r, result.active, 20 * qp.m + 100)
         iterations += result.iterations
-        diagnostics.update(active_set_changes=diagnostics["active_set_changes"]
-                           + result.changes, safeguard="least-index pivoting")
+        diagnostics = replace(diagnostics, safeguard="least-index pivoting",
+                              active_set_changes=diagnostics.active_set_changes
+                              + tuple(result.changes))
         if result.status != STATUS_OK:
             return _fallback(qp, f"{reason}, then {result.reason}", diagnostics, start)
         reason += "; answered by least-index pivoting (safeguard)"
     scaled = S / np.outer(qp.row_scale, qp.row_scale)  # the solver's units, as for splu
-    diagnostics["condition_estimate"] = condition_1(scaled, result.active)
-    diagnostics["condensed"] = S  # B K^-1 B', reused by formulations.diagnostics
+    # S = B K^-1 B' is kept: formulations.diagnostics reuses it for the inf-sup constant
+    diagnostics = replace(diagnostics, condition_estimate=condition_1(scaled, result.active),
+                          condensed=S)
     u = factor.solve(qp.F - qp.B.T @ result.lam)
     return QPSolution(u=u, multipliers=result.lam, status=STATUS_OK, reason=reason,
                       iterations=iterations, solve_time=time.perf_counter() - start,

@@ -15,7 +15,7 @@ import numpy as np
 from scipy import sparse
 from scipy.sparse.linalg import LinearOperator, onenormest, splu
 
-from formulations.base import STATUS_FAILED, STATUS_OK, ContactQP
+from formulations.base import STATUS_FAILED, STATUS_OK, ContactQP, SolverDiagnostics
 
 VIOLATION_TOLERANCE = 1e-12  # relative to the displacement scale: round-off, not penetration
 
@@ -50,9 +50,10 @@ def solve_augmented(qp: ContactQP, active: np.ndarray, max_iter: int):
     u, lam = np.zeros(n), np.zeros(m)
 
     def diagnostics(cycled, system=None, lu=None):
-        return {"active_set_changes": tuple(changes), "cycled": cycled,
-                "condition_estimate": condition_estimate(system, lu) if lu is not None
-                else float("nan")}
+        return SolverDiagnostics(
+            active_set_changes=tuple(changes), cycled=cycled,
+            condition_estimate=condition_estimate(system, lu) if lu is not None
+            else float("nan"))
 
     for iteration in range(1, max_iter + 1):
         key = active.tobytes()

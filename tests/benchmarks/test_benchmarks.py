@@ -14,7 +14,7 @@ takes minutes (see the README's scaling table), too long to repeat.
 import numpy as np
 import pytest
 
-from bench.scaling import linear_rhs, paper_problem
+from bench.perf.scaling import linear_rhs, paper_problem
 from estimators import get_estimator
 from formulations import get_formulation, solve
 from formulations.diagnostics import inf_sup_constant, pressure_oscillation

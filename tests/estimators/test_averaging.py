@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from skfem import Basis, ElementTriP1, Functional
 
-from bench.loop import LoopConfig, run_sequence
+from bench.sequence.loop import LoopConfig, run_sequence
 from estimators import get_estimator
 from estimators.averaging import (
     averaged_stress,

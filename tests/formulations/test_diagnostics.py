@@ -15,7 +15,7 @@ def test_inf_sup_from_the_condensed_system_matches_its_own_computation():
     scene = get_scene("paper")
     disc = get_formulation("mixed")(scene, scene.mesh.refined(3))
     sol = solve(disc, "active-set", backend="cholmod")
-    reused = inf_sup_constant(disc, condensed=sol.diagnostics["condensed"])
+    reused = inf_sup_constant(disc, condensed=sol.diagnostics.condensed)
     # the same B K^-1 B' from two factorisations: equal to round-off
     assert reused == pytest.approx(inf_sup_constant(disc, backend="splu"), rel=1e-9)
     assert reused > 0.5  # h/H = 1/2 (measured 0.535 at 2112 DOFs)

@@ -49,8 +49,8 @@ def test_the_solver_safeguards_a_cycling_iteration(backend):
     expected = least_index_pivoting(CYCLING_S, CYCLING_R, CYCLING_START.copy(), 100).lam
     assert answer.multipliers == pytest.approx(expected, abs=1e-7)
     if backend == "cholmod":  # the condensed route cycles and pivots
-        assert answer.diagnostics["cycled"]
-        assert answer.diagnostics["safeguard"] == "least-index pivoting"
+        assert answer.diagnostics.cycled
+        assert answer.diagnostics.safeguard == "least-index pivoting"
         assert "cycles" in answer.reason and "least-index" in answer.reason
 
 
@@ -61,5 +61,5 @@ def test_an_exhausted_iteration_is_safeguarded_and_says_so(backend):
                               max_iter=1)
     assert answer.status == "ok" and "still changing" in answer.reason
     expected = {"cholmod": "least-index pivoting", "splu": "reference fallback"}[backend]
-    assert answer.diagnostics["safeguard"] == expected
+    assert answer.diagnostics.safeguard == expected
     assert (answer.backend == "clarabel") == (expected == "reference fallback")

@@ -78,7 +78,7 @@ def test_exact_linear_solution_is_reproduced(compression_scene):
     assert np.abs(nodal[1] - 0.005 * (1 - y)).max() < 1e-8
     assert np.abs(nodal[0]).max() < 1e-8
     # lambda_H = E delta / 2 = 5 on every segment; contact force = 5 * |Gamma_C| = 10
-    assert sol.extra["multipliers"] == pytest.approx(5.0, rel=1e-7)
+    assert sol.multipliers == pytest.approx(5.0, rel=1e-7)
     assert sol.contact_force() == pytest.approx(10.0, rel=1e-7)
     assert sol.active_constraints == disc.qp.m
 
@@ -93,7 +93,7 @@ def test_reference_solution_satisfies_kkt_conditions():
     # the rescaling back to physical units (K ~ E = 7e4, rows of B ~ h)
     assert max(r.violation, r.dual_violation, r.complementarity, r.stationarity) < 1e-6
     # and the same checks written out independently of formulations.kkt
-    u, lam = sol.u[disc.elasticity.free], sol.extra["multipliers"]
+    u, lam = sol.u[disc.elasticity.free], sol.multipliers
     qp = disc.qp
     assert (lam >= 0).all()
     assert ((qp.B @ u - qp.G) / qp.row_scale).max() < 1e-9

@@ -20,7 +20,7 @@ def penalty_solution(epsilon_0, young_modulus=70000.0, refinements=3):
 def max_penetration(sol):
     # penetration against the interpolated gap, lambda_h * eps, at many points per facet
     t = np.linspace(0.0, 1.0, 11)
-    return float((sol.pressure(t) * sol.extra["epsilon"][:, None]).max())
+    return float((sol.pressure(t) * sol.details.epsilon[:, None]).max())
 
 
 def test_pressure_is_non_negative_and_matches_the_active_set():

@@ -18,7 +18,7 @@ def solved(request):
 
 def test_no_nodal_penetration(solved):
     scene, disc, sol = solved
-    nodes = sol.extra["contact_nodes"]
+    nodes = sol.details.contact_nodes
     u = sol.elasticity.nodal(sol.u)[:, nodes]
     u_n = -u[1]  # outer normal (0, -1) on the bottom edge
     g = scene.gap(scene.mesh.refined(3).p[:, nodes])
@@ -29,7 +29,7 @@ def test_no_nodal_penetration(solved):
 
 def test_reactions_are_non_negative_and_balance_the_pressure(solved):
     _, disc, sol = solved
-    reactions = sol.extra["reactions"]
+    reactions = sol.details.reactions
     assert reactions.min() >= 0.0 and reactions.max() > 0.0
     # lumped recovery: int lambda_h = sum of the reactions up to the lumping of the ends of
     # the contact zone (one facet each); measured 0.3 % here

@@ -25,18 +25,18 @@ def solved(request):
 
 
 def test_both_solvers_succeed_and_the_fast_one_is_exact(solved):
-    _, _, fast, judge = solved
+    _, _, fast, reference = solved
     assert fast.status == "ok", fast.reason
-    assert judge.status == "ok", judge.reason
+    assert reference.status == "ok", reference.reason
     assert max(vars(fast.residuals).values()) < 1e-9
 
 
 def test_fast_and_reference_agree(solved):
-    scene, disc, fast, judge = solved
+    scene, disc, fast, reference = solved
     K = disc.elasticity.K
-    du = fast.u - judge.u
+    du = fast.u - reference.u
     # relative to the solution, or to sqrt(E) x the gap scale when the solution vanishes
-    scale = max(np.sqrt(judge.u @ K @ judge.u),
+    scale = max(np.sqrt(reference.u @ K @ reference.u),
                 np.sqrt(scene.material.young_modulus) * disc.qp.gap_scale)
     # measured: <= 6e-9 everywhere except where Clarabel (not the active-set solver, whose
     # residuals stay at round-off) loses accuracy: the 50:1 strip, up to 8.8e-5 (vi), and the
@@ -95,7 +95,7 @@ def penalty_sweep():
 
 def _penetration(sol):
     t = np.linspace(0.0, 1.0, 11)
-    return float((sol.pressure(t) * sol.extra["epsilon"][:, None]).max())
+    return float((sol.pressure(t) * sol.details.epsilon[:, None]).max())
 
 
 def test_extreme_penalty_fast_solver_stays_exact_and_penetration_scales(penalty_sweep):
@@ -110,7 +110,7 @@ def test_extreme_penalty_fast_solver_stays_exact_and_penetration_scales(penalty_
     assert all(s.status == "ok" for s in fast[:-1])
     assert fast[-1].status == "inaccurate" and "disagrees with the QP multipliers" in \
         fast[-1].reason
-    mismatch = np.array([s.extra["pressure_mismatch"] for s in fast])
+    mismatch = np.array([s.pressure_mismatch for s in fast])
     # fitted over 1e-2..1e-10: at 1e-12 it saturates (measured 2.5e-3 cholmod, 1.0 splu)
     slope = np.polyfit(np.log(EPSILONS[1:-1]), np.log(mismatch[1:-1]), 1)[0]
     assert slope == pytest.approx(-1.0, abs=0.15)  # measured -0.98 (cholmod), -1.01 (splu)
@@ -131,8 +131,8 @@ def test_extreme_penalty_reference_is_never_silently_wrong(penalty_sweep):
     # Clarabel loses accuracy on the ill-conditioned slack QP (measured: status inaccurate with
     # a 4.7e-5 residual at eps_0 = 1e-8); whenever it says ok, it agrees with the fast solver
     _, runs = penalty_sweep
-    for eps, (fast, judge) in runs.items():
-        if judge.status == "ok":
-            assert judge.energy == pytest.approx(fast.energy, rel=1e-7), eps
+    for eps, (fast, reference) in runs.items():
+        if reference.status == "ok":
+            assert reference.energy == pytest.approx(fast.energy, rel=1e-7), eps
         else:
-            assert judge.reason, eps
+            assert reference.reason, eps

@@ -1,0 +1,173 @@
+"""The commands of ``python -m bench``, dispatched from ``COMMANDS`` (the arguments are in
+``bench.cli.parser``). Exit status: 0 success, 1 a failed row, gate or unexpected verdict,
+2 bad input."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import pandas as pd
+
+from bench.cli.parser import build_parser
+from bench.hard import (
+    check_expected,
+    hard_case_descriptions,
+    hard_markdown,
+    run_hard,
+    write_hard,
+)
+from bench.matrix import RunConfig, run
+from bench.perf.scaling import run_scaling, write_scaling
+from bench.report import write_report
+from bench.sequence.loop import LevelResult
+from bench.sequence.rows import KEYS, level_time
+from bench.verify import load_expected, verdict_table, verify
+from estimators import estimator_descriptions, estimator_names
+from formulations import formulation_descriptions, formulation_names, solver_descriptions
+from scenes import get_scene, scene_descriptions, scene_names
+
+SUMMARY_COLUMNS = ["level", "ndofs", "energy", "contact_force", "active_constraints", "eta",
+                   "eta_0", "eta_geometric", "eta_complementarity", "energy_error",
+                   "effectivity_index", "iterations", "t_solve", "status"]
+HARD_TAG = "hard"
+
+
+def progress(result: LevelResult) -> None:
+    r = result.row
+    print(f"{r.scene}/{r.formulation}/{r.solver}/{r.estimator}/{r.strategy} "
+          f"level {r.level:2d}  ndofs {r.ndofs:8d}  eta {r.eta:11.5e}  "
+          f"time {level_time(r):7.2f} s  "
+          f"{r.status}{' (' + r.reason + ')' if r.reason else ''}", flush=True)
+
+
+def summary(table: pd.DataFrame) -> str:
+    parts = []
+    for key, group in table.groupby(KEYS, sort=False):
+        parts.append("== " + " / ".join(map(str, key)))
+        parts.append(group[SUMMARY_COLUMNS].to_string(index=False, float_format="{:.6g}".format))
+    return "\n".join(parts)
+
+
+def list_command(args) -> int:
+    for title, items in (("scenes", scene_descriptions()),
+                         ("formulations", formulation_descriptions()),
+                         ("solvers", solver_descriptions()),
+                         ("estimators", estimator_descriptions()),
+                         ("hard cases", hard_case_descriptions())):
+        print(f"{title}:")
+        for name, text in items.items():
+            print(f"  {name:14s} {text}")
+    return 0
+
+
+def configured(**fields) -> RunConfig | None:
+    """The run's configuration, or None after printing why it is refused."""
+    try:
+        return RunConfig(**fields)
+    except ValueError as error:
+        print(f"error: {error}", file=sys.stderr)
+        return None
+
+
+def run_config(config: RunConfig | None) -> int:
+    if config is None:
+        return 2
+    result = run(config, on_level=progress)
+    print(f"wrote {result.store.out / 'rates.md'}\n")
+    print(summary(result.table))
+    print(f"\nwrote {len(result.rows)} rows to {result.store.parquet} and {result.store.csv}")
+    return 1 if result.failed else 0
+
+
+def run_command(args) -> int:
+    config = configured(
+        scenes=args.scene, formulations=args.formulation, solvers=args.solver,
+        estimators=args.estimator, strategies=args.strategy, max_dofs=args.max_dofs,
+        max_levels=args.max_levels, marking=args.marking, theta=args.theta,
+        backend=args.backend, nested=not args.cold_start, reference_dofs=args.reference_dofs,
+        crosscheck_dofs=args.crosscheck_dofs, out=args.out, overwrite=args.overwrite,
+        command=" ".join(["python -m bench", *args.argv]))
+    return run_config(config)
+
+
+def hard_command(args) -> int:
+    def show(name, frame):
+        print(f"hard case {name}: {len(frame)} rows, verdicts "
+              + ", ".join(f"{v} {n}" for v, n in frame["verdict"].value_counts().items()),
+              flush=True)
+
+    table = run_hard(args.case, on_case=show)
+    print(f"wrote {write_hard(table, args.out)}\n")
+    print(hard_markdown(table))
+    checks = check_expected(table, load_expected().get("hard", []))
+    wrong = [c for c in checks if not c["passed"]]
+    for c in wrong:
+        print(f"UNEXPECTED: {c['case']}/{c['formulation']}/{c['solver']}/{c['variant']}: "
+              f"{c['verdict']}, expected {c['expected']}")
+    print(f"\n{len(checks) - len(wrong)} of {len(checks)} hard verdicts as expected")
+    return 1 if wrong else 0
+
+
+def compare_command(args) -> int:
+    """The default comparison: every scene not tagged hard x every formulation x every
+    estimator x {uniform, adaptive} with the active-set solver, then the hard cases into the
+    same folder, then the report."""
+    config = configured(
+        scenes=[n for n in scene_names() if HARD_TAG not in get_scene(n).tags],
+        formulations=formulation_names(), solvers=("active-set",),
+        estimators=estimator_names(), strategies=("uniform", "adaptive"),
+        max_dofs=args.max_dofs, reference_dofs=args.reference_dofs,
+        crosscheck_dofs=args.crosscheck_dofs, out=args.out, overwrite=True,
+        command=f"python -m bench compare --max-dofs {args.max_dofs} --reference-dofs "
+                f"{args.reference_dofs} --crosscheck-dofs {args.crosscheck_dofs} --out "
+                f"{args.out} --reports {args.reports}")
+    status = run_config(config)
+    if config is None:
+        return status
+    args.case = None
+    hard_status = hard_command(args)
+    source = Path(args.out) / "results.parquet"
+    print(f"wrote {write_report(pd.read_parquet(source), args.reports, args.out)}")
+    return status or hard_status
+
+
+def report_command(args) -> int:
+    source = Path(args.results) / "results.parquet"
+    if not source.exists():
+        print(f"error: --results={args.results!r} holds no results.parquet", file=sys.stderr)
+        return 2
+    print(f"wrote {write_report(pd.read_parquet(source), args.out, args.results)}")
+    return 0
+
+
+def verify_command(args) -> int:
+    verdicts, _, closed_form = verify(args.out, on_level=progress)
+    print("\n" + closed_form.to_markdown(index=False, floatfmt=".4g") + "\n")
+    print(verdict_table(verdicts))
+    failed = [v for v in verdicts if not v.passed]
+    print(f"\n{len(verdicts) - len(failed)} of {len(verdicts)} gates pass"
+          f"{'' if not failed else '; FAILED: ' + ', '.join(sorted({v.gate for v in failed}))}")
+    return 1 if failed else 0
+
+
+def scaling_command(args) -> int:
+    def show(row):
+        print(f"{row['size']}: ndofs {row['ndofs']}  fast {row['t_fast_solve']:.2f} s  "
+              f"linear {row['t_linear_solve']:.2f} s  reference "
+              f"{row['t_reference_solve']:.2f} s  peak {row['peak_gib']:.2f} GiB", flush=True)
+    frame = run_scaling(args.sizes, args.backend, args.reference_max_dofs, on_row=show)
+    print(f"wrote {write_scaling(frame, args.out, args.readme)}")
+    return 0
+
+
+COMMANDS = {"run": run_command, "compare": compare_command, "report": report_command,
+            "verify": verify_command, "hard": hard_command, "scaling": scaling_command,
+            "list": list_command}
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = list(sys.argv[1:] if argv is None else argv)
+    args = build_parser().parse_args(argv)
+    args.argv = argv
+    return COMMANDS[args.command](args)

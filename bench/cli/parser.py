@@ -1,0 +1,195 @@
+"""The command line's arguments: ``build_parser`` and the validating option types (a bad value
+is refused naming the option, the value and what is allowed). Every list of names comes from
+a registry."""
+
+from __future__ import annotations
+
+import argparse
+
+from bench.hard import hard_case_names
+from bench.perf.scaling import SIZES
+from bench.sequence.loop import STRATEGIES
+from bench.sequence.marking import MARKINGS
+from estimators import estimator_names
+from formulations import formulation_names, solver_names
+from formulations.solvers.backends import BACKENDS
+from scenes import scene_names
+
+
+def _names(kind: str, valid: list[str], plural: str | None = None):
+    """A comma-separated list of names from ``valid`` (``kind``: what one name is)."""
+    def parse(text: str) -> list[str]:
+        names = [name.strip() for name in text.split(",") if name.strip()]
+        unknown = [name for name in names if name not in valid]
+        if not names or unknown:
+            raise argparse.ArgumentTypeError(
+                f"unknown {kind} {', '.join(map(repr, unknown)) or repr(text)}; "
+                f"valid {plural or kind + 's'}: {', '.join(valid)}")
+        return names
+    return parse
+
+
+def _integer(name: str, minimum: int, allowed: str):
+    """An int option >= ``minimum``, refused as "name='text' is not <allowed>"."""
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            value = minimum - 1
+        if value < minimum:
+            raise argparse.ArgumentTypeError(f"{name}={text!r} is not {allowed}")
+        return value
+    return parse
+
+
+def _positive_int(name: str):
+    return _integer(name, 1, "a positive integer")
+
+
+def _non_negative_int(name: str):
+    return _integer(name, 0, "an integer >= 0")
+
+
+def _theta(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not 0.0 < value <= 1.0:
+        raise argparse.ArgumentTypeError(f"theta={text!r} is not a number in (0, 1]")
+    return value
+
+
+def _run_parser(sub) -> None:
+    run = sub.add_parser("run", help="run solve -> estimate -> mark -> refine sequences and "
+                         "write results.parquet and results.csv",
+                         description="Run every combination of the given comma-separated "
+                         "lists and write one row per level to OUT/results.{parquet,csv}.")
+    run.add_argument("--scene", type=_names("scene", scene_names()), default=["paper"],
+                     help=f"scene(s), comma-separated; one of: {', '.join(scene_names())} "
+                          "(default: paper)")
+    run.add_argument("--formulation", type=_names("formulation", formulation_names()),
+                     default=["mixed"], help="formulation(s): "
+                     f"{', '.join(formulation_names())} (default: mixed)")
+    run.add_argument("--solver", type=_names("solver", solver_names()), default=["reference"],
+                     help=f"solver(s): {', '.join(solver_names())} (default: reference)")
+    run.add_argument("--estimator", type=_names("estimator", estimator_names()),
+                     default=["residual"],
+                     help=f"estimator(s): {', '.join(estimator_names())} (default: residual)")
+    run.add_argument("--strategy", type=_names("strategy", list(STRATEGIES), "strategies"),
+                     default=["adaptive"],
+                     help="refinement strategy(ies): uniform, adaptive (default: adaptive)")
+    run.add_argument("--max-dofs", type=_positive_int("max_dofs"), default=20000,
+                     help="DOF budget: stop before a level with more unknowns (default: 20000)")
+    run.add_argument("--max-levels", type=_positive_int("max_levels"), default=40,
+                     help="maximum number of levels (default: 40)")
+    run.add_argument("--marking", choices=MARKINGS, default="doerfler",
+                     help="adaptive marking: doerfler (bulk) or maximum (default: doerfler)")
+    run.add_argument("--theta", type=_theta, default=0.5,
+                     help="marking parameter in (0, 1] (default: 0.5)")
+    run.add_argument("--backend", choices=BACKENDS, default=None,
+                     help="sparse direct back-end of the active-set solver: cholmod (needs "
+                          "scikit-sparse) or splu (scipy) (default: cholmod when installed)")
+    run.add_argument("--cold-start", action="store_true",
+                     help="solve every level from scratch instead of starting from the "
+                          "previous level's contact zone (nested iteration, the default)")
+    run.add_argument("--reference-dofs", type=_positive_int("reference_dofs"), default=None,
+                     help="measure errors of scenes without an exact solution against a "
+                          "cached adaptive overkill reference with about this many DOFs "
+                          "(default: only scenes with an exact solution get errors)")
+    run.add_argument("--crosscheck-dofs", type=_non_negative_int("crosscheck_dofs"), default=0,
+                     help="also solve levels with at most this many DOFs with the reference "
+                          "solver and record the differences (default: 0, never)")
+    run.add_argument("--out", default="results",
+                     help="output folder for results.parquet and results.csv (default: results)")
+    run.add_argument("--overwrite", action="store_true",
+                     help="delete earlier results in OUT first (default: keep and append)")
+
+
+def _report_parser(sub) -> None:
+    report = sub.add_parser("report", help="render the report of a results folder",
+                            description="Render OUT/README.md, OUT/index.html and "
+                            "OUT/figures/*.png from RESULTS/results.parquet (and the hard "
+                            "cases' RESULTS/hard.csv) without recomputing anything.")
+    report.add_argument("--results", default="results",
+                        help="folder holding results.parquet (default: results)")
+    report.add_argument("--out", default="reports", help="report folder (default: reports)")
+
+
+def _scaling_parser(sub) -> None:
+    scaling = sub.add_parser(
+        "scaling", help="time assembly, linear solve, fast and reference contact solves and "
+        "the estimator against N, with peak memory",
+        description="Measure every phase once per size, each size in a fresh process, and "
+        "write OUT/scaling.{md,csv} (and the README's table with --readme).")
+    scaling.add_argument("--sizes", type=_names("size", list(SIZES)), default=list(SIZES),
+                         help=f"sizes, comma-separated: {', '.join(SIZES)} (default: all)")
+    scaling.add_argument("--backend", choices=BACKENDS, default=None,
+                         help="sparse back-end (default: cholmod when installed)")
+    scaling.add_argument("--reference-max-dofs", type=_positive_int("reference_max_dofs"),
+                         default=200_000, help="run the reference solver only up to this "
+                         "many DOFs (default: 200000)")
+    scaling.add_argument("--out", default="reports", help="output folder (default: reports)")
+    scaling.add_argument("--readme", default=None,
+                         help="also replace the table between the scaling markers of this "
+                              "README (e.g. README.md)")
+
+
+def _compare_parser(sub) -> None:
+    compare = sub.add_parser(
+        "compare", help="the default comparison (the README's main job): run, hard, report",
+        description="Run every scene not tagged hard x formulation x estimator x {uniform, "
+        "adaptive} with the active-set solver (cross-checked by the reference on small "
+        "levels), errors against exact solutions or cached overkill references, then every "
+        "hard case into the same folder, then render the report.")
+    compare.add_argument("--max-dofs", type=_positive_int("max_dofs"), default=20000,
+                         help="DOF budget per sequence (default: 20000)")
+    compare.add_argument("--reference-dofs", type=_positive_int("reference_dofs"),
+                         default=500000, help="overkill reference size (default: 500000)")
+    compare.add_argument("--crosscheck-dofs", type=_non_negative_int("crosscheck_dofs"),
+                         default=3000, help="cross-check levels up to this size with the "
+                         "reference solver (default: 3000)")
+    compare.add_argument("--out", default="results", help="results folder (default: results)")
+    compare.add_argument("--reports", default="reports", help="report folder (default: reports)")
+
+
+def _verify_parser(sub) -> None:
+    verify = sub.add_parser("verify", help="run the verification gates of expected.toml "
+                            "and print a pass/fail table",
+                            description="Run small sequences on the exact-solution scenes and "
+                            "the paper scene (against a cached overkill reference), fit rates, "
+                            "compute effectivity indices and the Hertz comparison, and check "
+                            "every gate of bench/verify/expected.toml. Exit status 1 if any "
+                            "fails.")
+    verify.add_argument("--out", default="results-verify",
+                        help="folder for the gate runs' results (default: results-verify)")
+
+
+def _hard_parser(sub) -> None:
+    hard = sub.add_parser(
+        "hard", help="run the hard cases and print their verdicts",
+        description="Run every hard case (bench/hard) with every formulation and every "
+        "solver, write OUT/hard.{csv,md}, and check each verdict against "
+        "bench/verify/expected.toml. Exit status 1 if a verdict differs from the expected one.")
+    hard.add_argument("--case", type=_names("hard case", hard_case_names()), default=None,
+                      help=f"case(s), comma-separated: {', '.join(hard_case_names())} "
+                           "(default: all)")
+    hard.add_argument("--out", default="results-hard",
+                      help="folder for hard.csv and hard.md (default: results-hard)")
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="python -m bench",
+        description="signorini-bench: compare formulations and a posteriori error estimators "
+                    "for Signorini's contact problem.")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    _run_parser(sub)
+    _report_parser(sub)
+    _scaling_parser(sub)
+    _compare_parser(sub)
+    _verify_parser(sub)
+    _hard_parser(sub)
+    sub.add_parser("list", help="list registered scenes, formulations, solvers, estimators "
+                   "and hard cases",
+                   description="List everything registered, with one line of description.")
+    return parser

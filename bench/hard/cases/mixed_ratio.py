@@ -1,0 +1,34 @@
+"""The mixed method with h/H = 1, 1/2, 1/4: its discrete inf-sup constant and multiplier
+oscillation under refinement (docs/theory.md, section 8)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from bench.hard.registry import hard_case
+from bench.hard.verdicts import solve_both
+from scenes import get_scene
+
+
+@hard_case("mixed-h/H", "mixed method with h/H = 1, 1/2, 1/4 on the paper scene: discrete "
+                        "inf-sup constant and multiplier oscillation under refinement")
+def mixed_ratio() -> list[dict]:
+    scene, records = get_scene("paper"), []
+    for ratio in (1.0, 0.5, 0.25):
+        for level in (2, 3, 4):
+            rows, _ = solve_both("mixed-h/H", scene, "mixed", scene.mesh.refined(level),
+                                 variant=f"h/H={ratio:g}", level=level, inf_sup=True,
+                                 h_over_H=ratio)
+            records += rows
+    frame = pd.DataFrame(records)
+    for ratio in (1.0, 0.5, 0.25):
+        part = frame[(frame["variant"] == f"h/H={ratio:g}") & (frame["solver"] == "active-set")]
+        # h ~ ndofs^(-1/2): the slope of log beta against log h
+        slope = -2 * np.polyfit(np.log(part["ndofs"]), np.log(part["inf_sup"]), 1)[0]
+        text = (f"beta_h {part['inf_sup'].iloc[0]:.3g} -> {part['inf_sup'].iloc[-1]:.3g} "
+                f"(~ h^{slope:.2f}); oscillation {part['pressure_oscillation'].iloc[-1]:.2f}")
+        for record in records:
+            if record["variant"] == f"h/H={ratio:g}":
+                record["finding"] = text
+    return records

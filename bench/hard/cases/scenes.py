@@ -1,0 +1,62 @@
+"""Every scene tagged ``hard`` as a hard case: every formulation that applies to it, every
+solver, at HARD_SCENE_LEVEL uniform refinements, with a finding stated in the scene's own
+numbers and whether the discretisation has settled."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from bench.hard.verdicts import solve_both
+from bench.measure.contact import contact_zone
+from formulations import STATUS_FAILED, get_formulation, solve
+from formulations.registry import FORMULATIONS
+from scenes import get_scene
+
+HARD_SCENE_LEVEL = 3  # refinements of each hard scene's initial mesh (544..4752 DOFs)
+# a discretisation is "settled" when the contact force changes by at most this much from one
+# uniform level to the next (the well-resolved cases here change by a few per cent)
+SETTLED = 0.1
+
+
+def applied_load(solution) -> float:
+    """|resultant of the load vector| (body force and tractions), 0 for a load-free scene."""
+    return float(np.linalg.norm(solution.elasticity.nodal(solution.elasticity.F).sum(axis=1)))
+
+
+def scene_finding(row: dict, solution) -> str:
+    """The contact zone, force and active rows in numbers; the force against the applied load
+    where the body is loaded."""
+    zone = contact_zone(solution) if solution.status != STATUS_FAILED else (np.nan, np.nan)
+    force = row["contact_force"]
+    text = (f"contact zone [{zone[0]:.3g}, {zone[1]:.3g}], force {force:.4g}" if np.isfinite(
+        zone[0]) else f"no contact, force {force:.3g}")
+    text += f", {row['active_constraints']} of {row['n_constraints']} rows active"
+    load = applied_load(solution)
+    if load > 0 and np.isfinite(force):
+        text += f", force = {force / load:.1e} of the applied load"
+    return text
+
+
+def force_change(scene, formulation: str, fine: float) -> float:
+    """Relative change of the contact force from one uniform level coarser."""
+    coarse = solve(get_formulation(formulation)(scene, scene.mesh.refined(
+        HARD_SCENE_LEVEL - 1)), "active-set").contact_force()
+    return abs(fine - coarse) / max(abs(fine), abs(coarse)) if fine or coarse else 0.0
+
+
+def scene_case(name: str) -> list[dict]:
+    scene = get_scene(name)
+    mesh = scene.mesh.refined(HARD_SCENE_LEVEL)
+    records = []
+    for formulation in FORMULATIONS.names():
+        if FORMULATIONS.why_not(formulation, scene=scene) is not None:
+            continue
+        rows, sols = solve_both(name, scene, formulation, mesh, level=HARD_SCENE_LEVEL)
+        change = force_change(scene, formulation, rows[0]["contact_force"])
+        for row, sol in zip(rows, sols, strict=True):
+            row["finding"] = (scene_finding(row, sol)
+                              + f"; force changed by {change:.1%} from the level before")
+            row["force_change"] = change
+            row["discretisation"] = "settled" if change <= SETTLED else "unsettled"
+        records += rows
+    return records

@@ -1,0 +1,28 @@
+"""The hard-case registry: every scene tagged ``hard`` is a case of its own (``cases.scenes``),
+and ``@hard_case(name, description)`` registers any other (one file in ``bench/hard/cases``).
+``hard_case_names`` reads both at call time, so a scene or case registered later is listed
+(and run by ``bench.hard.run``) too."""
+
+from __future__ import annotations
+
+from scenes import get_scene, scene_descriptions, scene_names
+from scenes.registry import Registry
+
+HARD_CASES = Registry("hard case")
+hard_case = HARD_CASES.register
+HARD_TAG = "hard"
+
+
+def hard_scene_names() -> list[str]:
+    return [name for name in scene_names() if HARD_TAG in get_scene(name).tags]
+
+
+def hard_case_names() -> list[str]:
+    """The hard scenes, then the other registered cases."""
+    return hard_scene_names() + HARD_CASES.names()
+
+
+def hard_case_descriptions() -> dict[str, str]:
+    scenes = scene_descriptions()
+    return {**{name: f"scene {name!r}: {scenes[name]}" for name in hard_scene_names()},
+            **HARD_CASES.descriptions()}

@@ -1,0 +1,88 @@
+"""Verdicts of the hard cases (docs/theory.md, section 8): each (hard case x formulation
+x solver x variant) row gets a loss, a pressure loss and a verdict.
+
+Every discrete problem is solved by every registered solver. The **loss** of a row is how far
+it is from the exact discrete solution: the larger of its own KKT residuals
+(``formulations.kkt``) and its relative energy-norm difference to the best-certified answer
+(the one with the smallest residuals; for a convex QP, residuals at round-off certify the
+minimiser); its
+**pressure loss** is the max pressure difference to that answer, relative to max lambda_h. The
+pressure counts because a penalty pressure (u_hn - g_h)_+ / eps magnifies an error in u by
+1/eps: an answer can be right in energy and wrong in pressure. Verdicts:
+
+* ``accurate``: converged, loss <= ``LOSS_TOLERANCE`` and pressure loss <=
+  ``PRESSURE_TOLERANCE``;
+* ``inaccurate``: converged (status ok or inaccurate) but above either bar -- the loss columns
+  give the measured loss;
+* ``failed``: no solution; the reason says why;
+* ``refused``: an invalid problem, rejected with a clear error before any solve.
+
+``finding`` states what the case is about, measured (inf-sup decay, penetration, scaling...).
+The expected verdicts live in ``bench/verify/expected.toml`` ([[hard]]), checked by
+``python -m bench hard``, ``python -m bench verify`` and tests/bench/hard. The cases are in
+``bench.hard.cases``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from bench.measure.contact import penetration
+from bench.measure.difference import solution_difference
+from formulations import STATUS_FAILED, STATUS_OK, get_formulation, solve, solver_names
+from formulations.diagnostics import inf_sup_constant, pressure_oscillation
+from scenes import Scene
+
+LOSS_TOLERANCE = 1e-6  # the same bar as a residual for status "ok" (formulations.kkt)
+# the pressure is a pointwise, derived quantity: the reference (tolerances 1e-10) gets the mixed
+# multipliers to ~1e-8, but the penalty pressure only to 1e-5..4e-4 at the default eps_0 = 1e-3
+# (measured), which is still a usable answer; 0.1 % (as the penalty's own self-check,
+# formulations.penalty.PRESSURE_CONSISTENCY) separates that from a wrong pressure
+PRESSURE_TOLERANCE = 1e-3
+ACCURATE, INACCURATE, FAILED, REFUSED = "accurate", "inaccurate", "failed", "refused"
+
+
+def _record(case, scene, disc, sol, variant, level) -> dict:
+    residual = max(vars(sol.residuals).values())
+    return dict(case=case, scene=scene.name, formulation=disc.formulation, solver=sol.solver,
+                variant=variant, level=level, ndofs=disc.ndofs, status=sol.status,
+                reason=sol.reason, backend=sol.backend,
+                safeguard=sol.diagnostics.safeguard,
+                iterations=sol.iterations, max_residual=residual,
+                condition_estimate=sol.diagnostics.condition_estimate,
+                inf_sup=np.nan, pressure_oscillation=pressure_oscillation(sol),
+                contact_force=sol.contact_force() if sol.status != STATUS_FAILED else np.nan,
+                active_constraints=sol.active_constraints, n_constraints=disc.qp.m,
+                penetration=penetration(scene, sol) if sol.status != STATUS_FAILED else np.nan,
+                finding="")
+
+
+def verdict(status: str, loss: float, pressure_loss: float = 0.0) -> str:
+    if status == STATUS_FAILED or not np.isfinite(loss):
+        return FAILED
+    accurate = loss <= LOSS_TOLERANCE and pressure_loss <= PRESSURE_TOLERANCE
+    return ACCURATE if status == STATUS_OK and accurate else INACCURATE
+
+
+def solve_both(case: str, scene: Scene, formulation: str, mesh, variant: str = "",
+               level: int = 0, inf_sup: bool = False, **options) -> tuple[list[dict], list]:
+    """Every solver on one discrete problem: records with loss and verdict, and the
+    solutions (in the order of ``solver_names()``)."""
+    disc = get_formulation(formulation)(scene, mesh, **options)
+    solutions = [solve(disc, solver) for solver in solver_names()]
+    records = [_record(case, scene, disc, sol, variant, level) for sol in solutions]
+    best = int(np.argmin([r["max_residual"] if np.isfinite(r["max_residual"]) else np.inf
+                          for r in records]))
+    # B K^-1 B' from whichever solver formed it (the active-set solver on cholmod)
+    condensed = next((s.diagnostics.condensed for s in solutions
+                      if s.diagnostics.condensed is not None), None)
+    beta = inf_sup_constant(disc, condensed=condensed) if inf_sup else np.nan
+    for record, sol in zip(records, solutions, strict=True):
+        differences = (0.0, 0.0)
+        if sol is not solutions[best] and sol.status != STATUS_FAILED:
+            differences = solution_difference(disc, sol, solutions[best])
+        # the penalty's own pressure self-check is a measured pressure loss too
+        record.update(loss=max(record["max_residual"], differences[0]),
+                      pressure_loss=max(differences[1], sol.pressure_mismatch), inf_sup=beta)
+        record["verdict"] = verdict(record["status"], record["loss"], record["pressure_loss"])
+    return records, solutions

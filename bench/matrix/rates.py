@@ -1,0 +1,66 @@
+"""The rates table: convergence slopes and effectivity per combination.
+
+The slope of log(y) against log(ndofs) is fitted by least squares (``np.polyfit``) over the last
+``RATE_LEVELS`` ok levels that have y > 0 (earlier levels are pre-asymptotic: on the paper scene
+nothing touches on the first two). In 2D, O(h^1/2) is slope -1/4 and O(h) is slope -1/2.
+Effectivity statistics use the same levels and skip rows whose reference is too coarse.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from bench.sequence.rows import KEYS
+
+RATE_LEVELS = 4
+
+
+def slope(group: pd.DataFrame, column: str, levels: int = RATE_LEVELS) -> float:
+    ok = group[(group["status"] == "ok") & (group[column] > 0)].sort_values("ndofs")
+    ok = ok.tail(levels)
+    if len(ok) < 2:
+        return float("nan")
+    return float(np.polyfit(np.log(ok["ndofs"]), np.log(ok[column]), 1)[0])
+
+
+def rates_table(table: pd.DataFrame, levels: int = RATE_LEVELS) -> pd.DataFrame:
+    rows = []
+    table = table[table["level"] >= 0]
+    for key, group in table.groupby(KEYS, sort=True):
+        group = group.sort_values("level")
+        ok = group[group["status"] == "ok"]
+        tail = ok.tail(levels)
+        usable = tail[~tail["reference_too_coarse"].astype(bool)
+                      & (tail["effectivity_index"] > 0)] if "effectivity_index" in tail else tail
+        effectivity = usable["effectivity_index"] if len(usable) else pd.Series(dtype=float)
+        rows.append({
+            **dict(zip(KEYS, key, strict=True)),
+            "levels": len(group), "fit_levels": len(tail),
+            "ndofs_last": int(group["ndofs"].iloc[-1]),
+            "error_rate": slope(group, "energy_error", levels),
+            "eta_rate": slope(group, "eta", levels),
+            "pressure_error_rate": slope(group, "pressure_error", levels),
+            "effectivity_last": float(tail["effectivity_index"].iloc[-1]) if len(tail) else
+            float("nan"),
+            "effectivity_min": float(effectivity.min()) if len(effectivity) else float("nan"),
+            "effectivity_max": float(effectivity.max()) if len(effectivity) else float("nan"),
+            "effectivity_variation": float(effectivity.max() / effectivity.min())
+            if len(effectivity) else float("nan"),
+            "too_coarse_rows": int(tail["reference_too_coarse"].astype(bool).sum()),
+            "truth": str(group["truth"].iloc[-1]),
+        })
+    return pd.DataFrame(rows)
+
+
+def write_rates(table: pd.DataFrame, out: str | Path) -> Path:
+    """rates.csv and rates.md next to the results."""
+    out = Path(out)
+    rates = rates_table(table)
+    rates.to_csv(out / "rates.csv", index=False)
+    (out / "rates.md").write_text(
+        f"Slopes over the last {RATE_LEVELS} levels (-1/4 = O(h^1/2), -1/2 = O(h)).\n\n"
+        + rates.to_markdown(index=False, floatfmt=".3g") + "\n")
+    return out / "rates.md"

@@ -1,0 +1,41 @@
+"""Contact quantities of a discrete solution: samples of lambda_h along Gamma_C, the contact
+zone, its distance to a true zone, and the penetration of the obstacle."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from formulations import DiscreteSolution
+from formulations.kkt import ACTIVE_FRACTION
+
+
+def facet_samples(coordinate: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """Contact coordinates of the local points ``t`` in [0, 1] of every facet, shape
+    (n_facets, len(t)); ``coordinate`` (2, n_facets) are the facets' end points."""
+    s0, s1 = coordinate
+    return s0[:, None] + (s1 - s0)[:, None] * np.asarray(t)[None, :]
+
+
+def contact_zone(solution: DiscreteSolution) -> tuple[float, float]:
+    """End points (contact coordinates) of the union of contact facets where lambda_h > 0,
+    i.e. above ACTIVE_FRACTION x max lambda_h: an interior-point solution leaves multipliers
+    of ~1e-9 relative on every facet, which are not contact."""
+    values = solution.pressure(np.array([0.25, 0.5, 0.75]))
+    pressed = (values > ACTIVE_FRACTION * values.max(initial=0.0)).any(axis=1)
+    if not pressed.any():
+        return float("nan"), float("nan")
+    s0, s1 = solution.trace.coordinate
+    return float(s0[pressed].min()), float(s1[pressed].max())
+
+
+def zone_error(zone: tuple[float, float], true_zone: tuple[float, float]) -> float:
+    """The larger distance between the end points of two contact zones."""
+    return float(max(abs(zone[0] - true_zone[0]), abs(zone[1] - true_zone[1])))
+
+
+def penetration(scene, solution: DiscreteSolution) -> float:
+    """max over the contact nodes of (u_h . n - g)^+ (a length)."""
+    trace, ends = solution.trace, np.array([0.0, 1.0])
+    u_n = trace.normal_displacement(solution.elasticity.nodal(solution.u), ends)
+    gap = np.asarray(scene.gap(trace.points(ends)))
+    return float(np.maximum(u_n - gap, 0.0).max(initial=0.0))

@@ -1,0 +1,73 @@
+"""Discretisation errors of a solution against an exact solution (docs/theory.md, section 6):
+
+* energy-norm error ||u - u_h|| = a(u - u_h, u - u_h)^(1/2);
+* contact-pressure error ||lambda - lambda_h||_{0, Gamma_C};
+* contact-zone error: the larger distance between computed and true zone end points.
+
+Against an exact solution the integrals run over the mesh of u_h with a 6th-order rule (exact
+for u_h, accurate for the smooth u); against a reference on another mesh see
+``bench.measure.nonnested``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from skfem import Basis, ElementTriP1, ElementVector
+
+from bench.measure.contact import contact_zone, facet_samples, zone_error
+from formulations import DiscreteSolution
+from formulations.contact import gauss_legendre
+from formulations.elasticity import stress_from_gradient
+
+EXACT_INTORDER = 6
+PRESSURE_POINTS = 6  # Gauss points per contact facet for ||lambda - lambda_h||
+
+
+@dataclass(frozen=True)
+class Errors:
+    energy_error: float
+    pressure_error: float
+    zone_error: float
+    contact_zone_start: float
+    contact_zone_end: float
+
+
+def energy_density(grad: np.ndarray, lam: float, mu: float) -> np.ndarray:
+    """sigma(e) : eps(e) for the displacement gradient grad[i, j] of e."""
+    s11, s22, s12 = stress_from_gradient(grad, lam, mu)
+    return s11 * grad[0, 0] + s22 * grad[1, 1] + s12 * (grad[0, 1] + grad[1, 0])
+
+
+def element_gradients(solution: DiscreteSolution) -> np.ndarray:
+    """The constant P1 gradient per element, shape (2, 2, n_elements)."""
+    return solution.elasticity.basis.interpolate(solution.u).grad[:, :, :, 0]
+
+
+def pressure_error(solution: DiscreteSolution, true_pressure, trace=None) -> float:
+    """||lambda - lambda_h||_{0,Gamma_C} on the facets of ``trace`` (the finer one; default
+    u_h's), with ``true_pressure(s)`` a function of the contact coordinate."""
+    trace = solution.trace if trace is None else trace
+    t, w = gauss_legendre(PRESSURE_POINTS)
+    s = facet_samples(trace.coordinate, t)
+    diff = true_pressure(s) - solution.pressure_at(s.ravel()).reshape(s.shape)
+    return float(np.sqrt(trace.integrate(diff**2, w).sum()))
+
+
+def errors_from(energy_error: float, solution: DiscreteSolution, true_pressure,
+                true_zone) -> Errors:
+    """The pressure and zone errors of ``solution`` beside a measured energy-norm error."""
+    zone = contact_zone(solution)
+    return Errors(energy_error, pressure_error(solution, true_pressure),
+                  zone_error(zone, true_zone), *zone)
+
+
+def exact_errors(scene, solution: DiscreteSolution) -> Errors:
+    exact = scene.exact
+    basis = Basis(solution.elasticity.mesh, ElementVector(ElementTriP1()),
+                  intorder=EXACT_INTORDER)
+    grad_h = basis.interpolate(solution.u).grad
+    diff = exact.gradient(np.asarray(basis.global_coordinates())) - grad_h
+    energy = float((energy_density(diff, *solution.elasticity.lame) * basis.dx).sum())
+    return errors_from(np.sqrt(max(energy, 0.0)), solution, exact.pressure, exact.contact_zone)

@@ -1,0 +1,1 @@
+"""Performance measurements: the scaling table (``python -m bench scaling``)."""

@@ -1,0 +1,160 @@
+"""The scaling table: time of each phase and peak memory against problem size.
+
+``python -m bench scaling`` runs, for each size, in a fresh process (so that the peak resident
+memory belongs to that size alone): assembly of the mixed method on a uniform mesh of the paper
+scene, one plain linear solve of the same stiffness matrix with the same back-end (the physical
+floor), the fast contact solve (``active-set``, cold start), the residual estimator, and the
+reference solve (CVXPY + Clarabel) up to ``reference_max_dofs``. Same workloads as the
+pytest-benchmark module ``tests/benchmarks``.
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import platform
+import resource
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+# (initial_divisions, uniform refinements) of the paper scene for ~10^4, 10^5, 10^6 DOFs
+SIZES = {"1e4": (9, 3), "1e5": (14, 4), "1e6": (11, 6)}
+README_START, README_END = "<!-- scaling:start -->", "<!-- scaling:end -->"
+
+
+def paper_problem(size: str):
+    """(scene, mesh) of the paper scene with about ``size`` DOFs."""
+    from scenes import get_scene
+
+    if size not in SIZES:
+        raise ValueError(f"size={size!r} is not one of {', '.join(SIZES)}")
+    divisions, refinements = SIZES[size]
+    scene = get_scene("paper", initial_divisions=divisions)
+    return scene, scene.mesh.refined(refinements)
+
+
+def linear_rhs(qp) -> np.ndarray:
+    """Right-hand side of the plain linear solve: a unit pressure on every contact row (the
+    paper scene's F is zero, and a solve with b = 0 would prove nothing)."""
+    return qp.F - qp.B.T @ np.ones(qp.m)
+
+
+def _peak_gib() -> float:
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20  # KiB on Linux
+
+
+def measure(size: str, backend: str | None = None, reference: bool = True) -> dict:
+    """Time every phase once at ``size``; run in a fresh process for a meaningful peak."""
+    from estimators import get_estimator
+    from formulations import get_formulation, solve
+    from formulations.solvers.backends import check_backend, factorise
+
+    backend = check_backend(backend)
+    scene, mesh = paper_problem(size)
+    start = time.perf_counter()
+    disc = get_formulation("mixed")(scene, mesh)
+    row = {"size": size, "ndofs": disc.ndofs, "n_constraints": disc.qp.m, "backend": backend,
+           "t_assemble": time.perf_counter() - start}
+    start = time.perf_counter()
+    factorise(disc.qp.K, backend)(linear_rhs(disc.qp))
+    row["t_linear_solve"] = time.perf_counter() - start
+    fast = solve(disc, "active-set", backend=backend)
+    row.update(t_fast_solve=fast.solve_time, fast_iterations=fast.iterations,
+               fast_status=fast.status, fast_max_residual=max(vars(fast.residuals).values()))
+    start = time.perf_counter()
+    get_estimator("residual")(scene, fast)
+    row["t_estimate"] = time.perf_counter() - start
+    row["peak_gib_without_reference"] = _peak_gib()
+    row.update(t_reference_solve=np.nan, reference_iterations=0, reference_status="not run",
+               energy_norm_difference=np.nan, max_lambda_difference=np.nan)
+    if reference:
+        from bench.measure.difference import solution_difference
+
+        reference = solve(disc, "reference")
+        energy, pressure = solution_difference(disc, fast, reference)
+        row.update(t_reference_solve=reference.solve_time,
+                   reference_iterations=reference.iterations,
+                   reference_status=reference.status, energy_norm_difference=energy,
+                   max_lambda_difference=pressure)
+    row["peak_gib"] = _peak_gib()
+    return row
+
+
+def _measure_star(args):
+    return measure(*args)
+
+
+def run_scaling(sizes, backend=None, reference_max_dofs=200_000, on_row=None) -> pd.DataFrame:
+    """``measure`` every size in its own spawned process; the reference only up to
+    ``reference_max_dofs`` (its time grows fastest; see the README for where it stops)."""
+    rows = []
+    context = multiprocessing.get_context("spawn")
+    for size in sizes:
+        scene, mesh = paper_problem(size)  # cheap: the DOF count decides the reference
+        ndofs_estimate = 2 * mesh.p.shape[1]
+        with context.Pool(1) as pool:
+            row = pool.apply(_measure_star,
+                             ((size, backend, ndofs_estimate <= reference_max_dofs),))
+        rows.append(row)
+        if on_row is not None:
+            on_row(row)
+    frame = pd.DataFrame(rows)
+    frame["fast_over_linear"] = frame["t_fast_solve"] / frame["t_linear_solve"]
+    frame["reference_over_fast"] = frame["t_reference_solve"] / frame["t_fast_solve"]
+    return frame
+
+
+def machine_line() -> str:
+    import os
+
+    return (f"{platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}"
+            f", {platform.platform()}")
+
+
+def markdown_table(frame: pd.DataFrame) -> str:
+    table = pd.DataFrame({
+        "N (DOFs)": frame["ndofs"],
+        "contact rows": frame["n_constraints"],
+        "assembly [s]": frame["t_assemble"].map("{:.2f}".format),
+        "linear solve [s]": frame["t_linear_solve"].map("{:.2f}".format),
+        "fast contact solve [s]": frame["t_fast_solve"].map("{:.2f}".format),
+        "fast / linear": frame["fast_over_linear"].map("{:.2f}".format),
+        "iterations": frame["fast_iterations"],
+        "reference solve [s]": frame["t_reference_solve"].map(
+            lambda t: "not run" if t != t else f"{t:.2f}"),
+        "reference / fast": frame["reference_over_fast"].map(
+            lambda r: "" if r != r else f"{r:.1f}x"),
+        "energy-norm difference": frame["energy_norm_difference"].map(
+            lambda d: "" if d != d else f"{d:.1e}"),
+        "max lambda difference": frame["max_lambda_difference"].map(
+            lambda d: "" if d != d else f"{d:.1e}"),
+        "estimator [s]": frame["t_estimate"].map("{:.2f}".format),
+        "peak memory without reference [GiB]": frame["peak_gib_without_reference"].map(
+            "{:.2f}".format),
+        "peak memory [GiB]": frame["peak_gib"].map("{:.2f}".format),
+    })
+    backend = ", ".join(sorted(set(frame["backend"])))
+    return (f"Back-end: {backend}. Machine: {machine_line()}.\n\n"
+            + table.to_markdown(index=False))
+
+
+def write_scaling(frame: pd.DataFrame, out: str | Path, readme: str | Path | None = None):
+    """Write OUT/scaling.{csv,md}; with ``readme``, replace the table between the README's
+    scaling markers."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    frame.to_csv(out / "scaling.csv", index=False)
+    text = markdown_table(frame)
+    (out / "scaling.md").write_text(text + "\n")
+    if readme is not None:
+        readme = Path(readme)
+        content = readme.read_text()
+        if README_START not in content or README_END not in content:
+            raise ValueError(f"readme={str(readme)!r} has no {README_START} ... {README_END} "
+                             "markers")
+        head, rest = content.split(README_START, 1)
+        tail = rest.split(README_END, 1)[1]
+        readme.write_text(f"{head}{README_START}\n{text}\n{README_END}{tail}")
+    return out / "scaling.md"

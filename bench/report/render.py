@@ -1,0 +1,105 @@
+"""The comparison report: ``README.md`` and one self-contained ``index.html``, rendered by
+Jinja2 templates (``bench/report/templates``) from the same data, a pure function of a results
+folder (results.parquet, plus artifacts/, truth.json, run.json and hard.csv when present)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import jinja2
+import pandas as pd
+
+from bench.hard import LOSS_TOLERANCE, PRESSURE_TOLERANCE, hard_display
+from bench.matrix.rates import RATE_LEVELS, rates_table
+from bench.report import figures
+from bench.report.sections import Figures, scene_section
+from bench.report.tables import (
+    accuracy_table,
+    agreement_table,
+    effectivity_table,
+    failure_table,
+    rate_verdicts,
+    timing_table,
+)
+from bench.sequence.rows import COLUMNS, KEYS
+
+TEMPLATES = Path(__file__).with_name("templates")
+HARD_CAPTION = ("Hard cases: the mixed method's inf-sup constant beta_h against ndofs for "
+                "h/H = 1, 1/2, 1/4 (bounded below only for h/H <= 1/2); the penalty's "
+                "penetration and condition estimate against eps_0; and each solver's pressure "
+                "loss against eps_0, with the bar for 'accurate'.")
+
+
+def latest_run(table: pd.DataFrame) -> pd.DataFrame:
+    """Keep, per combination, the rows of the most recent run that produced it."""
+    last = table.groupby(KEYS)["run_id"].transform("max")
+    return table[table["run_id"] == last]
+
+
+def _read_json(results: Path | None, name: str) -> dict:
+    if results is None or not (results / name).exists():
+        return {}
+    return json.loads((results / name).read_text())
+
+
+def _hard_section(results: Path | None, figs: Figures) -> tuple[pd.DataFrame | None, list]:
+    """The hard cases' verdict table and figure, if the results folder has hard.csv."""
+    if results is None or not (results / "hard.csv").exists():
+        return None, []
+    raw = pd.read_csv(results / "hard.csv")
+    item = figs.add(figures.hard_stability(raw, PRESSURE_TOLERANCE), "hard-stability",
+                    HARD_CAPTION)
+    return hard_display(raw), [item] if item is not None else []
+
+
+def _tables(everything: pd.DataFrame, rows: pd.DataFrame, hard) -> dict:
+    rates = rates_table(rows) if len(rows) else pd.DataFrame()
+    return {"rates": rate_verdicts(rates), "effectivity": effectivity_table(rates),
+            "accuracy": accuracy_table(rows), "timing": timing_table(rows),
+            "agreement": agreement_table(rows), "failures": failure_table(everything),
+            "hard": hard if hard is not None else pd.DataFrame()}
+
+
+def _render(context: dict, out: Path) -> Path:
+    env = jinja2.Environment(loader=jinja2.FileSystemLoader(TEMPLATES),
+                             autoescape=jinja2.select_autoescape(["html", "html.j2"]),
+                             undefined=jinja2.StrictUndefined, trim_blocks=True,
+                             lstrip_blocks=True)
+    env.filters["markdown_table"] = lambda t: t.to_markdown(index=False) if len(t) else "None."
+    env.filters["records"] = lambda t: t.to_dict("records")
+    (out / "index.html").write_text(env.get_template("report.html.j2").render(**context))
+    path = out / "README.md"
+    path.write_text(env.get_template("report.md.j2").render(**context))
+    return path
+
+
+def write_report(table: pd.DataFrame, out: str | Path, results: str | Path | None = None,
+                 command: str = "") -> Path:
+    """Render ``out/README.md``, ``out/index.html`` and ``out/figures/*.png`` from a result
+    table (and its results folder); returns the README's path."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    results = Path(results) if results is not None else None
+    missing = [c for c in COLUMNS if c not in table.columns]
+    table = table.reindex(columns=list(dict.fromkeys([*COLUMNS, *table.columns])))
+    everything = latest_run(table) if len(table) else table
+    rows = everything[everything["level"] >= 0]
+    run_info, truth = _read_json(results, "run.json"), _read_json(results, "truth.json")
+    figs = Figures(out)
+    hard, hard_figures = _hard_section(results, figs)
+    head = everything.iloc[0] if len(everything) else pd.Series(dtype=object)
+    return _render({
+        "command": command or run_info.get("command", "(not recorded)"),
+        "configuration": run_info.get("configuration", {}),
+        "commit": head.get("commit", ""), "versions": head.get("versions", ""),
+        "machine": head.get("machine", ""), "python": head.get("python", ""),
+        "rate_levels": RATE_LEVELS, "loss_tolerance": LOSS_TOLERANCE,
+        "pressure_tolerance": PRESSURE_TOLERANCE, "missing_columns": missing,
+        "scenes": [scene_section(name, group, results, figs, truth)
+                   for name, group in rows.groupby("scene", sort=True)],
+        "tables": _tables(everything, rows, hard),
+        "hard_run": hard is not None, "hard_figures": hard_figures,
+        "n_rows": len(everything), "n_too_coarse": int(rows["reference_too_coarse"]
+                                                        .fillna(False).astype(bool).sum()),
+    }, out)

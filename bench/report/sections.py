@@ -1,0 +1,110 @@
+"""The report's per-scene sections and their figures (PNG files plus base64 for the HTML)."""
+
+from __future__ import annotations
+
+import base64
+import io
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from bench.matrix.artifacts import artifact_path, load_artifact
+from bench.report import figures
+from bench.sequence.rows import KEYS
+from scenes import get_scene
+
+
+class Figures:
+    """Saves each figure as PNG under ``out/figures`` and keeps its base64 for the HTML."""
+
+    def __init__(self, out: Path):
+        self.out = out / "figures"
+        self.out.mkdir(parents=True, exist_ok=True)
+        self.items: list[dict] = []
+
+    def add(self, figure, name: str, caption: str) -> dict | None:
+        if figure is None:
+            return None
+        buffer = io.BytesIO()
+        figure.savefig(buffer, format="png", dpi=110)
+        data = buffer.getvalue()
+        (self.out / f"{name}.png").write_bytes(data)
+        item = {"file": f"figures/{name}.png", "caption": caption,
+                "data": base64.b64encode(data).decode("ascii")}
+        self.items.append(item)
+        return item
+
+
+def _artifacts(results: Path | None, group: pd.DataFrame) -> dict:
+    out = {}
+    if results is None:
+        return out
+    for _, row in group.drop_duplicates(KEYS).iterrows():
+        data = load_artifact(artifact_path(results, row))
+        if data is not None:
+            out[(row["formulation"], row["estimator"], row["strategy"])] = data
+    return out
+
+
+def _scene(name: str):
+    try:
+        return get_scene(name)
+    except KeyError:
+        return None
+
+
+def _pressure_curve(scene, artifacts: dict):
+    """The true pressure to draw beside lambda_h: the exact one, or the scene's closed-form
+    prediction at the computed contact force of the first adaptive artifact."""
+    if scene is None:
+        return None
+    if scene.exact is not None:
+        s = np.linspace(*np.sort(scene.contact_coordinate(scene.mesh.p))[[0, -1]], 801)
+        return s, scene.exact.pressure(s), "exact pressure"
+    data = _first_adaptive(artifacts)
+    if scene.predict_contact is None or data is None:
+        return None
+    predicted = scene.predict_contact(float(data["contact_force"]))
+    b = predicted.half_width
+    s = np.linspace(predicted.centre - 1.5 * b, predicted.centre + 1.5 * b, 601)
+    return s, predicted.pressure(s), predicted.label
+
+
+def _first_adaptive(artifacts: dict):
+    return next(iter(v for k, v in sorted(artifacts.items()) if k[2] == "adaptive"), None)
+
+
+def scene_section(name: str, group: pd.DataFrame, results: Path | None, figs: Figures,
+                  truth: dict) -> dict:
+    scene = _scene(name)
+    artifacts = _artifacts(results, group)
+    section = {"name": name, "truth": truth.get(name, {"kind": "unknown"}), "figures": []}
+    preferred = _first_adaptive(artifacts)
+    for figure, suffix, caption in (
+            (figures.scene_picture(scene) if scene is not None else None, "scene",
+             "Geometry (initial mesh), boundary parts and the obstacle."),
+            (figures.convergence(group), "convergence",
+             "Error and estimator against ndofs, uniform (squares) and adaptive (circles), with "
+             "O(h^1/2) and O(h) slope triangles (the paper's Figure 2)."),
+            (figures.effectivity(group), "effectivity",
+             "Effectivity index eta / ||u - u_h||; crosses mark rows whose reference is too "
+             "coarse."),
+            (figures.work_precision(group), "work-precision",
+             "Work-precision: error (eta without a truth) against cumulative wall time and "
+             "against the level's solve time."),
+            (figures.meshes(artifacts), "meshes",
+             "Final adaptive meshes per formulation/estimator (the paper's Figure 1b)."),
+            (figures.deformed(preferred, name), "deformed",
+             "Deformed body coloured by von Mises stress; the colour scale is clipped at the "
+             f"{figures.VON_MISES_PERCENTILE:g}th percentile because the stress is singular at "
+             "the clamped corners (the paper's Figure 1a)."),
+            (figures.pressures(artifacts, _pressure_curve(scene, artifacts)), "pressure",
+             "Contact pressure lambda_h along Gamma_C (adaptive, last level) per formulation; "
+             "dotted lines are the contact-zone end points.")):
+        item = figs.add(figure, f"{name}-{suffix}", caption)
+        if item is not None:
+            section["figures"].append(item)
+    if scene is None:
+        section["missing"] = f"scene {name!r} is not registered here: no picture"
+    return section

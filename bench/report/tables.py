@@ -1,0 +1,121 @@
+"""The report's tables, as DataFrames of formatted strings (both templates show the same)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from bench.sequence.rows import KEYS, phase_time
+from bench.verify import claims
+from formulations import STATUS_OK
+
+CLAIM_TOLERANCE = 0.1  # |measured - claimed| slope within which we say "agrees"
+TIME_SHIFT = 1.0  # s, shift of the shifted geometric mean of times
+
+
+def _fmt(value, spec=".3g") -> str:
+    if value is None or (isinstance(value, float) and not np.isfinite(value)):
+        return ""
+    return format(value, spec) if isinstance(value, (int, float, np.floating, np.integer)) \
+        else str(value)
+
+
+def _verdict(measured: float, claimed: float) -> str:
+    if not np.isfinite(measured):
+        return "not measured"
+    if abs(measured - claimed) <= CLAIM_TOLERANCE:
+        return "agrees"
+    return "steeper than claimed" if measured < claimed else "shallower than claimed"
+
+
+def rate_verdicts(rates: pd.DataFrame) -> pd.DataFrame:
+    """Measured slopes beside the claimed ones (``[[claim]]`` in expected.toml)."""
+    rows, claimed_slopes = [], claims()
+    for _, r in rates.iterrows():
+        claimed, source = claimed_slopes.get((r["scene"], r["strategy"]), (np.nan, "no claim"))
+        measured = r["error_rate"] if np.isfinite(r["error_rate"]) else r["eta_rate"]
+        rows.append({"scene": r["scene"], "formulation": r["formulation"],
+                     "estimator": r["estimator"], "strategy": r["strategy"],
+                     "error rate": _fmt(r["error_rate"]), "eta rate": _fmt(r["eta_rate"]),
+                     "pressure error rate": _fmt(r["pressure_error_rate"]),
+                     "claimed": _fmt(claimed), "source": source,
+                     "verdict": _verdict(measured, claimed) if np.isfinite(claimed) else ""})
+    return pd.DataFrame(rows)
+
+
+def effectivity_table(rates: pd.DataFrame) -> pd.DataFrame:
+    if rates.empty:
+        return pd.DataFrame()
+    return pd.DataFrame({
+        "scene": rates["scene"], "formulation": rates["formulation"],
+        "estimator": rates["estimator"], "strategy": rates["strategy"],
+        "last": rates["effectivity_last"].map(_fmt), "min": rates["effectivity_min"].map(_fmt),
+        "max": rates["effectivity_max"].map(_fmt),
+        "max/min": rates["effectivity_variation"].map(_fmt),
+        "rows with too coarse reference": rates["too_coarse_rows"]})
+
+
+def _total_time(group: pd.DataFrame) -> float:
+    return float(phase_time(group).sum())
+
+
+def accuracy_table(rows: pd.DataFrame) -> pd.DataFrame:
+    out = []
+    for key, group in rows.groupby(KEYS, sort=True):
+        last = group.sort_values("level").iloc[-1]
+        out.append({**dict(zip(KEYS, key, strict=True)), "ndofs": int(last["ndofs"]),
+                    "energy": _fmt(last["energy"], ".6g"),
+                    "contact force": _fmt(last["contact_force"], ".6g"),
+                    "error": _fmt(last["energy_error"]), "eta": _fmt(last["eta"]),
+                    "eta_0": _fmt(last["eta_0"]), "eta_geometric": _fmt(last["eta_geometric"]),
+                    "eta_compl.": _fmt(last["eta_complementarity"]),
+                    "effectivity": _fmt(last["effectivity_index"]),
+                    "zone": f"[{_fmt(last['contact_zone_start'], '.4g')}, "
+                            f"{_fmt(last['contact_zone_end'], '.4g')}]",
+                    "iterations": int(last["iterations"]),
+                    "pressure oscillation": _fmt(last.get("pressure_oscillation")),
+                    "inf-sup": _fmt(last.get("inf_sup")),
+                    "total time [s]": _fmt(_total_time(group), ".3g"), "status": last["status"]})
+    return pd.DataFrame(out)
+
+
+def timing_table(rows: pd.DataFrame) -> pd.DataFrame:
+    """Shifted geometric mean over scenes of each sequence's total wall time, normalised by
+    the best combination: exp(mean(log(t + s))) - s with shift s = TIME_SHIFT."""
+    keys = ["formulation", "solver", "estimator", "strategy"]
+    totals = rows.groupby(["scene", *keys]).apply(_total_time, include_groups=False)
+    if totals.empty:
+        return pd.DataFrame()
+    totals = totals.rename("t").reset_index()
+    sgm = totals.groupby(keys)["t"].apply(
+        lambda t: float(np.exp(np.mean(np.log(t + TIME_SHIFT))) - TIME_SHIFT))
+    best = sgm.min()
+    out = sgm.rename("shifted geometric mean [s]").reset_index()
+    out["relative to best"] = (sgm.values / best) if best > 0 else np.nan
+    out["scenes"] = totals.groupby(keys)["scene"].nunique().values
+    out["shifted geometric mean [s]"] = out["shifted geometric mean [s]"].map(_fmt)
+    out["relative to best"] = out["relative to best"].map(lambda v: _fmt(v, ".2f"))
+    return out.sort_values("relative to best")
+
+
+def agreement_table(rows: pd.DataFrame) -> pd.DataFrame:
+    checked = rows[rows["crosscheck_status"].fillna("").astype(str) != ""]
+    if checked.empty:
+        return pd.DataFrame()
+    keys = ["scene", "formulation", "solver"]
+    out = checked.groupby(keys).agg(
+        levels=("level", "count"), max_ndofs=("ndofs", "max"),
+        energy_norm=("crosscheck_energy_difference", "max"),
+        pressure=("crosscheck_pressure_difference", "max"),
+        reference_ok=("crosscheck_status", lambda s: int((s == STATUS_OK).sum()))).reset_index()
+    out["energy_norm"] = out["energy_norm"].map(lambda v: _fmt(v, ".1e"))
+    out["pressure"] = out["pressure"].map(lambda v: _fmt(v, ".1e"))
+    return out.rename(columns={"energy_norm": "max rel. energy-norm difference",
+                               "pressure": "max rel. pressure difference",
+                               "reference_ok": "reference ok"})
+
+
+def failure_table(everything: pd.DataFrame) -> pd.DataFrame:
+    bad = everything[everything["status"].fillna("missing") != STATUS_OK]
+    cols = [*KEYS, "level", "status", "reason"]
+    return bad[cols].astype(str) if len(bad) else pd.DataFrame()

@@ -1,0 +1,57 @@
+"""The column groups of a level's result row beyond its basic numbers: errors against the
+truth, the solver's and the discretisation's stability diagnostics, and the cross-check by the
+reference solver (docs/theory.md, section 7)."""
+
+from __future__ import annotations
+
+import time
+
+from bench.measure.difference import solution_difference
+from formulations import STATUS_FAILED, SolverDiagnostics, solve
+from formulations.diagnostics import inf_sup_constant, pressure_oscillation
+
+
+def error_columns(truth, solution, estimate) -> dict:
+    """Errors against ``truth`` (``bench.truth``) and effectivity indices eta / error."""
+    start = time.perf_counter()
+    errors = truth.errors(solution)
+    out = dict(vars(errors), truth=truth.kind, reference_error=truth.estimated_error,
+               reference_too_coarse=truth.too_coarse(errors.energy_error))
+    if estimate is not None and errors.energy_error > 0:
+        out.update(effectivity_index=estimate.eta / errors.energy_error,
+                   effectivity_0=estimate.eta_0 / errors.energy_error,
+                   effectivity_geometric=estimate.eta_geometric / errors.energy_error,
+                   effectivity_complementarity=estimate.eta_complementarity
+                   / errors.energy_error)
+    out["t_error"] = time.perf_counter() - start
+    return out
+
+
+def solver_columns(diagnostics: SolverDiagnostics) -> dict:
+    """The solver's own diagnostics as result columns."""
+    return dict(condition_estimate=diagnostics.condition_estimate,
+                active_set_changes=",".join(map(str, diagnostics.active_set_changes)),
+                cycled=diagnostics.cycled, safeguard=diagnostics.safeguard)
+
+
+def diagnostic_columns(disc, sol, inf_sup: bool, backend: str | None) -> dict:
+    """The solver's diagnostics and the stability measures of ``formulations.diagnostics``;
+    ``inf_sup``: compute the inf-sup constant too (free when the solver kept B K^-1 B')."""
+    start = time.perf_counter()
+    out = dict(solver_columns(sol.diagnostics), pressure_oscillation=pressure_oscillation(sol))
+    if inf_sup:
+        out["inf_sup"] = inf_sup_constant(disc, backend, condensed=sol.diagnostics.condensed)
+    out["t_diagnostics"] = time.perf_counter() - start
+    return out
+
+
+def crosscheck_columns(disc, sol) -> dict:
+    """Solve the same discrete problem with the reference solver and compare: relative
+    energy-norm difference of u_h and max pressure difference relative to max lambda_h."""
+    reference = solve(disc, "reference")
+    out = {"crosscheck_status": reference.status}
+    if reference.status == STATUS_FAILED:
+        return out
+    energy, pressure = solution_difference(disc, sol, reference)
+    out.update(crosscheck_energy_difference=energy, crosscheck_pressure_difference=pressure)
+    return out

@@ -1,0 +1,131 @@
+"""The refinement loop solve -> estimate -> mark -> refine, one result row per level
+(docs/theory.md, section 7)."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+
+from skfem import MeshTri
+
+from bench.sequence.columns import (
+    crosscheck_columns,
+    diagnostic_columns,
+    error_columns,
+    solver_columns,
+)
+from bench.sequence.marking import check_marking, grade_contact_trace, mark
+from bench.sequence.rows import ResultRow, identity_columns
+from estimators import get_estimator
+from formulations import STATUS_FAILED, get_formulation, solve
+from formulations.elasticity import element_diameters
+from scenes import Scene
+
+STRATEGIES = ("uniform", "adaptive")
+
+
+@dataclass(frozen=True)
+class LoopConfig:
+    """How a refinement sequence is run; validated on construction."""
+
+    strategy: str = "adaptive"
+    max_dofs: int = 20000
+    max_levels: int = 40
+    marking: str = "doerfler"
+    theta: float = 0.5
+    nested: bool = True
+    grade_contact: bool = True  # 2:1 grading closure along Gamma_C (bench.sequence.marking)
+    # the inf-sup constant: free with the active-set solver on cholmod (its condensed system),
+    # else a factorisation and m solves per level
+    diagnostics: bool = True
+    solver_options: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        if self.strategy not in STRATEGIES:
+            raise ValueError(f"strategy={self.strategy!r} is not one of {', '.join(STRATEGIES)}")
+        for name in ("max_dofs", "max_levels"):
+            value = getattr(self, name)
+            if not (isinstance(value, int) and value > 0):
+                raise ValueError(f"{name}={value!r} is not a positive integer")
+        check_marking(self.marking, self.theta)
+
+
+@dataclass(frozen=True, eq=False)
+class LevelResult:
+    """Everything one level produced: the row and the objects behind it (for plots, tests)."""
+
+    row: ResultRow
+    solution: object | None
+    estimate: object | None
+
+
+def level_columns(disc, sol, mesh, options: dict) -> dict:
+    """The basic numbers of a solved level: sizes, energy, contact, residuals, status."""
+    h = element_diameters(mesh)
+    return dict(
+        ndofs=disc.ndofs, n_elements=mesh.t.shape[1], h_max=float(h.max()),
+        h_min=float(h.min()), max_h_over_H=sol.max_h_over_H, energy=sol.energy,
+        contact_force=sol.contact_force(), active_constraints=sol.active_constraints,
+        n_constraints=disc.qp.m, iterations=sol.iterations, backend=sol.backend,
+        warm_started="warm_start" in options, t_solve=sol.solve_time, status=sol.status,
+        reason=sol.reason, **vars(sol.residuals))
+
+
+def refine(mesh: MeshTri, sol, est, config: LoopConfig) -> MeshTri:
+    """The next mesh: uniform refinement, or marking (plus the contact grading closure)."""
+    if config.strategy == "uniform":
+        return mesh.refined()
+    marked = mark(est.indicators, config.marking, config.theta)
+    if config.grade_contact:
+        trace = sol.trace
+        marked = grade_contact_trace(marked, trace.length, trace.element, trace.coordinate,
+                                     mesh.t.shape[1])
+    return mesh.refined(marked)
+
+
+def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
+                 config: LoopConfig, identity: dict | None = None,
+                 mesh: MeshTri | None = None, truth=None,
+                 crosscheck_dofs: int = 0) -> Iterator[LevelResult]:
+    """Yield one ``LevelResult`` per level until the DOF budget or the level count is reached,
+    or a level fails (its row says why). With a ``truth`` (``bench.truth``) every level also
+    gets its errors and effectivity indices; ``identity``: the run's columns (run id,
+    provenance)."""
+    discretise, estimate = get_formulation(formulation), get_estimator(estimator)
+    ident = identity_columns(scene.name, formulation, solver, estimator, config, identity)
+    mesh = scene.mesh if mesh is None else mesh
+    t_refine, previous = 0.0, None
+    for level in range(config.max_levels):
+        start = time.perf_counter()
+        disc = discretise(scene, mesh)
+        t_assemble = time.perf_counter() - start
+        if level > 0 and disc.ndofs > config.max_dofs:
+            return
+        options = dict(config.solver_options)
+        if config.nested and previous is not None and previous.ok:
+            options["warm_start"] = disc.warm_start(previous)  # nested iteration
+        sol = previous = solve(disc, solver, **options)
+        failed = sol.status == STATUS_FAILED
+        start = time.perf_counter()
+        est = None if failed else estimate(scene, sol)
+        t_estimate = float("nan") if failed else time.perf_counter() - start
+        numbers = dict(level_columns(disc, sol, mesh, options), level=level,
+                       t_assemble=t_assemble, t_refine=t_refine, t_estimate=t_estimate)
+        if failed:
+            numbers.update(solver_columns(sol.diagnostics))
+        else:
+            numbers.update(diagnostic_columns(disc, sol, config.diagnostics,
+                                              config.solver_options.get("backend")))
+            numbers.update(eta=est.eta, eta_0=est.eta_0, eta_geometric=est.eta_geometric,
+                           eta_complementarity=est.eta_complementarity)
+            if truth is not None:
+                numbers.update(error_columns(truth, sol, est))
+            if solver != "reference" and disc.ndofs <= crosscheck_dofs:
+                numbers.update(crosscheck_columns(disc, sol))
+        yield LevelResult(ResultRow(**ident, **numbers), sol, est)
+        if failed:
+            return
+        start = time.perf_counter()
+        mesh = refine(mesh, sol, est, config)
+        t_refine = time.perf_counter() - start

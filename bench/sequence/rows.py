@@ -1,0 +1,104 @@
+"""One result row per (scene, formulation, solver, estimator, strategy, level).
+
+Column names are a public interface (see the README's table of columns and units): add new
+columns, never rename.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, fields
+
+
+@dataclass(frozen=True)
+class ResultRow:
+    scene: str
+    formulation: str
+    solver: str
+    estimator: str
+    strategy: str
+    level: int
+    ndofs: int = 0
+    n_elements: int = 0
+    h_max: float = math.nan
+    h_min: float = math.nan
+    max_h_over_H: float = math.nan
+    energy: float = math.nan
+    contact_force: float = math.nan
+    active_constraints: int = 0
+    n_constraints: int = 0
+    eta: float = math.nan
+    eta_0: float = math.nan
+    eta_geometric: float = math.nan
+    eta_complementarity: float = math.nan
+    violation: float = math.nan
+    dual_violation: float = math.nan
+    complementarity: float = math.nan
+    stationarity: float = math.nan
+    iterations: int = 0
+    backend: str = ""
+    warm_started: bool = False
+    t_assemble: float = math.nan
+    t_solve: float = math.nan
+    t_estimate: float = math.nan
+    t_refine: float = math.nan
+    status: str = ""
+    reason: str = ""
+    truth: str = ""
+    energy_error: float = math.nan
+    pressure_error: float = math.nan
+    zone_error: float = math.nan
+    contact_zone_start: float = math.nan
+    contact_zone_end: float = math.nan
+    effectivity_index: float = math.nan
+    effectivity_0: float = math.nan
+    effectivity_geometric: float = math.nan
+    effectivity_complementarity: float = math.nan
+    reference_error: float = math.nan
+    reference_too_coarse: bool = False
+    t_error: float = math.nan
+    crosscheck_status: str = ""
+    crosscheck_energy_difference: float = math.nan
+    crosscheck_pressure_difference: float = math.nan
+    marking: str = ""
+    theta: float = math.nan
+    condition_estimate: float = math.nan
+    active_set_changes: str = ""
+    cycled: bool = False
+    safeguard: str = ""
+    inf_sup: float = math.nan
+    pressure_oscillation: float = math.nan
+    t_diagnostics: float = math.nan
+    run_id: str = ""
+    commit: str = ""
+    python: str = ""
+    versions: str = ""
+    machine: str = ""
+
+    def as_dict(self) -> dict:
+        return asdict(self)
+
+
+COLUMNS = [f.name for f in fields(ResultRow)]
+KEYS = ["scene", "formulation", "solver", "estimator", "strategy"]  # identity of a combination
+# the phases of a level whose wall times add up to the level's time
+PHASE_TIMES = ["t_assemble", "t_solve", "t_estimate", "t_refine"]
+
+
+def identity_columns(scene: str, formulation: str, solver: str, estimator: str, config,
+                     run: dict | None = None) -> dict:
+    """The columns that name a sequence: the combination, its marking (``config`` is a
+    ``bench.sequence.loop.LoopConfig``) and the run's identity and provenance (``run``)."""
+    return dict(scene=scene, formulation=formulation, solver=solver, estimator=estimator,
+                strategy=config.strategy, marking=config.marking, theta=config.theta,
+                **(run or {}))
+
+
+def level_time(row: ResultRow) -> float:
+    """Wall time of a level: the sum of its phases (a phase that did not run counts 0)."""
+    return float(sum(t for t in (getattr(row, c) for c in PHASE_TIMES) if math.isfinite(t)))
+
+
+def phase_time(frame):
+    """Per row of a result table (a DataFrame), the sum of its phase times."""
+    return frame[PHASE_TIMES].fillna(0).sum(axis=1)

@@ -1,0 +1,39 @@
+"""Computed contact against a scene's closed-form prediction (``Scene.predict_contact``, e.g.
+Hertz's half-width and peak pressure) at the computed contact force."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from bench.measure.contact import contact_zone
+from bench.sequence.loop import LoopConfig, run_sequence
+from scenes import get_scene
+
+PEAK_SAMPLES = 8001  # points over +-4 half-widths where the computed peak pressure is sought
+
+
+def closed_form_table(run: dict) -> pd.DataFrame:
+    """One row per formulation: computed and predicted half-width and peak pressure, and their
+    relative errors (``run``: the ``[closed_form]`` entry of expected.toml)."""
+    scene = get_scene(run["scene"])
+    rows = []
+    for formulation in run["formulations"]:
+        *_, result = run_sequence(scene, formulation, run["solver"], run["estimator"],
+                                  LoopConfig(strategy="adaptive", max_dofs=run["max_dofs"]))
+        sol = result.solution
+        force = sol.contact_force()
+        predicted = scene.predict_contact(force)
+        start, end = contact_zone(sol)
+        b = predicted.half_width
+        s = np.linspace(predicted.centre - 4 * b, predicted.centre + 4 * b, PEAK_SAMPLES)
+        rows.append({"scene": scene.name, "formulation": formulation,
+                     "ndofs": result.row.ndofs, "contact_force": force,
+                     "half_width": 0.5 * (end - start), "predicted_half_width": b,
+                     "peak_pressure": float(sol.pressure_at(s).max()),
+                     "predicted_peak_pressure": predicted.peak_pressure})
+    table = pd.DataFrame(rows)
+    table["half_width_error"] = table["half_width"] / table["predicted_half_width"] - 1
+    table["peak_pressure_error"] = (table["peak_pressure"] / table["predicted_peak_pressure"]
+                                    - 1)
+    return table

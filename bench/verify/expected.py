@@ -1,0 +1,29 @@
+"""The one file of expectations, ``expected.toml``: the gate runs, the gates, the claimed
+slopes the report compares with, the closed-form comparison and the hard cases' verdicts. A
+``[[run]]`` that names no formulations or estimators runs every registered one."""
+
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+
+from estimators import estimator_names
+from formulations import formulation_names
+
+EXPECTED = Path(__file__).with_name("expected.toml")
+
+
+def load_expected(path: str | Path = EXPECTED) -> dict:
+    with open(path, "rb") as handle:
+        expected = tomllib.load(handle)
+    for run in [*expected.get("run", []), expected.get("closed_form", {})]:
+        run.setdefault("formulations", formulation_names())
+        run.setdefault("estimators", estimator_names())
+    return expected
+
+
+def claims(expected: dict | None = None) -> dict[tuple[str, str], tuple[float, str]]:
+    """(scene, strategy) -> (claimed slope of log(error) against log(ndofs), its source)."""
+    expected = load_expected() if expected is None else expected
+    return {(c["scene"], c["strategy"]): (float(c["slope"]), c["source"])
+            for c in expected.get("claim", [])}

@@ -1,0 +1,107 @@
+"""Verification gates: run the sequences of ``expected.toml``, compute rates, effectivity and
+the closed-form comparison, and check every gate (and the hard cases' verdicts) against it.
+
+``python -m bench verify`` prints the pass/fail table; tests/bench/verify asserts it.
+"""
+
+from __future__ import annotations
+
+import fnmatch
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from bench.hard import check_expected, run_hard, write_hard
+from bench.matrix import RunConfig, run
+from bench.matrix.rates import rates_table
+from bench.sequence.rows import KEYS
+from bench.verify.closed_form import closed_form_table
+from bench.verify.expected import EXPECTED, load_expected
+
+
+@dataclass(frozen=True)
+class Verdict:
+    gate: str
+    combination: str
+    value: float
+    low: float
+    high: float
+    passed: bool
+    source: str
+    expected: str = ""  # a verdict gate's expected verdict (instead of a [low, high] band)
+
+
+def run_gate_matrices(expected: dict, out: str | Path, on_level=None) -> pd.DataFrame:
+    """The result rows of every ``[[run]]`` of expected.toml (stored together in ``out``)."""
+    tables = []
+    for k, entry in enumerate(expected["run"]):
+        config = RunConfig(scenes=(entry["scene"],), formulations=entry["formulations"],
+                           solvers=(entry["solver"],), estimators=entry["estimators"],
+                           strategies=entry["strategies"], max_dofs=entry["max_dofs"],
+                           reference_dofs=entry.get("reference_dofs"), out=str(out),
+                           overwrite=k == 0, command="python -m bench verify")
+        tables.append(run(config, on_level=on_level).table)
+    return pd.concat(tables, ignore_index=True)
+
+
+def _matches(row: pd.Series, gate: dict) -> bool:
+    return all(fnmatch.fnmatch(str(row[k]), str(gate.get(k, "*"))) for k in KEYS if k in row)
+
+
+def check_gates(expected: dict, rates: pd.DataFrame,
+                closed_form: pd.DataFrame) -> list[Verdict]:
+    verdicts = []
+    for gate in expected["gate"]:
+        low, high = gate.get("min", -np.inf), gate.get("max", np.inf)
+        source = gate["source"]
+        table = closed_form if gate["quantity"] in closed_form.columns else rates
+        selected = [row for _, row in table.iterrows() if _matches(row, gate)]
+        if not selected:
+            verdicts.append(Verdict(gate["name"], "(no rows)", np.nan, low, high, False, source))
+        for row in selected:
+            value = float(row[gate["quantity"]])
+            label = "/".join(str(row[k]) for k in KEYS if k in row)
+            verdicts.append(Verdict(gate["name"], label, value, low, high,
+                                    bool(low <= value <= high), source))
+    return verdicts
+
+
+def hard_verdicts(expected: dict, hard: pd.DataFrame) -> list[Verdict]:
+    """The hard cases' verdicts (``bench.hard``) against their [[hard]] entries."""
+    out = []
+    for check, (_, row) in zip(check_expected(hard, expected.get("hard", [])), hard.iterrows(),
+                               strict=True):
+        label = "/".join(str(check[k]) for k in ("formulation", "solver", "variant")
+                         if str(check[k]) not in ("", "nan"))
+        out.append(Verdict(f"hard case {check['case']}", label, float(row.get("loss", np.nan)),
+                           np.nan, np.nan, check["passed"],
+                           f"got {check['verdict']}; {check['source']}", check["expected"]))
+    return out
+
+
+def verify(out: str | Path = "results-verify", expected_path: str | Path = EXPECTED,
+           on_level=None, hard: bool = True) -> tuple[list[Verdict], pd.DataFrame, pd.DataFrame]:
+    """Every gate; with ``hard`` also the hard cases' verdicts (written to out/hard.csv).
+    Returns the verdicts, the rates table and the closed-form comparison."""
+    expected = load_expected(expected_path)
+    rows = run_gate_matrices(expected, out, on_level)
+    rates = rates_table(rows)
+    closed_form = closed_form_table(expected["closed_form"])
+    rates.to_csv(Path(out) / "rates.csv", index=False)
+    closed_form.to_csv(Path(out) / "closed-form.csv", index=False)
+    verdicts = check_gates(expected, rates, closed_form)
+    if hard:
+        table = run_hard()
+        write_hard(table, out)
+        verdicts += hard_verdicts(expected, table)
+    return verdicts, rates, closed_form
+
+
+def verdict_table(verdicts: list[Verdict]) -> str:
+    frame = pd.DataFrame([{"gate": v.gate, "combination": v.combination,
+                           "value": f"{v.value:.4g}",
+                           "allowed": v.expected or f"[{v.low:g}, {v.high:g}]",
+                           "verdict": "pass" if v.passed else "FAIL"} for v in verdicts])
+    return frame.to_markdown(index=False)

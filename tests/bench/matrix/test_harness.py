@@ -1,0 +1,41 @@
+"""The full matrix runs, and impossible combinations are skipped with a reason."""
+
+import pytest
+
+from bench.sequence.loop import LoopConfig
+from bench.matrix.harness import run_matrix
+from bench.matrix.store import ResultStore
+from estimators.base import ESTIMATORS, register_estimator
+
+
+def test_full_matrix_on_the_paper_scene_has_no_failed_rows(tmp_path):
+    rows = run_matrix(["paper"], ["mixed", "penalty", "vi"], ["reference"],
+                      ["residual", "averaging"], ["uniform", "adaptive"],
+                      ResultStore(tmp_path), LoopConfig(max_dofs=2500))
+    combos = {(r.formulation, r.estimator, r.strategy) for r in rows}
+    assert len(combos) == 12
+    assert [r for r in rows if r.status != "ok"] == []
+    for combo in combos:  # every combination refined at least three times
+        assert max(r.level for r in rows if (r.formulation, r.estimator, r.strategy) == combo) >= 3
+
+
+@pytest.fixture
+def picky_estimator():
+    def refuse_penalty(scene, formulation):
+        return "needs a multiplier" if formulation == "penalty" else None
+
+    register_estimator("picky", "test only", applies=refuse_penalty)(
+        ESTIMATORS.get("residual"))
+    yield "picky"
+    ESTIMATORS.unregister("picky")
+
+
+def test_impossible_combination_becomes_one_skipped_row(tmp_path, picky_estimator):
+    store = ResultStore(tmp_path)
+    rows = run_matrix(["paper"], ["penalty", "mixed"], ["active-set"], [picky_estimator],
+                      ["uniform"], store, LoopConfig(max_dofs=200))
+    skipped = [r for r in rows if r.status == "skipped"]
+    assert len(skipped) == 1 and skipped[0].formulation == "penalty"
+    assert skipped[0].reason == "needs a multiplier" and skipped[0].level == -1
+    assert {r.status for r in rows if r.formulation == "mixed"} == {"ok"}
+    assert (store.table()["status"] == "skipped").sum() == 1

@@ -1,0 +1,133 @@
+"""The report: renders from a small results table, self-contained HTML, escaping, missing data,
+and a real browser."""
+
+import base64
+import shutil
+import subprocess
+from html.parser import HTMLParser
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from bench.hard import run_hard
+from bench.hard import write_hard
+from bench.sequence.loop import LoopConfig
+from bench.matrix.harness import run_matrix
+from bench.report import write_report
+from bench.matrix.store import ResultStore
+
+SECTIONS = ["contents", "what-was-run", "scenes", "results-per-scene", "summary-across-scenes",
+            "failures-and-skips", "hard-cases", "known-limitations"]
+PNG = b"\x89PNG\r\n\x1a\n"
+
+
+class Collector(HTMLParser):
+    def __init__(self):
+        super().__init__()
+        self.ids, self.images, self.external = [], [], []
+
+    def handle_starttag(self, tag, attrs):
+        attrs = dict(attrs)
+        if "id" in attrs:
+            self.ids.append(attrs["id"])
+        if tag == "img":
+            self.images.append(attrs.get("src", ""))
+        if tag in ("script", "link") or (tag == "img" and not attrs.get("src", "")
+                                         .startswith("data:")):
+            self.external.append(tag)
+
+
+@pytest.fixture(scope="module")
+def results(tmp_path_factory):
+    out = tmp_path_factory.mktemp("results")
+    store = ResultStore(out)
+    run_matrix(["paper", "free-boundary"], ["mixed", "vi"], ["active-set"], ["residual"],
+               ["uniform", "adaptive"], store, LoopConfig(max_dofs=600), crosscheck_dofs=600)
+    write_hard(run_hard(["no-contact", "penalty-eps", "invalid"]), out)
+    return out
+
+
+@pytest.fixture(scope="module")
+def report(results, tmp_path_factory):
+    out = tmp_path_factory.mktemp("report")
+    write_report(pd.read_parquet(results / "results.parquet"), out, results, "test command")
+    return out
+
+
+def test_html_is_self_contained_with_every_section_and_figure(report):
+    html = (report / "index.html").read_text()
+    parser = Collector()
+    parser.feed(html)
+    assert [s for s in SECTIONS if s not in parser.ids] == []
+    assert parser.external == []  # no scripts, stylesheets or linked images
+    # 2 scenes x (scene, convergence, effectivity, work-precision, meshes, deformed, pressure),
+    # less the paper's effectivity: without --reference-dofs it has no error to divide by;
+    # plus the hard cases' figure
+    assert len(parser.images) == 14
+    for src in parser.images:
+        assert src.startswith("data:image/png;base64,")
+        data = base64.b64decode(src.split(",", 1)[1])
+        assert data.startswith(PNG) and len(data) > 5000
+
+
+def test_markdown_links_every_figure_file(report):
+    text = (report / "README.md").read_text()
+    for title in ("## Contents", "## What was run", "## Scenes", "## Results per scene",
+                  "## Summary across scenes", "## Failures and skips", "## Hard cases",
+                  "## Known limitations"):
+        assert title in text
+    hard = text.split("## Hard cases")[1].split("## Known limitations")[0]
+    assert "poisson_ratio=0.5 is not < 0.5" in hard and "| refused " in hard
+    assert hard.count("| no-contact ") == 6  # 3 formulations x 2 solvers
+    figures = sorted(p.name for p in (report / "figures").glob("*.png"))
+    assert len(figures) == 14 and "hard-stability.png" in figures
+    for name in figures:
+        assert f"figures/{name}" in text
+    assert "test command" in text and "agrees" in text  # rates verdicts against the claims
+
+
+def test_strings_from_results_are_escaped_and_missing_columns_reported(results, tmp_path):
+    table = pd.read_parquet(results / "results.parquet")
+    table.loc[table.index[0], "status"] = "failed"
+    table.loc[table.index[0], "reason"] = "<script>alert('x')</script> & co"
+    table = table.drop(columns=["effectivity_index", "t_refine"])
+    write_report(table, tmp_path, None)
+    html = (tmp_path / "index.html").read_text()
+    assert "<script>" not in html
+    assert "&lt;script&gt;alert(&#39;x&#39;)&lt;/script&gt; &amp; co" in html
+    assert "effectivity_index" in html and "t_refine" in html  # listed as missing
+    assert "Missing columns" in (tmp_path / "README.md").read_text()
+
+
+def test_report_of_only_failed_rows_still_renders(tmp_path):
+    table = pd.DataFrame([{"scene": "paper", "formulation": "mixed", "solver": "reference",
+                           "estimator": "residual", "strategy": "uniform", "level": -1,
+                           "status": "failed", "reason": "RuntimeError: boom", "run_id": "1"}])
+    write_report(table, tmp_path)
+    text = (tmp_path / "README.md").read_text()
+    assert "RuntimeError: boom" in text
+    assert "Not run for these results (no `hard.csv`" in text
+
+
+CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
+
+
+@pytest.mark.skipif(CHROMIUM is None, reason="Debian's chromium is not installed "
+                                             "(.ci/run installs it)")
+def test_html_renders_in_headless_chromium(report, tmp_path):
+    shot = tmp_path / "shot.png"
+    run = subprocess.run(
+        [CHROMIUM, "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic",
+         "--no-first-run", "--disable-background-networking", "--disable-component-update",
+         "--disable-sync", f"--user-data-dir={tmp_path / 'profile'}", "--enable-logging=stderr",
+         "--v=0", "--window-size=1280,2400", f"--screenshot={shot}",
+         (report / "index.html").as_uri()], capture_output=True, text=True, timeout=120)
+    assert shot.exists(), run.stderr[-2000:]
+    console = [line for line in run.stderr.splitlines() if "CONSOLE" in line
+               or "Failed to load resource" in line or "Uncaught" in line]
+    assert console == []
+    from matplotlib.image import imread
+
+    pixels = imread(shot)
+    assert pixels.shape[0] > 1000 and float(np.std(pixels[..., :3])) > 0.05  # not blank
