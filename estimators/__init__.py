@@ -1,4 +1,4 @@
-"""Estimators: how the error of a discrete solution is estimated (DESIGN.md section 4).
+"""Estimators: how the error of a discrete solution is estimated (docs/theory.md, section 4).
 
 Importing this package registers every estimator module listed below; adding an estimator is one
 new module with a ``@register_estimator`` ``estimate(scene, solution)`` function and one import

@@ -1,4 +1,4 @@
-"""The estimate of one discrete solution (DESIGN.md section 4)."""
+"""The estimate of one discrete solution (docs/theory.md, section 4)."""
 
 from __future__ import annotations
 

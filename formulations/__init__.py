@@ -1,4 +1,4 @@
-"""Formulations: how a scene is discretised and solved (DESIGN.md section 3).
+"""Formulations: how a scene is discretised and solved (docs/theory.md, section 3).
 
 Importing this package registers every formulation module listed below; adding a formulation is
 one new module with a ``@register_formulation`` ``discretise`` function and one import line here.

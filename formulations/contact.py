@@ -1,7 +1,7 @@
 """The contact boundary Gamma_C of one mesh: facets in order, normals, quadrature.
 
 Facets are sorted by the scene's ``contact_coordinate`` and oriented so that ``start`` has the
-smaller coordinate. Normals are OUTER unit normals (DESIGN.md section 1).
+smaller coordinate. Normals are OUTER unit normals (docs/theory.md, section 1).
 """
 
 from __future__ import annotations
@@ -46,6 +46,12 @@ class ContactTrace:
         a = self.mesh.p[:, self.vertices[0]][:, :, None]
         b = self.mesh.p[:, self.vertices[1]][:, :, None]
         return a + (b - a) * t[None, None, :]
+
+    def coordinates_at(self, t: np.ndarray) -> np.ndarray:
+        """Contact coordinates at local coordinates t in [0, 1] on each facet; shape
+        (n, len(t)) (the coordinate is affine along a facet of a straight Gamma_C)."""
+        s0, s1 = self.coordinate
+        return s0[:, None] + (s1 - s0)[:, None] * np.asarray(t)[None, :]
 
     def normal_displacement(self, u_nodal: np.ndarray, t: np.ndarray) -> np.ndarray:
         """u_h . n at local coordinates t (P1: linear along each facet); shape (n, len(t))."""

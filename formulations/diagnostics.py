@@ -1,5 +1,5 @@
-"""Stability diagnostics of a discrete contact solution (issue 7), computed from the assembled
-arrays and the returned solution, never taken from a solver.
+"""Stability diagnostics of a discrete contact solution (docs/theory.md, section 5), computed
+from the assembled arrays and the returned solution, never taken from a solver.
 
 * ``inf_sup_constant``: the discrete inf-sup constant of a formulation with a multiplier space
   (the mixed method), for the contact part,

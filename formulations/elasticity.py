@@ -1,4 +1,5 @@
-"""P1 (triangles) linear elasticity on scikit-fem: stiffness, loads, stresses (DESIGN.md section 1).
+"""P1 (triangles) linear elasticity on scikit-fem: stiffness, loads, stresses
+(docs/theory.md, section 1).
 
 Plane stress uses lambda* = E nu / (1 - nu^2), plane strain lambda = E nu / ((1+nu)(1-2nu)).
 Everything is vectorised over elements by scikit-fem's assembly.
@@ -45,7 +46,7 @@ class Elasticity:
         return u
 
     def energy(self, u: np.ndarray) -> float:
-        """E(u) = 1/2 u'Ku - F'u (the energy functional of DESIGN.md section 1)."""
+        """E(u) = 1/2 u'Ku - F'u (the energy functional of docs/theory.md, section 1)."""
         return float(0.5 * u @ (self.K @ u) - self.F @ u)
 
     def nodal(self, u: np.ndarray) -> np.ndarray:
@@ -73,7 +74,8 @@ def stress_from_gradient(grad: np.ndarray, lam: float, mu: float) -> np.ndarray:
 
 
 def von_mises(stress: np.ndarray) -> np.ndarray:
-    """Plane-stress von Mises stress sqrt(s11^2 + s22^2 - s11 s22 + 3 s12^2) (DESIGN.md sec. 2)."""
+    """Plane-stress von Mises stress sqrt(s11^2 + s22^2 - s11 s22 + 3 s12^2) (docs/theory.md,
+    section 1)."""
     s11, s22, s12 = stress
     return np.sqrt(s11**2 + s22**2 - s11 * s22 + 3 * s12**2)
 

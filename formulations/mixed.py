@@ -1,4 +1,4 @@
-"""``mixed``: Haslinger's mixed method, the seed paper's (3) (DESIGN.md section 3).
+"""``mixed``: Haslinger's mixed method, the seed paper's (3) (docs/theory.md, section 3).
 
 lambda_H is piecewise constant on a contact mesh T_{C,H} coarser than the trace of T_h. The QP is
 min 1/2 u'Ku - F'u s.t. Bu <= G with B_ij = int_{S_i} phi_j . n ds and G_i = int_{S_i} g ds, so
@@ -7,10 +7,10 @@ the KKT multiplier of row i is the value of lambda_H on segment S_i.
 Contact mesh (h/H <= 1/2 by construction, on uniform and adaptive meshes alike): the segments
 are runs of consecutive contact facets, each as short as possible subject to every facet in it
 being at most half its length. On a uniform trace that pairs neighbouring facets (H = 2h, as in
-the paper); on a graded trace the segments follow the grading. (An earlier construction used the
-maximal dyadic parents of the facets; on graded traces those stay as coarse as the coarsest
-facet around, and on the Hertz scene, whose contact zone is smaller than one initial facet, the
-multiplier mesh then lagged the refinement by a dozen levels.)
+the paper); on a graded trace the segments follow the grading. (Maximal dyadic parents of the
+facets would not: on graded traces they stay as coarse as the coarsest facet around, and on the
+Hertz scene, whose contact zone is smaller than one initial facet, such a multiplier mesh lags
+the refinement by a dozen levels.)
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""``penalty``: the primal penalty method (DESIGN.md section 3).
+"""``penalty``: the primal penalty method (docs/theory.md, section 3).
 
 Minimise E(v) + 1/(2 eps) int_{Gamma_C} (v_n - g)_+^2 ds over P1 displacements, with
 eps = eps_0 h_e / E on each contact facet e (h_e its length, E Young's modulus). The factor
@@ -8,7 +8,8 @@ E = 70000. The discrete pressure is lambda_h = (u_hn - g)_+ / eps (a formula, no
 Default eps_0 = 1e-3: the penalty's consistency error in the energy norm is about
 sqrt(eps) ||lambda||_{0,Gamma_C} ~ sqrt(eps_0 h) relative, i.e. 3 % of sqrt(h) -- well below the
 O(h^1/2) discretisation error of every formulation here -- while the penalty block stays within a
-factor 1/eps_0 = 1e3 of the stiffness (conditioning). Smaller eps_0 is a hard case (issue 7).
+factor 1/eps_0 = 1e3 of the stiffness (conditioning). Smaller eps_0 is a hard case
+(``bench.hard.cases.penalty_eps``).
 
 The gap is the P1 interpolant g_h of g on the contact facets (as the nodal constraints of
 ``vi`` see it): with the exact g, u_hn - g (linear minus curved) penetrates by O(h^2 g'') between
@@ -73,6 +74,49 @@ class PenaltyDetails:
     slacks: np.ndarray
 
 
+def normal_trace_operator(elasticity, trace, t: np.ndarray) -> sparse.csr_matrix:
+    """P: u_h . n at the local points ``t`` of every contact facet, on the free DOFs (facet f,
+    point q -> row f * len(t) + q)."""
+    nf, nq = trace.size, t.size
+    dofs = elasticity.basis.nodal_dofs
+    rows = np.repeat(np.arange(nf * nq).reshape(nf, nq), 4, axis=1).ravel()
+    shape = np.stack([1 - t, 1 - t, t, t], axis=1)  # (nq, 4): end 0 (x, y), end 1 (x, y)
+    cols = np.stack([dofs[0, trace.vertices[0]], dofs[1, trace.vertices[0]],
+                     dofs[0, trace.vertices[1]], dofs[1, trace.vertices[1]]], axis=1)
+    normal = np.stack([trace.normal[0], trace.normal[1]] * 2, axis=1)  # (nf, 4)
+    vals = (normal[:, None, :] * shape[None, :, :]).ravel()
+    return sparse.csr_matrix((vals, (rows, np.repeat(cols, nq, axis=0).ravel())),
+                             shape=(nf * nq, elasticity.basis.N))[:, elasticity.free]
+
+
+def pressure_mismatch(penetration: np.ndarray, epsilon: np.ndarray, multipliers: np.ndarray,
+                      row_length: np.ndarray, floor: float) -> float:
+    """Max difference at the Gauss points between the formula's pressure
+    penetration_+ / eps and the multiplier of each row u_n - s <= g per unit length
+    (``row_length`` = Gauss weight x facet length; equal at an exact minimiser: D s = mu),
+    relative to the larger pressure, or to ``floor`` = E max|g| / |Gamma_C| when both vanish.
+    The formula divides u's error by eps, the multiplier does not: a large mismatch means u is
+    too inaccurate for this eps."""
+    if not np.isfinite(multipliers).all() or not np.isfinite(penetration).all():
+        return float("nan")
+    formula = np.maximum(penetration, 0.0) / epsilon
+    from_multiplier = np.maximum(multipliers, 0.0) / row_length
+    scale = max(formula.max(initial=0.0), from_multiplier.max(initial=0.0), floor)
+    return float(np.abs(formula - from_multiplier).max(initial=0.0) / scale) if scale else 0.0
+
+
+def slack_qp(elasticity, P: sparse.csr_matrix, gap: np.ndarray, D: np.ndarray,
+             young: float) -> ContactQP:
+    """min 1/2 u'Ku - F'u + 1/2 s'Ds  s.t.  P u - s <= g, -s <= 0 (module docstring)."""
+    ns = gap.size
+    eye = sparse.identity(ns, format="csr")
+    return ContactQP(K=sparse.block_diag([elasticity.K_free, sparse.diags(D)], format="csr"),
+                     F=np.concatenate([elasticity.F[elasticity.free], np.zeros(ns)]),
+                     B=sparse.bmat([[P, -eye], [None, -eye]], format="csr"),
+                     G=np.concatenate([gap, np.zeros(ns)]), row_scale=np.ones(2 * ns),
+                     objective_scale=young)
+
+
 @register_formulation("penalty", "primal penalty, eps = eps_0 h_e / E (eps_0 = 1e-3), "
                                  "lambda_h = (u_hn - g_h)_+ / eps")
 def discretise(scene: Scene, mesh: MeshTri,
@@ -93,42 +137,10 @@ def discretise(scene: Scene, mesh: MeshTri,
         return ends[:, :1] + (ends[:, 1:] - ends[:, :1]) * np.asarray(tt)[None, :]
 
     gap = gap_h(t)
-
-    # P: u_n at the quadrature points (facet f, point q -> row f * nq + q)
-    dofs = elasticity.basis.nodal_dofs
-    rows = np.repeat(np.arange(ns).reshape(nf, nq), 4, axis=1).ravel()
-    shape = np.stack([1 - t, 1 - t, t, t], axis=1)  # (nq, 4): end 0 (x, y), end 1 (x, y)
-    cols = np.stack([dofs[0, trace.vertices[0]], dofs[1, trace.vertices[0]],
-                     dofs[0, trace.vertices[1]], dofs[1, trace.vertices[1]]], axis=1)
-    normal = np.stack([trace.normal[0], trace.normal[1]] * 2, axis=1)  # (nf, 4)
-    vals = (normal[:, None, :] * shape[None, :, :]).ravel()
-    P = sparse.csr_matrix((vals, (rows, np.repeat(cols, nq, axis=0).ravel())),
-                          shape=(ns, elasticity.basis.N))[:, elasticity.free]
-    eye = sparse.identity(ns, format="csr")
-    D = young / epsilon_0 * np.tile(w, nf)
-    qp = ContactQP(K=sparse.block_diag([elasticity.K_free, sparse.diags(D)], format="csr"),
-                   F=np.concatenate([elasticity.F[elasticity.free], np.zeros(ns)]),
-                   B=sparse.bmat([[P, -eye], [None, -eye]], format="csr"),
-                   G=np.concatenate([gap.ravel(), np.zeros(ns)]), row_scale=np.ones(2 * ns),
-                   objective_scale=young)
+    P = normal_trace_operator(elasticity, trace, t)
+    qp = slack_qp(elasticity, P, gap.ravel(), young / epsilon_0 * np.tile(w, nf), young)
     epsilon = epsilon_0 * trace.length / young
-
-    def pressure_mismatch(u_free, multipliers) -> float:
-        """Max difference at the Gauss points between the formula's pressure and the multiplier
-        of each row u_n - s <= g per unit length (equal at an exact minimiser: D s = mu),
-        relative to the larger pressure, or to E max|g| / |Gamma_C| when both vanish. The
-        formula divides u's error by eps, the multiplier does not: a large mismatch means u is
-        too inaccurate for this eps."""
-        if not np.isfinite(multipliers).all() or not np.isfinite(u_free).all():
-            return float("nan")
-        formula = np.maximum(P @ u_free - gap.ravel(), 0.0) / np.repeat(epsilon, nq)
-        from_multiplier = np.maximum(multipliers, 0.0) / (np.tile(w, nf)
-                                                          * np.repeat(trace.length, nq))
-        scale = max(formula.max(initial=0.0), from_multiplier.max(initial=0.0),
-                    young * np.abs(gap).max(initial=0.0) / trace.length.sum())
-        return float(np.abs(formula - from_multiplier).max(initial=0.0) / scale) if scale \
-            else 0.0
-    s_points = trace.coordinate[0][:, None] + np.diff(trace.coordinate, axis=0).T * t[None, :]
+    s_points = trace.coordinates_at(t)
 
     def transfer(previous: DiscreteSolution) -> np.ndarray:
         pressing = previous.pressure_at(s_points.ravel()) > 0  # u_n - s <= g active
@@ -137,7 +149,10 @@ def discretise(scene: Scene, mesh: MeshTri,
     def recover(answer: QPSolution, residuals: Residuals, status: str,
                 reason: str) -> DiscreteSolution:
         u_free = answer.u[:n]
-        mismatch = pressure_mismatch(answer.u[:n], answer.multipliers[:ns])
+        mismatch = pressure_mismatch(P @ u_free - gap.ravel(), np.repeat(epsilon, nq),
+                                     answer.multipliers[:ns], np.tile(w, nf)
+                                     * np.repeat(trace.length, nq), young
+                                     * np.abs(gap).max(initial=0.0) / trace.length.sum())
         if status == STATUS_OK and mismatch > PRESSURE_CONSISTENCY:
             status, reason = STATUS_INACCURATE, (
                 f"penalty pressure (u_hn - g_h)_+/eps disagrees with the QP multipliers by "

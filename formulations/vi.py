@@ -1,4 +1,4 @@
-"""``vi``: the primal variational inequality with nodal constraints (DESIGN.md section 3).
+"""``vi``: the primal variational inequality with nodal constraints (docs/theory.md, section 3).
 
 Find u_h in the P1 space with u_h(x_i) . n_i <= g(x_i) at every node x_i of Gamma_C minimising
 the energy: the QP min 1/2 u'Ku - F'u s.t. Bu <= G with one row per contact node,

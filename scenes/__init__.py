@@ -1,4 +1,4 @@
-"""Scene catalogue: what the problem is (DESIGN.md section 2).
+"""Scene catalogue: what the problem is (docs/theory.md, section 2).
 
 Importing this package registers every scene module listed below; adding a scene is one new
 module with a ``@register_scene`` factory and one import line here.

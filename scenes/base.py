@@ -1,4 +1,4 @@
-"""Scene data: what a Signorini problem is (DESIGN.md sections 1 and 2).
+"""Scene data: what a Signorini problem is (docs/theory.md, sections 1 and 2).
 
 A scene is declarative: geometry and initial mesh, which boundary part is which, the material,
 the loads, the linearised gap g and a coordinate along Gamma_C. It validates itself on
@@ -28,7 +28,7 @@ def _check(condition: bool, parameter: str, value, allowed: str) -> None:
 
 @dataclass(frozen=True)
 class Material:
-    """Isotropic linear elastic material (DESIGN.md section 1).
+    """Isotropic linear elastic material (docs/theory.md, section 1).
 
     ``plane`` is ``"stress"`` or ``"strain"``; the Lame parameters follow from it.
     """
@@ -87,7 +87,7 @@ class ContactPrediction:
 
 @dataclass(frozen=True, eq=False)
 class Scene:
-    """A Signorini problem on a 2D body (DESIGN.md section 2).
+    """A Signorini problem on a 2D body (docs/theory.md, section 2).
 
     Boundary parts are given as predicates on facet midpoints; every boundary facet that is
     neither Dirichlet nor contact is a Neumann facet (traction ``traction``, zero if None).

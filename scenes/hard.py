@@ -1,4 +1,5 @@
-"""Hard scenes (tag ``hard``): cases where a formulation or a solver may break (issue 7).
+"""Hard scenes (tag ``hard``): cases where a formulation or a solver may break
+(docs/theory.md, section 8).
 
 Each is a rectangle clamped on top with Gamma_C its bottom edge (outer normal (0, -1)), so the
 gap is g(x) along n = (0, -1): negative g means the obstacle pushes the body up. They are left

@@ -1,4 +1,4 @@
-"""The ``paper`` scene: section 5 of the seed paper, as fixed in DESIGN.md section 2.
+"""The ``paper`` scene: section 5 of the seed paper (docs/theory.md, section 2).
 
 Omega = (-1, 1)^2, Gamma_C the bottom edge (outer normal (0, -1)), Gamma_D the top edge, traction
 free sides, f = 0, plane stress, E = 70000 N/mm^2, nu = 0.33. The obstacle surface

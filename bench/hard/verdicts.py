@@ -42,9 +42,9 @@ PRESSURE_TOLERANCE = 1e-3
 ACCURATE, INACCURATE, FAILED, REFUSED = "accurate", "inaccurate", "failed", "refused"
 
 
-def _record(case, scene, disc, sol, variant, level) -> dict:
+def _record(case, scene, formulation, disc, sol, variant, level) -> dict:
     residual = max(vars(sol.residuals).values())
-    return dict(case=case, scene=scene.name, formulation=disc.formulation, solver=sol.solver,
+    return dict(case=case, scene=scene.name, formulation=formulation, solver=sol.solver,
                 variant=variant, level=level, ndofs=disc.ndofs, status=sol.status,
                 reason=sol.reason, backend=sol.backend,
                 safeguard=sol.diagnostics.safeguard,
@@ -70,7 +70,8 @@ def solve_both(case: str, scene: Scene, formulation: str, mesh, variant: str = "
     solutions (in the order of ``solver_names()``)."""
     disc = get_formulation(formulation)(scene, mesh, **options)
     solutions = [solve(disc, solver) for solver in solver_names()]
-    records = [_record(case, scene, disc, sol, variant, level) for sol in solutions]
+    records = [_record(case, scene, formulation, disc, sol, variant, level)
+               for sol in solutions]
     best = int(np.argmin([r["max_residual"] if np.isfinite(r["max_residual"]) else np.inf
                           for r in records]))
     # B K^-1 B' from whichever solver formed it (the active-set solver on cholmod)

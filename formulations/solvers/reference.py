@@ -1,4 +1,4 @@
-"""The reference QP solver: CVXPY with Clarabel (DESIGN.md section 3).
+"""The reference QP solver: CVXPY with Clarabel (docs/theory.md, section 3).
 
 The judge of correctness, not the workhorse. The problem is scaled before it is handed over, so
 that Clarabel's absolute and relative tolerances mean the same thing on every mesh, for every

@@ -1,4 +1,5 @@
-"""The fast active-set solver: exact LCP answers, failure reporting, agreement with the reference solver."""
+"""The fast active-set solver: exact LCP answers, failure reporting, agreement with the
+reference solver."""
 
 import numpy as np
 import pytest

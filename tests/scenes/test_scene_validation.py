@@ -56,7 +56,7 @@ def test_paper_scene_matches_design():
     assert "paper" in scene_names()
     assert scene.material.young_modulus == 70000.0 and scene.material.poisson_ratio == 0.33
     assert scene.material.plane == "stress"
-    # plane stress: lambda* = E nu / (1 - nu^2), mu = E / (2 (1 + nu)) (DESIGN.md section 1)
+    # plane stress: lambda* = E nu / (1 - nu^2), mu = E / (2 (1 + nu)) (docs/theory.md, section 1)
     lam, mu = scene.material.lame
     assert lam == pytest.approx(70000 * 0.33 / (1 - 0.33**2), rel=1e-14)
     assert mu == pytest.approx(70000 / 2.66, rel=1e-14)

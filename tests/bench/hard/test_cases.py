@@ -3,8 +3,7 @@
 import numpy as np
 import pytest
 
-from bench.hard import hard_case_names, run_hard
-from bench.hard import check_expected, hard_markdown
+from bench.hard import check_expected, hard_case_names, hard_markdown, run_hard
 from bench.verify import load_expected
 
 

@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 from skfem import Basis, ElementTriP1, ElementVector
 
-from bench.truth import references
 from bench.measure.discretisation_error import energy_density, exact_errors
 from bench.measure.nonnested import P1Field, energy_error_on
+from bench.truth import references
 from formulations import get_formulation, solve
 from scenes import get_scene
 

@@ -10,12 +10,11 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from bench.hard import run_hard
-from bench.hard import write_hard
-from bench.sequence.loop import LoopConfig
+from bench.hard import run_hard, write_hard
 from bench.matrix.harness import run_matrix
-from bench.report import write_report
 from bench.matrix.store import ResultStore
+from bench.report import write_report
+from bench.sequence.loop import LoopConfig
 
 SECTIONS = ["contents", "what-was-run", "scenes", "results-per-scene", "summary-across-scenes",
             "failures-and-skips", "hard-cases", "known-limitations"]

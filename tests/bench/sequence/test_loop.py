@@ -4,10 +4,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from bench.sequence.loop import LoopConfig, run_sequence
 from bench.matrix.harness import run_matrix
-from bench.sequence.rows import COLUMNS
 from bench.matrix.store import ResultStore
+from bench.sequence.loop import LoopConfig, run_sequence
+from bench.sequence.rows import COLUMNS
 from scenes import get_scene
 
 REQUIRED = ("scene formulation solver estimator strategy level ndofs h_max h_min max_h_over_H "
@@ -85,8 +85,8 @@ def test_loop_config_validation(changes, message):
 
 
 def test_nested_iteration_keeps_active_set_iterations_flat():
-    # the goal: <= 3 active-set iterations per level after the first when each level
-    # starts from the previous level's contact zone; a cold start needs more on fine levels
+    # the point of nested iteration: <= 3 active-set iterations per level after the first when
+    # each level starts from the previous level's contact zone; a cold start needs more
     def iterations(nested):
         config = LoopConfig(strategy="adaptive", max_dofs=15000, nested=nested)
         return [r.row for r in run_sequence(get_scene("paper"), "mixed", "active-set",
