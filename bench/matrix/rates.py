@@ -14,12 +14,13 @@ import numpy as np
 import pandas as pd
 
 from bench.sequence.rows import KEYS
+from formulations import STATUS_OK
 
 RATE_LEVELS = 4
 
 
 def slope(group: pd.DataFrame, column: str, levels: int = RATE_LEVELS) -> float:
-    ok = group[(group["status"] == "ok") & (group[column] > 0)].sort_values("ndofs")
+    ok = group[(group["status"] == STATUS_OK) & (group[column] > 0)].sort_values("ndofs")
     ok = ok.tail(levels)
     if len(ok) < 2:
         return float("nan")
@@ -31,7 +32,7 @@ def rates_table(table: pd.DataFrame, levels: int = RATE_LEVELS) -> pd.DataFrame:
     table = table[table["level"] >= 0]
     for key, group in table.groupby(KEYS, sort=True):
         group = group.sort_values("level")
-        ok = group[group["status"] == "ok"]
+        ok = group[group["status"] == STATUS_OK]
         tail = ok.tail(levels)
         usable = tail[~tail["reference_too_coarse"].astype(bool)
                       & (tail["effectivity_index"] > 0)] if "effectivity_index" in tail else tail

@@ -15,7 +15,7 @@ from bench.matrix.store import ResultStore
 from bench.sequence.loop import STRATEGIES, LevelResult, LoopConfig
 from bench.sequence.rows import ResultRow
 from estimators import estimator_names
-from formulations import formulation_names, solver_names
+from formulations import STATUS_FAILED, formulation_names, solver_names
 from formulations.solvers.backends import check_backend
 from scenes import scene_names
 
@@ -80,7 +80,7 @@ class RunResult:
 
     @property
     def failed(self) -> list[ResultRow]:
-        return [r for r in self.rows if r.status == "failed"]
+        return [r for r in self.rows if r.status == STATUS_FAILED]
 
 
 def run(config: RunConfig, on_level: Callable[[LevelResult], None] | None = None) -> RunResult:

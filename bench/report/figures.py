@@ -14,6 +14,7 @@ from matplotlib.collections import LineCollection
 from matplotlib.figure import Figure
 from matplotlib.tri import Triangulation
 
+from bench.measure.contact import facet_samples
 from bench.sequence.loop import STRATEGIES
 from bench.sequence.rows import phase_time
 from estimators import estimator_names
@@ -191,9 +192,7 @@ def pressures(artifacts: dict, reference_curve=None):
     fig = Figure(figsize=(8, 4))
     ax = fig.subplots()
     for formulation, data in chosen.items():
-        s0, s1 = data["trace_coordinate"]
-        t = np.linspace(0, 1, data["pressure"].shape[1])
-        s = s0[:, None] + (s1 - s0)[:, None] * t[None, :]
+        s = facet_samples(data["trace_coordinate"], np.linspace(0, 1, data["pressure"].shape[1]))
         segments = np.stack([s, data["pressure"]], axis=-1)
         ax.add_collection(LineCollection(segments, colors=colour(formulation), linewidths=1,
                                          label=f"{formulation} ({int(data['ndofs'])} DOFs)"))

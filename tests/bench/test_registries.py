@@ -8,13 +8,13 @@ from dataclasses import replace
 import numpy as np
 import pandas as pd
 import pytest
-from conftest import square_scene
 
 from bench.cli import main
 from bench.hard import hard_case, hard_case_names, run_hard, write_hard
 from bench.hard.registry import HARD_CASES
 from bench.matrix import RunConfig, run
 from bench.report import figures, write_report
+from conftest import square_scene
 from estimators import residual
 from estimators.base import ESTIMATORS, register_estimator
 from formulations import mixed
