@@ -104,3 +104,18 @@ def assemble_elasticity(scene: Scene, mesh: MeshTri) -> Elasticity:
     clamped = basis.get_dofs(scene.dirichlet_facets(mesh)).all()
     free = np.setdiff1d(np.arange(basis.N), clamped)
     return Elasticity(mesh=mesh, basis=basis, lame=(lam, mu), K=K, F=F, free=free)
+
+
+def count_free_dofs(scene: Scene, mesh: MeshTri) -> int:
+    """The number of unknowns ``assemble_elasticity`` would give on ``mesh``, without
+    assembling: two per vertex, none on a vertex of a clamped facet."""
+    clamped = np.unique(mesh.facets[:, scene.dirichlet_facets(mesh)])
+    return int(2 * (mesh.p.shape[1] - clamped.size))
+
+
+def predict_uniform_free_dofs(scene: Scene, mesh: MeshTri) -> int:
+    """``count_free_dofs`` of ``mesh.refined()``, without refining: uniform refinement adds one
+    vertex per edge, and each clamped facet adds one clamped vertex (its midpoint)."""
+    dirichlet = scene.dirichlet_facets(mesh)
+    clamped = np.unique(mesh.facets[:, dirichlet]).size + dirichlet.size
+    return int(2 * (mesh.p.shape[1] + mesh.facets.shape[1] - clamped))

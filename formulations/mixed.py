@@ -28,6 +28,7 @@ from formulations.elasticity import assemble_elasticity
 from formulations.kkt import count_active
 from formulations.registry import register_formulation
 from scenes import Scene
+from scenes.base import is_number
 
 GAP_QUADRATURE_POINTS = 6  # G_i = int g: g is smooth on each facet; 6 Gauss points is plenty
 
@@ -72,7 +73,7 @@ def discretise(scene: Scene, mesh: MeshTri, h_over_H: float = 0.5) -> Discretisa
     """``h_over_H``: the largest allowed ratio of a facet to its multiplier segment. The
     paper's 1/2 (default) keeps the pair uniformly inf-sup stable; 1 (multiplier mesh = trace
     mesh) is not guaranteed to be (a hard case, see ``formulations.diagnostics``)."""
-    if not (isinstance(h_over_H, int | float) and 0.0 < h_over_H <= 1.0):
+    if not (is_number(h_over_H) and 0.0 < h_over_H <= 1.0):
         raise ValueError(f"h_over_H={h_over_H!r} is not in (0, 1]")
     elasticity = assemble_elasticity(scene, mesh)
     trace = contact_trace(scene, mesh)

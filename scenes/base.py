@@ -7,6 +7,7 @@ construction so that a bad problem is refused before any solve.
 
 from __future__ import annotations
 
+import numbers
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -19,6 +20,16 @@ PointFunction = Callable[[np.ndarray], np.ndarray]
 
 class SceneError(ValueError):
     """A scene parameter is out of its allowed range."""
+
+
+def is_number(value) -> bool:
+    """A real number as users write them: Python or numpy ints and floats, never a bool."""
+    return isinstance(value, numbers.Real) and not isinstance(value, bool | np.bool_)
+
+
+def is_integer(value) -> bool:
+    """An integer (Python or numpy), never a bool."""
+    return isinstance(value, numbers.Integral) and not isinstance(value, bool | np.bool_)
 
 
 def _check(condition: bool, parameter: str, value, allowed: str) -> None:
@@ -39,9 +50,9 @@ class Material:
 
     def __post_init__(self):
         E, nu = self.young_modulus, self.poisson_ratio
-        _check(isinstance(E, int | float) and np.isfinite(E) and E > 0,
+        _check(is_number(E) and np.isfinite(E) and E > 0,
                "young_modulus", E, "a finite number > 0")
-        _check(isinstance(nu, int | float) and np.isfinite(nu) and nu > -1,
+        _check(is_number(nu) and np.isfinite(nu) and nu > -1,
                "poisson_ratio", nu, "> -1")
         _check(nu < 0.5, "poisson_ratio", nu, "< 0.5")
         _check(self.plane in ("stress", "strain"), "plane", self.plane,
@@ -114,19 +125,30 @@ class Scene:
     def __post_init__(self):
         _check(isinstance(self.material, Material), "material", self.material,
                "a scenes.Material")
-        dirichlet, contact = self.dirichlet_facets(), self.contact_facets()
-        _check(contact.size > 0, "contact boundary", "empty",
+        self.check_mesh()
+
+    def check_mesh(self, mesh: MeshTri | None = None, level: int | None = None) -> None:
+        """The boundary parts and the gap checked on ``mesh`` (default: the initial mesh), as
+        every refined mesh must be: refinement puts new facet midpoints under the predicates,
+        which may then overlap or meet a non-finite gap. SceneError names the level."""
+        where = "" if level is None else f" on the mesh of level {level}"
+        dirichlet, contact = self.dirichlet_facets(mesh), self.contact_facets(mesh)
+        _check(contact.size > 0, "contact boundary", "empty" + where,
                "non-empty (no boundary facet satisfies is_contact)")
-        _check(self.facet_lengths(dirichlet).sum() > 0, "dirichlet boundary",
-               "of measure 0", "of positive measure (the body must be clamped somewhere)")
-        _check(np.intersect1d(dirichlet, contact).size == 0, "dirichlet boundary",
-               "overlapping the contact boundary", "disjoint from the contact boundary")
+        _check(self.facet_lengths(dirichlet, mesh).sum() > 0, "dirichlet boundary",
+               "of measure 0" + where, "of positive measure (rigid motion not prevented: the "
+               "body must be clamped somewhere)")
+        both = np.intersect1d(dirichlet, contact)
+        _check(both.size == 0, "dirichlet boundary",
+               f"overlapping the contact boundary{where} on {both.size} facets, the first "
+               f"at x={self.facet_points(both[:1], np.array([0.5]), mesh).ravel().tolist()}"
+               if both.size else "", "disjoint from the contact boundary")
         # the gap at a few points per contact facet, including the end points
-        x = self.facet_points(contact, np.array([0.0, 0.5, 1.0]))
+        x = self.facet_points(contact, np.array([0.0, 0.5, 1.0]), mesh)
         g = np.asarray(self.gap(x), dtype=float)
         bad = ~np.isfinite(g)
         _check(not bad.any(), "gap", f"{g[bad].ravel()[0]} at x={x[:, bad][:, 0].tolist()}"
-               if bad.any() else None, "finite on the contact boundary")
+               f"{where}" if bad.any() else None, "finite on the contact boundary")
 
     # --- boundary parts -------------------------------------------------------------------
     def dirichlet_facets(self, mesh: MeshTri | None = None) -> np.ndarray:

@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 from skfem import MeshTri
 
-from scenes.base import ContactPrediction, Material, Scene
+from scenes.base import ContactPrediction, Material, Scene, SceneError, is_integer
 from scenes.registry import register_scene
 
 _TOL = 1e-10
@@ -46,6 +46,10 @@ def hertz_contact(young_modulus: float, poisson_ratio: float, radius: float,
                          "(half-space model), plane strain; closed-form width and peak pressure")
 def hertz(young_modulus: float = 1000.0, poisson_ratio: float = 0.3, radius: float = 1.0,
           approach: float = 0.005, half_size: float = 2.0, initial_divisions: int = 16) -> Scene:
+    if not (is_integer(initial_divisions) and initial_divisions >= 2
+            and initial_divisions % 2 == 0):
+        raise SceneError(f"initial_divisions={initial_divisions!r} is not an even integer >= 2")
+    initial_divisions = int(initial_divisions)
     W = D = float(half_size)
     xs = np.linspace(-W, W, initial_divisions + 1)
     ys = np.linspace(-D, 0.0, initial_divisions // 2 + 1)

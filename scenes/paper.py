@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 from skfem import MeshTri
 
-from scenes.base import Material, Scene, SceneError
+from scenes.base import Material, Scene, SceneError, is_integer
 from scenes.registry import register_scene
 
 _TOL = 1e-10
@@ -25,9 +25,9 @@ def paper_gap(x: np.ndarray) -> np.ndarray:
                          "(seed paper, section 5)")
 def paper(young_modulus: float = 70000.0, poisson_ratio: float = 0.33, plane: str = "stress",
           initial_divisions: int = 4) -> Scene:
-    if not (isinstance(initial_divisions, int) and initial_divisions >= 2):
+    if not (is_integer(initial_divisions) and initial_divisions >= 2):
         raise SceneError(f"initial_divisions={initial_divisions!r} is not an integer >= 2")
-    grid = np.linspace(-1.0, 1.0, initial_divisions + 1)
+    grid = np.linspace(-1.0, 1.0, int(initial_divisions) + 1)
     mesh = MeshTri.init_tensor(grid, grid)
     return Scene(
         name="paper",
@@ -39,7 +39,8 @@ def paper(young_modulus: float = 70000.0, poisson_ratio: float = 0.33, plane: st
         is_contact=lambda x: np.abs(x[1] + 1.0) < _TOL,
         gap=paper_gap,
         contact_coordinate=lambda x: x[0],
-        parameters={"young_modulus": young_modulus, "poisson_ratio": poisson_ratio,
-                    "plane": plane, "initial_divisions": initial_divisions},
+        # plain Python numbers, so that the reference cache key does not depend on their type
+        parameters={"young_modulus": float(young_modulus), "poisson_ratio": float(poisson_ratio),
+                    "plane": plane, "initial_divisions": int(initial_divisions)},
         tags=("paper",),
     )

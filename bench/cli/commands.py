@@ -5,10 +5,10 @@
 from __future__ import annotations
 
 import sys
-from pathlib import Path
 
 import pandas as pd
 
+from bench.cli.guards import InputError, check_output_folders
 from bench.cli.parser import build_parser
 from bench.hard import (
     check_expected,
@@ -18,13 +18,16 @@ from bench.hard import (
     write_hard,
 )
 from bench.matrix import RunConfig, run
+from bench.matrix.store import ResultsError, read_results
 from bench.perf.scaling import run_scaling, write_scaling
 from bench.report import write_report
 from bench.sequence.loop import LevelResult
 from bench.sequence.rows import KEYS, level_time
+from bench.truth import TruthError
 from bench.verify import load_expected, verdict_table, verify
 from estimators import estimator_descriptions, estimator_names
 from formulations import formulation_descriptions, formulation_names, solver_descriptions
+from formulations.solvers.backends import check_backend
 from scenes import get_scene, scene_descriptions, scene_names
 
 SUMMARY_COLUMNS = ["level", "ndofs", "energy", "contact_force", "active_constraints", "eta",
@@ -86,7 +89,8 @@ def run_command(args) -> int:
         estimators=args.estimator, strategies=args.strategy, max_dofs=args.max_dofs,
         max_levels=args.max_levels, marking=args.marking, theta=args.theta,
         backend=args.backend, nested=not args.cold_start, reference_dofs=args.reference_dofs,
-        crosscheck_dofs=args.crosscheck_dofs, out=args.out, overwrite=args.overwrite,
+        crosscheck_dofs=args.crosscheck_dofs, max_memory_gib=args.max_memory, out=args.out,
+        overwrite=args.overwrite,
         command=" ".join(["python -m bench", *args.argv]))
     return run_config(config)
 
@@ -118,7 +122,8 @@ def compare_command(args) -> int:
         formulations=formulation_names(), solvers=("active-set",),
         estimators=estimator_names(), strategies=("uniform", "adaptive"),
         max_dofs=args.max_dofs, reference_dofs=args.reference_dofs,
-        crosscheck_dofs=args.crosscheck_dofs, out=args.out, overwrite=True,
+        crosscheck_dofs=args.crosscheck_dofs, max_memory_gib=args.max_memory, out=args.out,
+        overwrite=True,
         command=f"python -m bench compare --max-dofs {args.max_dofs} --reference-dofs "
                 f"{args.reference_dofs} --crosscheck-dofs {args.crosscheck_dofs} --out "
                 f"{args.out} --reports {args.reports}")
@@ -127,17 +132,16 @@ def compare_command(args) -> int:
         return status
     args.case = None
     hard_status = hard_command(args)
-    source = Path(args.out) / "results.parquet"
-    print(f"wrote {write_report(pd.read_parquet(source), args.reports, args.out)}")
+    print(f"wrote {write_report(read_results(args.out), args.reports, args.out)}")
     return status or hard_status
 
 
 def report_command(args) -> int:
-    source = Path(args.results) / "results.parquet"
-    if not source.exists():
+    table = read_results(args.results)
+    if table is None:
         print(f"error: --results={args.results!r} holds no results.parquet", file=sys.stderr)
         return 2
-    print(f"wrote {write_report(pd.read_parquet(source), args.out, args.results)}")
+    print(f"wrote {write_report(table, args.out, args.results)}")
     return 0
 
 
@@ -156,6 +160,10 @@ def scaling_command(args) -> int:
         print(f"{row['size']}: ndofs {row['ndofs']}  fast {row['t_fast_solve']:.2f} s  "
               f"linear {row['t_linear_solve']:.2f} s  reference "
               f"{row['t_reference_solve']:.2f} s  peak {row['peak_gib']:.2f} GiB", flush=True)
+    try:
+        check_backend(args.backend)
+    except ValueError as error:
+        raise InputError(f"--backend: {error}") from None
     frame = run_scaling(args.sizes, args.backend, args.reference_max_dofs, on_row=show)
     print(f"wrote {write_scaling(frame, args.out, args.readme)}")
     return 0
@@ -170,4 +178,13 @@ def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     args = build_parser().parse_args(argv)
     args.argv = argv
-    return COMMANDS[args.command](args)
+    try:
+        check_output_folders(args.command, args)
+        return COMMANDS[args.command](args)
+    except (InputError, ResultsError, TruthError) as error:
+        print(f"error: {error}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"interrupted: every finished row is kept in {getattr(args, 'out', 'the output')}"
+              " (results.parquet, results.csv)", file=sys.stderr)
+        return 130

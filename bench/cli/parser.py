@@ -5,6 +5,7 @@ a registry."""
 from __future__ import annotations
 
 import argparse
+import sys
 
 from bench.hard import hard_case_names
 from bench.perf.scaling import SIZES
@@ -17,7 +18,8 @@ from scenes import scene_names
 
 
 def _names(kind: str, valid: list[str], plural: str | None = None):
-    """A comma-separated list of names from ``valid`` (``kind``: what one name is)."""
+    """A comma-separated list of names from ``valid`` (``kind``: what one name is); a name
+    given twice is kept once, with a note on standard error."""
     def parse(text: str) -> list[str]:
         names = [name.strip() for name in text.split(",") if name.strip()]
         unknown = [name for name in names if name not in valid]
@@ -25,16 +27,33 @@ def _names(kind: str, valid: list[str], plural: str | None = None):
             raise argparse.ArgumentTypeError(
                 f"unknown {kind} {', '.join(map(repr, unknown)) or repr(text)}; "
                 f"valid {plural or kind + 's'}: {', '.join(valid)}")
-        return names
+        once = list(dict.fromkeys(names))
+        for name in {n for n in names if names.count(n) > 1}:
+            print(f"note: {kind} {name!r} given {names.count(name)} times; running it once",
+                  file=sys.stderr)
+        return once
     return parse
+
+
+def integer_value(text: str) -> int | None:
+    """``text`` as an int, also when written as a float with an integer value ("1e3", "2.0");
+    None when it is not an integer."""
+    try:
+        return int(text)
+    except ValueError:
+        pass
+    try:
+        value = float(text)
+    except ValueError:
+        return None
+    return int(value) if value.is_integer() else None
 
 
 def _integer(name: str, minimum: int, allowed: str):
     """An int option >= ``minimum``, refused as "name='text' is not <allowed>"."""
     def parse(text: str) -> int:
-        try:
-            value = int(text)
-        except ValueError:
+        value = integer_value(text)
+        if value is None:
             value = minimum - 1
         if value < minimum:
             raise argparse.ArgumentTypeError(f"{name}={text!r} is not {allowed}")
@@ -48,6 +67,23 @@ def _positive_int(name: str):
 
 def _non_negative_int(name: str):
     return _integer(name, 0, "an integer >= 0")
+
+
+def _gib(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not (value > 0 and value < float("inf")):
+        raise argparse.ArgumentTypeError(f"max_memory={text!r} is not a number of GiB > 0")
+    return value
+
+
+def _memory_option(parser) -> None:
+    parser.add_argument("--max-memory", type=_gib, default=None, metavar="GIB",
+                        help="refuse (status failed) a level whose predicted peak memory "
+                             "exceeds this many GiB, before building it (default: the memory "
+                             "the machine has available, minus 10 %% and at least 1 GiB)")
 
 
 def _theta(text: str) -> float:
@@ -97,6 +133,7 @@ def _run_parser(sub) -> None:
                      help="measure errors of scenes without an exact solution against a "
                           "cached adaptive overkill reference with about this many DOFs "
                           "(default: only scenes with an exact solution get errors)")
+    _memory_option(run)
     run.add_argument("--crosscheck-dofs", type=_non_negative_int("crosscheck_dofs"), default=0,
                      help="also solve levels with at most this many DOFs with the reference "
                           "solver and record the differences (default: 0, never)")
@@ -146,6 +183,7 @@ def _compare_parser(sub) -> None:
                          help="DOF budget per sequence (default: 20000)")
     compare.add_argument("--reference-dofs", type=_positive_int("reference_dofs"),
                          default=500000, help="overkill reference size (default: 500000)")
+    _memory_option(compare)
     compare.add_argument("--crosscheck-dofs", type=_non_negative_int("crosscheck_dofs"),
                          default=3000, help="cross-check levels up to this size with the "
                          "reference solver (default: 3000)")

@@ -4,6 +4,7 @@ stored next to the results so that reports can draw meshes and fields without re
 from __future__ import annotations
 
 import os
+import re
 from pathlib import Path
 
 import numpy as np
@@ -15,9 +16,16 @@ from formulations.elasticity import von_mises
 PRESSURE_SAMPLES = np.linspace(0.0, 1.0, 9)
 
 
+def file_stem(*parts) -> str:
+    """A file name from names read from a results table: anything but letters, digits, '.',
+    '_' and '-' becomes '_', and no part can climb out of its folder ('..', '/')."""
+    text = "-".join(str(part) for part in parts)
+    stem = re.sub(r"[^A-Za-z0-9._-]", "_", text).replace("..", "__")
+    return stem.lstrip(".") or "_"
+
+
 def artifact_path(out: str | Path, row) -> Path:
-    name = "-".join(str(getattr(row, k)) for k in KEYS)
-    return Path(out) / "artifacts" / f"{name}.npz"
+    return Path(out) / "artifacts" / f"{file_stem(*(getattr(row, k) for k in KEYS))}.npz"
 
 
 def save_artifact(out: str | Path, result) -> Path | None:

@@ -53,18 +53,19 @@ def run_matrix(scenes: Sequence[str], formulations: Sequence[str], solvers: Sequ
                config: LoopConfig, on_level: Callable[[LevelResult], None] | None = None,
                scene_parameters: dict | None = None,
                reference_dofs: int | None = None,
-               crosscheck_dofs: int = 0) -> list[ResultRow]:
+               crosscheck_dofs: int = 0, truths: dict | None = None) -> list[ResultRow]:
     """Run the cross product; each finished level is stored at once. An exception inside one
     combination becomes a ``failed`` row with the reason, and the next combination runs; an
     impossible combination becomes one ``skipped`` row with the reason. Errors are measured
     against each scene's exact solution, or an overkill reference of ``reference_dofs`` DOFs
-    (``bench.truth``; None and no exact solution: no errors). Levels with at most
+    (``bench.truth``; None and no exact solution: no errors; ``truths`` may hold them already,
+    by scene name). Levels with at most
     ``crosscheck_dofs`` DOFs are also solved by the reference solver for comparison. The last
     level of every combination is saved as an artifact (``bench.matrix.artifacts``) for the
     report."""
     run_id = time.strftime("%Y%m%dT%H%M%S")
     identity = {"run_id": run_id, **provenance()}
-    rows, truths = [], {}
+    rows, truths = [], dict(truths or {})
 
     def record(result: LevelResult) -> None:
         store.append(result.row)
@@ -83,8 +84,8 @@ def run_matrix(scenes: Sequence[str], formulations: Sequence[str], solvers: Sequ
                 record(_whole_run_row(names, STATUS_SKIPPED, reason))
                 continue
             if scene_name not in truths:
-                truths[scene_name] = truth_for(scene, reference_dofs)
-                _write_truth_summary(store.out, scene_name, truths[scene_name])
+                truths[scene_name] = truth_for(scene, reference_dofs, config.max_dofs)
+            _write_truth_summary(store.out, scene_name, truths[scene_name])
             last = None
             for result in run_sequence(scene, formulation, solver, estimator, cfg, identity,
                                        truth=truths[scene_name], crosscheck_dofs=crosscheck_dofs):

@@ -14,10 +14,12 @@ from bench.matrix.rates import write_rates
 from bench.matrix.store import ResultStore
 from bench.sequence.loop import STRATEGIES, LevelResult, LoopConfig
 from bench.sequence.rows import ResultRow
+from bench.truth import truth_for
 from estimators import estimator_names
 from formulations import STATUS_FAILED, formulation_names, solver_names
 from formulations.solvers.backends import check_backend
-from scenes import scene_names
+from scenes import get_scene, scene_names
+from scenes.base import is_integer
 
 NAME_LISTS = {"scenes": scene_names, "formulations": formulation_names,
               "solvers": solver_names, "estimators": estimator_names,
@@ -42,6 +44,7 @@ class RunConfig:
     nested: bool = True
     reference_dofs: int | None = None
     crosscheck_dofs: int = 0
+    max_memory_gib: float | None = None  # None: what the machine has available, minus a margin
     out: str = "results"
     overwrite: bool = False
     command: str = ""  # how the run was asked for, recorded in run.json
@@ -56,7 +59,7 @@ class RunConfig:
                                  f"; valid: {', '.join(valid())}")
         for name in ("reference_dofs", "crosscheck_dofs"):
             value = getattr(self, name)
-            if value is not None and not (isinstance(value, int) and value >= 0):
+            if value is not None and not (is_integer(value) and value >= 0):
                 raise ValueError(f"{name}={value!r} is not an integer >= 0")
         if self.backend is not None:
             check_backend(self.backend)
@@ -65,7 +68,8 @@ class RunConfig:
     def loop_config(self, strategy: str) -> LoopConfig:
         return LoopConfig(strategy=strategy, max_dofs=self.max_dofs, max_levels=self.max_levels,
                           marking=self.marking, theta=self.theta, nested=self.nested,
-                          solver_options={"backend": self.backend} if self.backend else {})
+                          solver_options={"backend": self.backend} if self.backend else {},
+                          max_memory_gib=self.max_memory_gib)
 
     def record(self) -> dict:
         """The configuration as written to run.json."""
@@ -85,14 +89,18 @@ class RunResult:
 
 def run(config: RunConfig, on_level: Callable[[LevelResult], None] | None = None) -> RunResult:
     """Run every combination of ``config`` into ``config.out``: results.{parquet,csv} (each
-    level as it finishes), run.json, truth.json, artifacts/ and rates.{csv,md}."""
+    level as it finishes), run.json, truth.json, artifacts/ and rates.{csv,md}. Raises
+    ``bench.truth.TruthError`` before any run if a reference cannot judge the runs."""
+    # every truth first: a reference that cannot judge these runs is refused before any run
+    truths = {name: truth_for(get_scene(name), config.reference_dofs, config.max_dofs)
+              for name in config.scenes}
     store = ResultStore(config.out, overwrite=config.overwrite)
     (store.out / "run.json").write_text(json.dumps(
         {"command": config.command, "configuration": config.record()}, indent=1, default=str))
     rows = run_matrix(config.scenes, config.formulations, config.solvers, config.estimators,
                       config.strategies, store, config.loop_config(config.strategies[0]),
                       on_level=on_level, reference_dofs=config.reference_dofs,
-                      crosscheck_dofs=config.crosscheck_dofs)
+                      crosscheck_dofs=config.crosscheck_dofs, truths=truths)
     table = store.run_table()
     write_rates(table, store.out)
     return RunResult(rows, table, store)

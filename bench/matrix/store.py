@@ -8,11 +8,39 @@ interrupted run loses no finished result. Rows of earlier runs in the same folde
 from __future__ import annotations
 
 import os
+import sys
 from pathlib import Path
 
 import pandas as pd
 
 from bench.sequence.rows import COLUMNS, ResultRow
+
+
+class ResultsError(ValueError):
+    """A results table that cannot be read."""
+
+
+def read_results(folder: str | Path) -> pd.DataFrame | None:
+    """The rows of ``folder/results.parquet`` (None if there is none). An unreadable parquet
+    falls back to the CSV mirror when that is intact (with a note on standard error); when
+    both are unreadable, ResultsError names the file and what to do."""
+    folder = Path(folder)
+    parquet, csv = folder / "results.parquet", folder / "results.csv"
+    if not parquet.exists():
+        return None
+    try:
+        return pd.read_parquet(parquet)
+    except Exception as error:  # pyarrow raises several types for a damaged file
+        why = f"{parquet} is unreadable ({type(error).__name__}: {error})"
+    try:
+        table = pd.read_csv(csv)
+        if "scene" not in table.columns or "level" not in table.columns:
+            raise ValueError("not a results table")
+    except Exception as error:
+        raise ResultsError(f"{why}, and so is its CSV mirror {csv} ({error}); move the folder "
+                           "away or rerun with --overwrite") from None
+    print(f"note: {why}; using its CSV mirror {csv} ({len(table)} rows)", file=sys.stderr)
+    return table
 
 
 class ResultStore:
@@ -23,7 +51,7 @@ class ResultStore:
         if overwrite:
             for path in (self.csv, self.parquet):
                 path.unlink(missing_ok=True)
-        self.previous = pd.read_parquet(self.parquet) if self.parquet.exists() else None
+        self.previous = read_results(self.out)
         if self.previous is not None and list(self.previous.columns) != COLUMNS:
             # written by a version with fewer columns: new columns are added, never renamed
             self.previous = self.previous.reindex(columns=COLUMNS)

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from bench.matrix.artifacts import artifact_path, load_artifact
+from bench.matrix.artifacts import artifact_path, file_stem, load_artifact
 from bench.report import figures
 from bench.sequence.rows import KEYS
 from scenes import get_scene
@@ -102,7 +102,7 @@ def scene_section(name: str, group: pd.DataFrame, results: Path | None, figs: Fi
             (figures.pressures(artifacts, _pressure_curve(scene, artifacts)), "pressure",
              "Contact pressure lambda_h along Gamma_C (adaptive, last level) per formulation; "
              "dotted lines are the contact-zone end points.")):
-        item = figs.add(figure, f"{name}-{suffix}", caption)
+        item = figs.add(figure, file_stem(name, suffix), caption)
         if item is not None:
             section["figures"].append(item)
     if scene is None:

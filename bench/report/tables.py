@@ -99,7 +99,7 @@ def timing_table(rows: pd.DataFrame) -> pd.DataFrame:
 
 
 def agreement_table(rows: pd.DataFrame) -> pd.DataFrame:
-    checked = rows[rows["crosscheck_status"].fillna("").astype(str) != ""]
+    checked = rows[rows["crosscheck_status"].astype(object).fillna("").astype(str) != ""]
     if checked.empty:
         return pd.DataFrame()
     keys = ["scene", "formulation", "solver"]

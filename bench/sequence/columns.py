@@ -16,7 +16,7 @@ def error_columns(truth, solution, estimate) -> dict:
     start = time.perf_counter()
     errors = truth.errors(solution)
     out = dict(vars(errors), truth=truth.kind, reference_error=truth.estimated_error,
-               reference_too_coarse=truth.too_coarse(errors.energy_error))
+               reference_too_coarse=truth.too_coarse(errors.energy_error, solution))
     if estimate is not None and errors.energy_error > 0:
         out.update(effectivity_index=estimate.eta / errors.energy_error,
                    effectivity_0=estimate.eta_0 / errors.energy_error,

@@ -16,11 +16,18 @@ from bench.sequence.columns import (
     solver_columns,
 )
 from bench.sequence.marking import check_marking, grade_contact_trace, mark
+from bench.sequence.memory import available_gib, predict_peak_gib, route
 from bench.sequence.rows import ResultRow, identity_columns
 from estimators import get_estimator
 from formulations import STATUS_FAILED, get_formulation, solve
-from formulations.elasticity import element_diameters
+from formulations.elasticity import (
+    count_free_dofs,
+    element_diameters,
+    predict_uniform_free_dofs,
+)
+from formulations.solvers.backends import check_backend
 from scenes import Scene
+from scenes.base import is_integer, is_number
 
 STRATEGIES = ("uniform", "adaptive")
 
@@ -40,15 +47,21 @@ class LoopConfig:
     # else a factorisation and m solves per level
     diagnostics: bool = True
     solver_options: dict = field(default_factory=dict)
+    # refuse a level whose predicted peak memory exceeds this (GiB); None: what the machine has
+    # available minus a margin (bench.sequence.memory)
+    max_memory_gib: float | None = None
 
     def __post_init__(self):
         if self.strategy not in STRATEGIES:
             raise ValueError(f"strategy={self.strategy!r} is not one of {', '.join(STRATEGIES)}")
         for name in ("max_dofs", "max_levels"):
             value = getattr(self, name)
-            if not (isinstance(value, int) and value > 0):
+            if not (is_integer(value) and value > 0):
                 raise ValueError(f"{name}={value!r} is not a positive integer")
         check_marking(self.marking, self.theta)
+        if self.max_memory_gib is not None and not (
+                is_number(self.max_memory_gib) and self.max_memory_gib > 0):
+            raise ValueError(f"max_memory_gib={self.max_memory_gib!r} is not a number > 0")
 
 
 @dataclass(frozen=True, eq=False)
@@ -84,6 +97,18 @@ def refine(mesh: MeshTri, sol, est, config: LoopConfig) -> MeshTri:
     return mesh.refined(marked)
 
 
+def memory_refusal(level: int, ndofs: int, solver: str, config: LoopConfig) -> str | None:
+    """Why a level of ``ndofs`` unknowns must not be built (its predicted peak memory does not
+    fit), or None."""
+    backend = check_backend(config.solver_options.get("backend"))
+    need = predict_peak_gib(ndofs, solver, backend)
+    limit = config.max_memory_gib if config.max_memory_gib is not None else available_gib()
+    if need <= limit:
+        return None
+    return (f"memory: level {level} needs ~{need:.2f} GiB ({ndofs} DOFs, "
+            f"{route(solver, backend)}), {limit:.2f} available")
+
+
 def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
                  config: LoopConfig, identity: dict | None = None,
                  mesh: MeshTri | None = None, truth=None,
@@ -97,11 +122,19 @@ def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
     mesh = scene.mesh if mesh is None else mesh
     t_refine, previous = 0.0, None
     for level in range(config.max_levels):
+        ndofs = count_free_dofs(scene, mesh)  # the budgets are checked before any assembly
+        if level > 0 and ndofs > config.max_dofs:
+            return
+        refusal = memory_refusal(level, ndofs, solver, config)
+        if refusal is not None:
+            yield LevelResult(ResultRow(**ident, level=level, ndofs=ndofs,
+                                        n_elements=mesh.t.shape[1], status=STATUS_FAILED,
+                                        reason=refusal), None, None)
+            return
+        scene.check_mesh(mesh, level)
         start = time.perf_counter()
         disc = discretise(scene, mesh)
         t_assemble = time.perf_counter() - start
-        if level > 0 and disc.ndofs > config.max_dofs:
-            return
         options = dict(config.solver_options)
         if config.nested and previous is not None and previous.ok:
             options["warm_start"] = disc.warm_start(previous)  # nested iteration
@@ -124,7 +157,8 @@ def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
             if solver != "reference" and disc.ndofs <= crosscheck_dofs:
                 numbers.update(crosscheck_columns(disc, sol))
         yield LevelResult(ResultRow(**ident, **numbers), sol, est)
-        if failed:
+        if failed or (config.strategy == "uniform"
+                      and predict_uniform_free_dofs(scene, mesh) > config.max_dofs):
             return
         start = time.perf_counter()
         mesh = refine(mesh, sol, est, config)

@@ -2,5 +2,6 @@
 (docs/theory.md, section 6)."""
 
 from bench.truth.kinds import ExactTruth, ReferenceTruth, truth_for
+from bench.truth.references import TruthError
 
-__all__ = ["ExactTruth", "ReferenceTruth", "truth_for"]
+__all__ = ["ExactTruth", "ReferenceTruth", "TruthError", "truth_for"]

@@ -6,16 +6,23 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
+
 from bench.measure.discretisation_error import Errors, exact_errors
-from bench.truth.references import load_or_build
+from bench.truth.cache import load_or_build
+from bench.truth.references import TruthError
 
 TOO_COARSE = 0.1  # a reference whose own error exceeds 10 % of the measured error is too coarse
+# A reference needs at least this many times the DOFs of the finest level it judges: at the
+# adaptive rate N^(-1/2) its own error is then at most 1/sqrt(10) = 0.32 of that level's, the
+# least for the two to be told apart; a smaller one is refused before any run.
+REFERENCE_FACTOR = 10
 
 
 class _Truth:
     estimated_error: float
 
-    def too_coarse(self, energy_error: float) -> bool:
+    def too_coarse(self, energy_error: float, solution) -> bool:
         return bool(self.estimated_error > TOO_COARSE * energy_error)
 
 
@@ -41,12 +48,33 @@ class ReferenceTruth(_Truth):
     def errors(self, solution) -> Errors:
         return self.reference.errors(solution)
 
+    def too_coarse(self, energy_error: float, solution) -> bool:
+        """Also when the judged solution has contact and the reference has none."""
+        no_contact = not self.reference.zone[0] == self.reference.zone[0]  # NaN: no zone
+        return super().too_coarse(energy_error, solution) or bool(
+            no_contact and solution.active_constraints > 0)
 
-def truth_for(scene, reference_dofs: int | None):
+
+def check_reference(reference, scene, judged_max_dofs: int | None) -> None:
+    """Refuse a reference that cannot judge runs up to ``judged_max_dofs`` DOFs."""
+    where = f"the {scene.name!r} reference ({reference.ndofs} DOFs)"
+    if not (np.isfinite(reference.estimated_error) and reference.estimated_error > 0):
+        raise TruthError(f"{where} estimates its own error as {reference.estimated_error:g}: "
+                         "it has not shown it is sharper than anything; raise --reference-dofs")
+    if judged_max_dofs is not None and reference.ndofs < REFERENCE_FACTOR * judged_max_dofs:
+        raise TruthError(f"{where} is not {REFERENCE_FACTOR}x finer than the runs it would "
+                         f"judge (--max-dofs={judged_max_dofs}); raise --reference-dofs to at "
+                         f"least {REFERENCE_FACTOR * judged_max_dofs * 2} or lower --max-dofs")
+
+
+def truth_for(scene, reference_dofs: int | None, judged_max_dofs: int | None = None):
     """Exact if the scene has an exact solution; else the cached reference with
-    ``reference_dofs`` DOFs (None: no error measurement)."""
+    ``reference_dofs`` DOFs (None: no error measurement), refused (TruthError) if it cannot
+    judge runs up to ``judged_max_dofs`` DOFs."""
     if scene.exact is not None:
         return ExactTruth(scene)
     if reference_dofs is None:
         return None
-    return ReferenceTruth(load_or_build(scene, reference_dofs))
+    reference = load_or_build(scene, reference_dofs)
+    check_reference(reference, scene, judged_max_dofs)
+    return ReferenceTruth(reference)

@@ -6,10 +6,9 @@ from its last two levels: if the error decays like N^(-1/2) (the adaptive rate, 
 the levels are nearly orthogonal in the energy norm, e_L = ||u_L - u_(L-1)|| / sqrt(N_L/N_(L-1)
 - 1). It is a model, not a bound; ``reference_too_coarse`` flags rows whose error is within 10x.
 
-The cache key hashes everything that determines the reference: scene name and parameters,
-formulation, solver, estimator, marking, DOF budget and ``ASSEMBLY_VERSION`` (bump it when the
-assembly or a formulation changes). The folder is ``$SIGNORINI_BENCH_CACHE`` or
-``.cache/references`` under the working directory.
+The cache (``bench.truth.cache``) is keyed by a hash of everything that determines the
+reference: scene name and parameters, formulation, solver, estimator, marking, DOF budget and
+``ASSEMBLY_VERSION`` (bump it when the assembly or a formulation changes).
 """
 
 from __future__ import annotations
@@ -17,9 +16,7 @@ from __future__ import annotations
 import functools
 import hashlib
 import json
-import os
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 from skfem import MeshTri
@@ -66,10 +63,6 @@ class Reference:
                 "estimated_error": self.estimated_error, "key": self.key}
 
 
-def cache_folder() -> Path:
-    return Path(os.environ.get("SIGNORINI_BENCH_CACHE", ".cache/references"))
-
-
 def reference_key(scene, max_dofs: int) -> str:
     recipe = {"scene": scene.name, "parameters": scene.parameters, "max_dofs": max_dofs,
               "assembly_version": ASSEMBLY_VERSION, **RECIPE}
@@ -82,6 +75,10 @@ def _sampled_pressure(solution: DiscreteSolution):
     return facet_samples(solution.trace.coordinate, t).ravel(), solution.pressure(t).ravel()
 
 
+class TruthError(ValueError):
+    """A reference that cannot be built or cannot be trusted for the runs it would judge."""
+
+
 def build_reference(scene, max_dofs: int) -> Reference:
     config = LoopConfig(strategy="adaptive", max_dofs=max_dofs, marking=RECIPE["marking"],
                         theta=RECIPE["theta"], diagnostics=False)
@@ -89,8 +86,13 @@ def build_reference(scene, max_dofs: int) -> Reference:
     for result in run_sequence(scene, RECIPE["formulation"], RECIPE["solver"],
                                RECIPE["estimator"], config):
         if result.row.status != STATUS_OK:
-            raise RuntimeError(f"reference level {result.row.level} failed: {result.row.reason}")
+            raise TruthError(f"reference for scene {scene.name!r}: level {result.row.level} "
+                             f"failed: {result.row.reason}")
         previous, last = last, result
+    if previous is None:
+        raise TruthError(f"reference_dofs={max_dofs} leaves the {scene.name!r} reference one "
+                         f"level ({last.row.ndofs} DOFs): its own error cannot be estimated; "
+                         "give a budget of at least ten times the runs' --max-dofs")
     sol = last.solution
     u_nodal = sol.elasticity.nodal(sol.u)
     difference = energy_error_on(P1Field.from_nodal(sol.elasticity.mesh, u_nodal),
@@ -102,28 +104,3 @@ def build_reference(scene, max_dofs: int) -> Reference:
                      pressure_values=values, ndofs=last.row.ndofs, energy=sol.energy,
                      contact_force=sol.contact_force(), zone=contact_zone(sol),
                      estimated_error=float(difference / np.sqrt(max(ratio - 1.0, 1e-12))))
-
-
-def load_or_build(scene, max_dofs: int) -> Reference:
-    """The cached reference for (scene, max_dofs), built and stored if missing."""
-    key = reference_key(scene, max_dofs)
-    path = cache_folder() / f"{key}.npz"
-    if path.exists():
-        data = np.load(path)
-        meta = json.loads(str(data["meta"]))
-        return Reference(key=key, mesh=MeshTri(data["p"], data["t"]), u_nodal=data["u"],
-                         lame=tuple(meta["lame"]), pressure_s=data["pressure_s"],
-                         pressure_values=data["pressure_values"], ndofs=meta["ndofs"],
-                         energy=meta["energy"], contact_force=meta["contact_force"],
-                         zone=tuple(meta["zone"]), estimated_error=meta["estimated_error"])
-    ref = build_reference(scene, max_dofs)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    meta = {"lame": list(ref.lame), "ndofs": ref.ndofs, "energy": ref.energy,
-            "contact_force": ref.contact_force, "zone": list(ref.zone),
-            "estimated_error": ref.estimated_error}
-    tmp = path.with_suffix(".tmp.npz")
-    np.savez_compressed(tmp, p=ref.mesh.p, t=ref.mesh.t, u=ref.u_nodal,
-                        pressure_s=ref.pressure_s, pressure_values=ref.pressure_values,
-                        meta=json.dumps(meta))
-    os.replace(tmp, path)
-    return ref

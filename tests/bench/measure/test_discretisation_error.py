@@ -6,7 +6,7 @@ from skfem import Basis, ElementTriP1, ElementVector
 
 from bench.measure.discretisation_error import energy_density, exact_errors
 from bench.measure.nonnested import P1Field, energy_error_on
-from bench.truth import references
+from bench.truth import cache
 from formulations import get_formulation, solve
 from scenes import get_scene
 
@@ -65,7 +65,7 @@ def test_reference_error_agrees_with_exact_error_on_non_nested_meshes(tmp_path, 
     # solution, up to the reference's own error
     monkeypatch.setenv("SIGNORINI_BENCH_CACHE", str(tmp_path))
     scene = get_scene("free-boundary")
-    ref = references.load_or_build(scene, 40000)
+    ref = cache.load_or_build(scene, 40000)
     sol = solved(scene, scene.mesh.refined(3))
     exact = exact_errors(scene, sol).energy_error
     measured = ref.errors(sol).energy_error
@@ -83,12 +83,12 @@ def test_reference_error_agrees_with_exact_error_on_non_nested_meshes(tmp_path, 
 def test_reference_is_cached_and_keyed_by_what_determines_it(tmp_path, monkeypatch):
     monkeypatch.setenv("SIGNORINI_BENCH_CACHE", str(tmp_path))
     scene = get_scene("paper")
-    first = references.load_or_build(scene, 3000)
+    first = cache.load_or_build(scene, 3000)
     files = list(tmp_path.glob("*.npz"))
     assert len(files) == 1 and first.key in files[0].name
-    again = references.load_or_build(scene, 3000)
+    again = cache.load_or_build(scene, 3000)
     assert again.ndofs == first.ndofs and np.array_equal(again.u_nodal, first.u_nodal)
     assert again.energy == first.energy and again.zone == first.zone
-    other = references.reference_key(get_scene("paper", young_modulus=1.0), 3000)
-    assert other != first.key and references.reference_key(scene, 6000) != first.key
+    other = cache.reference_key(get_scene("paper", young_modulus=1.0), 3000)
+    assert other != first.key and cache.reference_key(scene, 6000) != first.key
     assert first.estimated_error > 0 and np.isfinite(first.estimated_error)

@@ -1,0 +1,86 @@
+"""The on-disk cache of overkill references: one ``.npz`` per reference with a SHA-256
+checksum beside it (``.sha256``). A file that fails its checksum or cannot be read is named,
+deleted and rebuilt. The folder is ``$SIGNORINI_BENCH_CACHE`` or ``.cache/references`` under the
+working directory."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import sys
+from pathlib import Path
+
+import numpy as np
+from skfem import MeshTri
+
+from bench.truth.references import Reference, build_reference, reference_key
+
+
+class CorruptCache(Exception):
+    """A cached reference that must not be used (the message says why)."""
+
+
+def cache_folder() -> Path:
+    return Path(os.environ.get("SIGNORINI_BENCH_CACHE", ".cache/references"))
+
+
+def _digest(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def _checksum_path(path: Path) -> Path:
+    return path.with_suffix(".sha256")
+
+
+def save_reference(ref: Reference, path: Path) -> None:
+    """Write the reference and then its checksum, each atomically."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    meta = {"lame": list(ref.lame), "ndofs": ref.ndofs, "energy": ref.energy,
+            "contact_force": ref.contact_force, "zone": list(ref.zone),
+            "estimated_error": ref.estimated_error}
+    tmp = path.with_suffix(".tmp.npz")
+    np.savez_compressed(tmp, p=ref.mesh.p, t=ref.mesh.t, u=ref.u_nodal,
+                        pressure_s=ref.pressure_s, pressure_values=ref.pressure_values,
+                        meta=json.dumps(meta))
+    checksum = _checksum_path(path).with_suffix(".sha256.tmp")
+    checksum.write_text(_digest(tmp) + "\n")
+    os.replace(tmp, path)
+    os.replace(checksum, _checksum_path(path))
+
+
+def load_reference(path: Path, key: str) -> Reference:
+    """The reference stored at ``path``; CorruptCache if its checksum is missing or wrong or
+    it cannot be read."""
+    checksum = _checksum_path(path)
+    if not checksum.exists():
+        raise CorruptCache("no checksum beside it")
+    if checksum.read_text().strip() != _digest(path):
+        raise CorruptCache("checksum mismatch")
+    try:
+        with np.load(path) as data:
+            meta = json.loads(str(data["meta"]))
+            return Reference(key=key, mesh=MeshTri(data["p"], data["t"]), u_nodal=data["u"],
+                             lame=tuple(meta["lame"]), pressure_s=data["pressure_s"],
+                             pressure_values=data["pressure_values"], ndofs=meta["ndofs"],
+                             energy=meta["energy"], contact_force=meta["contact_force"],
+                             zone=tuple(meta["zone"]), estimated_error=meta["estimated_error"])
+    except Exception as error:  # zip, pickle, JSON and key errors alike: do not trust it
+        raise CorruptCache(f"{type(error).__name__}: {error}") from None
+
+
+def load_or_build(scene, max_dofs: int) -> Reference:
+    """The cached reference for (scene, max_dofs), built and stored if missing or corrupt."""
+    key = reference_key(scene, max_dofs)
+    path = cache_folder() / f"{key}.npz"
+    if path.exists():
+        try:
+            return load_reference(path, key)
+        except CorruptCache as error:
+            print(f"note: cached reference {path} is corrupt ({error}); deleting and "
+                  "rebuilding it", file=sys.stderr)
+            path.unlink(missing_ok=True)
+            _checksum_path(path).unlink(missing_ok=True)
+    ref = build_reference(scene, max_dofs)
+    save_reference(ref, path)
+    return ref

@@ -1,0 +1,231 @@
+"""One test per guard: a bad input or a fault ends in a clear one-line refusal or a correct
+recovery, never in a traceback or a machine out of memory."""
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from dataclasses import replace
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import bench.sequence.loop as loop_module
+from bench.cli import main
+from bench.matrix.artifacts import file_stem
+from bench.report import write_report
+from bench.sequence.loop import LoopConfig, run_sequence
+from bench.sequence.memory import MODEL, available_gib, predict_peak_gib
+from bench.truth import cache
+from conftest import square_scene
+from formulations.solvers import backends
+from scenes import SceneError, get_scene
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+
+def assembled_sizes(monkeypatch) -> list[int]:
+    """Record the DOFs of every discretisation the loop builds."""
+    sizes, real = [], loop_module.get_formulation
+
+    def recording(name):
+        discretise = real(name)
+
+        def wrapped(scene, mesh, **options):
+            disc = discretise(scene, mesh, **options)
+            sizes.append(disc.ndofs)
+            return disc
+        return wrapped
+    monkeypatch.setattr(loop_module, "get_formulation", recording)
+    return sizes
+
+
+@pytest.mark.parametrize("strategy", ["uniform", "adaptive"])
+def test_no_level_over_the_dof_budget_is_assembled(monkeypatch, strategy):
+    sizes = assembled_sizes(monkeypatch)
+    rows = [r.row for r in run_sequence(get_scene("paper"), "mixed", "active-set", "residual",
+                                        LoopConfig(strategy=strategy, max_dofs=2500))]
+    assert max(sizes) <= 2500 and sizes == [r.ndofs for r in rows]
+    assert rows[-1].status == "ok"
+
+
+def test_a_level_that_would_not_fit_in_memory_is_refused_before_it_is_built(monkeypatch):
+    sizes = assembled_sizes(monkeypatch)
+    limit = predict_peak_gib(2112, "active-set", backends.check_backend(None)) * 1.01
+    rows = [r.row for r in run_sequence(
+        get_scene("paper"), "mixed", "active-set", "residual",
+        LoopConfig(strategy="uniform", max_dofs=10**8, max_memory_gib=limit))]
+    last = rows[-1]
+    assert [r.status for r in rows[:-1]] == ["ok"] * 4 and rows[-2].ndofs == 2112
+    assert last.status == "failed" and last.ndofs == 8320 and 8320 not in sizes
+    assert last.reason.startswith("memory: level 4 needs ~") and "available" in last.reason
+
+
+def test_memory_model_matches_the_scaling_table_within_1_5():
+    table = pd.read_csv(os.path.join(ROOT, "reports", "scaling.csv"))
+    for _, row in table.iterrows():
+        predicted = MODEL[row["backend"]].peak_gib(row["ndofs"])
+        assert 1 / 1.5 <= predicted / row["peak_gib_without_reference"] <= 1.5, row["ndofs"]
+    assert 0 < available_gib() < float("inf")
+
+
+def test_reference_budget_too_small_for_two_levels_is_refused(tmp_path, monkeypatch, capsys):
+    monkeypatch.setenv("SIGNORINI_BENCH_CACHE", str(tmp_path / "cache"))
+    assert main(["run", "--reference-dofs", "53", "--out", str(tmp_path / "r")]) == 2
+    err = capsys.readouterr().err
+    assert "reference_dofs=53" in err and "one level" in err and "Traceback" not in err
+
+
+def test_a_degenerate_reference_is_refused_before_any_run(tmp_path, monkeypatch, capsys):
+    monkeypatch.setenv("SIGNORINI_BENCH_CACHE", str(tmp_path / "cache"))
+    out = tmp_path / "r"
+    assert main(["run", "--reference-dofs", "60", "--max-dofs", "300", "--out", str(out)]) == 2
+    assert "54 DOFs" in capsys.readouterr().err
+    assert not (out / "results.parquet").exists()  # refused before the runs start
+
+
+def test_a_reference_coarser_than_ten_times_the_runs_is_refused(tmp_path, monkeypatch, capsys):
+    monkeypatch.setenv("SIGNORINI_BENCH_CACHE", str(tmp_path / "cache"))
+    assert main(["run", "--reference-dofs", "3000", "--max-dofs", "2000",
+                 "--out", str(tmp_path / "r")]) == 2
+    assert "is not 10x finer than the runs it would judge" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("damage", ["truncate", "garble", "checksum"])
+def test_a_corrupt_cached_reference_is_named_deleted_and_rebuilt(tmp_path, monkeypatch, capsys,
+                                                               damage):
+    monkeypatch.setenv("SIGNORINI_BENCH_CACHE", str(tmp_path))
+    scene = get_scene("paper")
+    first = cache.load_or_build(scene, 3000)
+    path = next(tmp_path.glob("*.npz"))
+    data = path.read_bytes()
+    if damage == "truncate":
+        path.write_bytes(data[: len(data) // 2])
+    elif damage == "garble":
+        path.write_bytes(data[:100] + bytes(200) + data[300:])
+    else:
+        path.with_suffix(".sha256").unlink()
+    again = cache.load_or_build(scene, 3000)
+    assert f"cached reference {path} is corrupt" in capsys.readouterr().err
+    assert np.array_equal(again.u_nodal, first.u_nodal)
+    assert cache.load_reference(path, again.key).ndofs == first.ndofs  # sound again
+
+
+@pytest.mark.parametrize("command", [["run"], ["hard", "--case", "invalid"], ["verify"],
+                                     ["compare"]])
+def test_an_output_folder_that_is_a_file_is_refused_first(tmp_path, capsys, command):
+    target = tmp_path / "taken"
+    target.write_text("a file")
+    assert main([*command, "--out", str(target)]) == 2
+    assert "is a file, not a folder" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("folder", ["/proc/signorini-bench", "/proc/1/nonexistent/mount"])
+def test_an_output_folder_that_cannot_be_written_is_refused_first(capsys, folder):
+    assert main(["hard", "--out", folder]) == 2  # before any case runs
+    err = capsys.readouterr().err
+    assert "cannot be written" in err and "Traceback" not in err
+
+
+@pytest.fixture
+def small_results(tmp_path):
+    out = tmp_path / "res"
+    assert main(["run", "--max-dofs", "300", "--out", str(out)]) == 0
+    return out
+
+
+def test_a_truncated_parquet_falls_back_to_its_csv_mirror(small_results, tmp_path, capsys):
+    parquet = small_results / "results.parquet"
+    parquet.write_bytes(parquet.read_bytes()[:200])
+    assert main(["report", "--results", str(small_results), "--out", str(tmp_path / "rep")]) == 0
+    assert "using its CSV mirror" in capsys.readouterr().err
+    assert main(["run", "--max-dofs", "300", "--out", str(small_results)]) == 0
+    assert len(pd.read_parquet(parquet)) == 2 * len(pd.read_csv(small_results / "results.csv")
+                                                    .query("run_id == run_id.iloc[0]"))
+
+
+def test_a_results_folder_with_both_tables_broken_is_named(small_results, tmp_path, capsys):
+    (small_results / "results.parquet").write_bytes(b"PAR1 garbage")
+    (small_results / "results.csv").write_bytes(b"\x00\x01 not a table")
+    assert main(["report", "--results", str(small_results), "--out", str(tmp_path / "x")]) == 2
+    err = capsys.readouterr().err
+    assert "results.parquet is unreadable" in err and "--overwrite" in err
+
+
+def test_names_from_a_results_table_cannot_escape_the_report_folder(small_results, tmp_path):
+    table = pd.read_parquet(small_results / "results.parquet")
+    table["scene"] = "../../escaped"
+    out = tmp_path / "deep" / "report"
+    write_report(table, out, small_results)
+    written = list(tmp_path.rglob("*escaped*"))
+    assert written and all(out in p.parents for p in written)
+    assert file_stem("../../X", "pressure") == "______X-pressure"
+
+
+def test_a_clamp_that_meets_gamma_c_after_refinement_fails_with_the_cause():
+    base = square_scene(lambda x: np.full(x.shape[1:], -0.01))  # clamped on top
+    scene = replace(base, is_dirichlet=lambda x: (np.abs(x[1] - 1) < 1e-10)
+                    | ((np.abs(x[1] + 1) < 1e-10) & (np.abs(x[0] - 0.3125) < 1e-3)))
+    for formulation in ("mixed", "vi"):
+        with pytest.raises(SceneError, match="overlapping the contact boundary on the mesh "
+                                             "of level 2"):
+            list(run_sequence(scene, formulation, "reference", "residual",
+                              LoopConfig(strategy="uniform")))
+
+
+def test_a_gap_that_is_not_finite_after_refinement_is_named():
+    scene = square_scene(lambda x: np.where(np.abs(x[0] - 0.3125) < 1e-3, np.nan, -0.01))
+    with pytest.raises(SceneError, match=r"gap='nan at x=\[0.3125, -1.0\] on the mesh of "
+                                         r"level 2' is not finite"):
+        list(run_sequence(scene, "mixed", "active-set", "residual",
+                          LoopConfig(strategy="uniform")))
+
+
+def test_numbers_as_users_write_them():
+    scene = get_scene("paper", young_modulus=np.float32(7e4), initial_divisions=np.int64(4))
+    assert scene.parameters["initial_divisions"] == 4 and scene.material.lame[1] > 0
+    with pytest.raises(SceneError, match="young_modulus=True is not a finite number"):
+        get_scene("paper", young_modulus=True)
+    with pytest.raises(SceneError, match="initial_divisions=True is not an integer"):
+        get_scene("paper", initial_divisions=True)
+
+
+def test_duplicate_names_run_once_and_integers_may_be_written_as_floats(tmp_path, capsys):
+    out = tmp_path / "r"
+    assert main(["run", "--formulation", "mixed,mixed", "--max-dofs", "1e3",
+                 "--out", str(out)]) == 0
+    assert "formulation 'mixed' given 2 times; running it once" in capsys.readouterr().err
+    table = pd.read_parquet(out / "results.parquet")
+    assert table.groupby("level").size().max() == 1 and table["ndofs"].max() <= 1000
+    with pytest.raises(SystemExit):
+        main(["run", "--max-dofs", "1.5"])
+    assert "max_dofs='1.5' is not a positive integer" in capsys.readouterr().err
+
+
+def test_scaling_with_a_missing_backend_is_refused(monkeypatch, tmp_path, capsys):
+    monkeypatch.setattr(backends, "available_backends", lambda: ("splu",))
+    assert main(["scaling", "--backend", "cholmod", "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert "backend='cholmod' is not available" in err and "Traceback" not in err
+
+
+def test_sigint_ends_with_one_line_and_keeps_every_finished_row(tmp_path):
+    out = tmp_path / "r"
+    process = subprocess.Popen([sys.executable, "-m", "bench", "run", "--strategy", "uniform",
+                                "--max-dofs", "2000000", "--solver", "reference", "--out",
+                                str(out)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                               text=True, cwd=tmp_path)
+    deadline = time.time() + 120
+    while time.time() < deadline:  # wait for three finished rows
+        csv = out / "results.csv"
+        if csv.exists() and len(csv.read_text().splitlines()) >= 4:
+            break
+        time.sleep(0.2)
+    process.send_signal(signal.SIGINT)
+    _, err = process.communicate(timeout=120)
+    assert process.returncode == 130, err
+    assert "Traceback" not in err and "interrupted: every finished row is kept" in err
+    table = pd.read_parquet(out / "results.parquet")
+    assert len(table) >= 3 and (table["status"] == "ok").all()
