@@ -10,6 +10,7 @@ import pandas as pd
 
 from bench.cli.guards import InputError, check_output_folders
 from bench.cli.parser import build_parser
+from bench.cli.progress import Progress
 from bench.hard import (
     check_expected,
     hard_case_descriptions,
@@ -18,12 +19,12 @@ from bench.hard import (
     write_hard,
 )
 from bench.matrix import RunConfig, run
+from bench.matrix.run import RunRefused
 from bench.matrix.store import ResultsError, read_results
 from bench.perf.scaling import run_scaling, write_scaling
 from bench.report import write_report
 from bench.sequence.loop import LevelResult
 from bench.sequence.rows import KEYS, level_time
-from bench.truth import TruthError
 from bench.verify import load_expected, verdict_table, verify
 from estimators import estimator_descriptions, estimator_names
 from formulations import formulation_descriptions, formulation_names, solver_descriptions
@@ -47,7 +48,7 @@ def progress(result: LevelResult) -> None:
 def summary(table: pd.DataFrame) -> str:
     parts = []
     for key, group in table.groupby(KEYS, sort=False):
-        parts.append("== " + " / ".join(map(str, key)))
+        parts.append("== " + " / ".join(str(k) for k in key if str(k)))
         parts.append(group[SUMMARY_COLUMNS].to_string(index=False, float_format="{:.6g}".format))
     return "\n".join(parts)
 
@@ -76,7 +77,12 @@ def configured(**fields) -> RunConfig | None:
 def run_config(config: RunConfig | None) -> int:
     if config is None:
         return 2
-    result = run(config, on_level=progress)
+    live = Progress(len(config.specs()))
+    result = run(config, on_level=live.level(progress), on_sequence=live.sequence)
+    live.close()
+    if result.reused:
+        print(f"reused {len(result.reused)} sequences finished by an earlier run in "
+              f"{result.store.out}")
     print(f"wrote {result.store.out / 'rates.md'}\n")
     print(summary(result.table))
     print(f"\nwrote {len(result.rows)} rows to {result.store.parquet} and {result.store.csv}")
@@ -90,7 +96,8 @@ def run_command(args) -> int:
         max_levels=args.max_levels, marking=args.marking, theta=args.theta,
         backend=args.backend, nested=not args.cold_start, reference_dofs=args.reference_dofs,
         crosscheck_dofs=args.crosscheck_dofs, max_memory_gib=args.max_memory, out=args.out,
-        overwrite=args.overwrite,
+        overwrite=args.overwrite, workers=args.workers, scheduler=args.scheduler,
+        cache=args.cache,
         command=" ".join(["python -m bench", *args.argv]))
     return run_config(config)
 
@@ -123,7 +130,7 @@ def compare_command(args) -> int:
         estimators=estimator_names(), strategies=("uniform", "adaptive"),
         max_dofs=args.max_dofs, reference_dofs=args.reference_dofs,
         crosscheck_dofs=args.crosscheck_dofs, max_memory_gib=args.max_memory, out=args.out,
-        overwrite=True,
+        overwrite=True, workers=args.workers, scheduler=args.scheduler, cache=args.cache,
         command=f"python -m bench compare --max-dofs {args.max_dofs} --reference-dofs "
                 f"{args.reference_dofs} --crosscheck-dofs {args.crosscheck_dofs} --out "
                 f"{args.out} --reports {args.reports}")
@@ -181,7 +188,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         check_output_folders(args.command, args)
         return COMMANDS[args.command](args)
-    except (InputError, ResultsError, TruthError) as error:
+    except (InputError, ResultsError, RunRefused) as error:
         print(f"error: {error}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:

@@ -8,6 +8,7 @@ import argparse
 import sys
 
 from bench.hard import hard_case_names
+from bench.matrix.spec import parse_item
 from bench.perf.scaling import SIZES
 from bench.sequence.loop import STRATEGIES
 from bench.sequence.marking import MARKINGS
@@ -17,12 +18,19 @@ from formulations.solvers.backends import BACKENDS
 from scenes import scene_names
 
 
-def _names(kind: str, valid: list[str], plural: str | None = None):
+def _names(kind: str, valid: list[str], plural: str | None = None, sweep: bool = False):
     """A comma-separated list of names from ``valid`` (``kind``: what one name is); a name
-    given twice is kept once, with a note on standard error."""
+    given twice is kept once, with a note on standard error. With ``sweep`` an item may carry
+    parameters, ``name:key=v1|v2:other=w`` (``bench.matrix.spec.parse_item``)."""
     def parse(text: str) -> list[str]:
         names = [name.strip() for name in text.split(",") if name.strip()]
-        unknown = [name for name in names if name not in valid]
+        if sweep:
+            for item in names:
+                try:
+                    parse_item(item, kind)
+                except ValueError as error:
+                    raise argparse.ArgumentTypeError(str(error)) from None
+        unknown = [name for name in names if name.split(":")[0] not in valid]
         if not names or unknown:
             raise argparse.ArgumentTypeError(
                 f"unknown {kind} {', '.join(map(repr, unknown)) or repr(text)}; "
@@ -79,6 +87,19 @@ def _gib(text: str) -> float:
     return value
 
 
+def _scale_out_options(parser) -> None:
+    parser.add_argument("--workers", type=_non_negative_int("workers"), default=0,
+                        help="run the sequences on a local Dask cluster of this many processes "
+                             "(one thread each) (default: 0, in this process)")
+    parser.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                        help="run the sequences on the existing Dask cluster at ADDRESS, e.g. "
+                             "tcp://10.0.0.5:8786 (its workers need this package and --cache "
+                             "on shared storage)")
+    parser.add_argument("--cache", default=None, metavar="DIR",
+                        help="folder of the cached overkill references (default: "
+                             "$SIGNORINI_BENCH_CACHE or .cache/references)")
+
+
 def _memory_option(parser) -> None:
     parser.add_argument("--max-memory", type=_gib, default=None, metavar="GIB",
                         help="refuse (status failed) a level whose predicted peak memory "
@@ -101,12 +122,16 @@ def _run_parser(sub) -> None:
                          "write results.parquet and results.csv",
                          description="Run every combination of the given comma-separated "
                          "lists and write one row per level to OUT/results.{parquet,csv}.")
-    run.add_argument("--scene", type=_names("scene", scene_names()), default=["paper"],
+    run.add_argument("--scene", type=_names("scene", scene_names(), sweep=True),
+                     default=["paper"],
                      help=f"scene(s), comma-separated; one of: {', '.join(scene_names())} "
-                          "(default: paper)")
-    run.add_argument("--formulation", type=_names("formulation", formulation_names()),
+                          "(default: paper); sweep parameters with name:key=v1|v2, e.g. "
+                          "paper:poisson_ratio=0.3|0.45")
+    run.add_argument("--formulation", type=_names("formulation", formulation_names(),
+                                                  sweep=True),
                      default=["mixed"], help="formulation(s): "
-                     f"{', '.join(formulation_names())} (default: mixed)")
+                     f"{', '.join(formulation_names())} (default: mixed); options as for "
+                     "--scene, e.g. mixed:h_over_H=0.5|0.25")
     run.add_argument("--solver", type=_names("solver", solver_names()), default=["reference"],
                      help=f"solver(s): {', '.join(solver_names())} (default: reference)")
     run.add_argument("--estimator", type=_names("estimator", estimator_names()),
@@ -134,13 +159,15 @@ def _run_parser(sub) -> None:
                           "cached adaptive overkill reference with about this many DOFs "
                           "(default: only scenes with an exact solution get errors)")
     _memory_option(run)
+    _scale_out_options(run)
     run.add_argument("--crosscheck-dofs", type=_non_negative_int("crosscheck_dofs"), default=0,
                      help="also solve levels with at most this many DOFs with the reference "
                           "solver and record the differences (default: 0, never)")
     run.add_argument("--out", default="results",
                      help="output folder for results.parquet and results.csv (default: results)")
     run.add_argument("--overwrite", action="store_true",
-                     help="delete earlier results in OUT first (default: keep and append)")
+                     help="delete earlier results in OUT first (default: keep them, and reuse "
+                          "every sequence an earlier run finished with the same settings)")
 
 
 def _report_parser(sub) -> None:
@@ -184,6 +211,7 @@ def _compare_parser(sub) -> None:
     compare.add_argument("--reference-dofs", type=_positive_int("reference_dofs"),
                          default=500000, help="overkill reference size (default: 500000)")
     _memory_option(compare)
+    _scale_out_options(compare)
     compare.add_argument("--crosscheck-dofs", type=_non_negative_int("crosscheck_dofs"),
                          default=3000, help="cross-check levels up to this size with the "
                          "reference solver (default: 3000)")

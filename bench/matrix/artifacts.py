@@ -19,7 +19,7 @@ PRESSURE_SAMPLES = np.linspace(0.0, 1.0, 9)
 def file_stem(*parts) -> str:
     """A file name from names read from a results table: anything but letters, digits, '.',
     '_' and '-' becomes '_', and no part can climb out of its folder ('..', '/')."""
-    text = "-".join(str(part) for part in parts)
+    text = "-".join(str(part) for part in parts if str(part) != "")
     stem = re.sub(r"[^A-Za-z0-9._-]", "_", text).replace("..", "__")
     return stem.lstrip(".") or "_"
 

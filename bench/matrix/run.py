@@ -1,35 +1,50 @@
 """The package's one entry point for running the matrix: a frozen ``RunConfig`` and
-``run(config)``, called alike by the command line, ``compare``, ``verify`` and the tests."""
+``run(config)``, called alike by the command line, ``compare``, ``verify`` and the tests.
+
+A run is a list of ``SequenceSpec``: the cross product of scenes (each with its swept
+parameters), formulations (each with its swept options), solvers, estimators and strategies.
+A sequence finished by an earlier run into the same folder with the same spec is reused, not
+recomputed, unless ``overwrite``."""
 
 from __future__ import annotations
 
+import itertools
 import json
+import os
 from collections.abc import Callable
 from dataclasses import dataclass, fields
 
 import pandas as pd
 
-from bench.matrix.harness import run_matrix
+from bench.matrix.harness import new_run_identity, run_specs, truth_name, write_truth_summary
 from bench.matrix.rates import write_rates
+from bench.matrix.spec import (
+    SequenceSpec,
+    build_scene,
+    check_formulation_options,
+    parse_item,
+)
 from bench.matrix.store import ResultStore
 from bench.sequence.loop import STRATEGIES, LevelResult, LoopConfig
-from bench.sequence.rows import ResultRow
+from bench.sequence.rows import COLUMNS, ResultRow
 from bench.truth import truth_for
 from estimators import estimator_names
 from formulations import STATUS_FAILED, formulation_names, solver_names
 from formulations.solvers.backends import check_backend
-from scenes import get_scene, scene_names
+from scenes import scene_names
 from scenes.base import is_integer
 
 NAME_LISTS = {"scenes": scene_names, "formulations": formulation_names,
               "solvers": solver_names, "estimators": estimator_names,
               "strategies": lambda: list(STRATEGIES)}
+SWEPT = ("scenes", "formulations")  # lists whose items may carry name:key=v1|v2 sweeps
 
 
 @dataclass(frozen=True)
 class RunConfig:
     """Everything that determines a run of the matrix (the options of ``python -m bench run``).
-    Name lists are checked against the registries on construction."""
+    Name lists are checked against the registries on construction; a scene or formulation may
+    carry a sweep, ``paper:poisson_ratio=0.3|0.45`` (see the README)."""
 
     scenes: tuple[str, ...] = ("paper",)
     formulations: tuple[str, ...] = ("mixed",)
@@ -47,17 +62,26 @@ class RunConfig:
     max_memory_gib: float | None = None  # None: what the machine has available, minus a margin
     out: str = "results"
     overwrite: bool = False
+    workers: int = 0  # > 0: a local Dask cluster of this many processes
+    scheduler: str | None = None  # the address of an existing Dask cluster
+    cache: str | None = None  # reference cache folder (default $SIGNORINI_BENCH_CACHE)
     command: str = ""  # how the run was asked for, recorded in run.json
 
     def __post_init__(self):
         for name, valid in NAME_LISTS.items():
-            names = tuple(getattr(self, name))
-            object.__setattr__(self, name, names)
+            items = tuple(getattr(self, name))
+            object.__setattr__(self, name, items)
+            names = [item.split(":")[0] for item in items] if name in SWEPT else list(items)
             unknown = [n for n in names if n not in valid()]
-            if not names or unknown:
-                raise ValueError(f"{name}={list(names)!r}: unknown {', '.join(unknown) or '(none)'}"
-                                 f"; valid: {', '.join(valid())}")
-        for name in ("reference_dofs", "crosscheck_dofs"):
+            if not items or unknown:
+                raise ValueError(f"{name}={list(items)!r}: unknown "
+                                 f"{', '.join(unknown) or '(none)'}; valid: {', '.join(valid())}")
+            if len(set(items)) < len(items):
+                raise ValueError(f"{name}={list(items)!r} names an item twice")
+            if name in SWEPT:
+                for item in items:
+                    parse_item(item, name)
+        for name in ("reference_dofs", "crosscheck_dofs", "workers"):
             value = getattr(self, name)
             if value is not None and not (is_integer(value) and value >= 0):
                 raise ValueError(f"{name}={value!r} is not an integer >= 0")
@@ -71,6 +95,22 @@ class RunConfig:
                           solver_options={"backend": self.backend} if self.backend else {},
                           max_memory_gib=self.max_memory_gib)
 
+    def specs(self) -> list[SequenceSpec]:
+        scenes = [s for item in self.scenes for s in parse_item(item, "scenes")]
+        formulations = [f for item in self.formulations
+                        for f in parse_item(item, "formulations")]
+        return [SequenceSpec(scene=scene, formulation=formulation, solver=solver,
+                             estimator=estimator, strategy=strategy,
+                             scene_parameters=tuple(sorted(parameters)),
+                             formulation_options=tuple(sorted(options)),
+                             max_dofs=self.max_dofs, max_levels=self.max_levels,
+                             marking=self.marking, theta=self.theta, nested=self.nested,
+                             backend=self.backend, reference_dofs=self.reference_dofs,
+                             crosscheck_dofs=self.crosscheck_dofs)
+                for (scene, parameters), (formulation, options), solver, estimator, strategy
+                in itertools.product(scenes, formulations, self.solvers, self.estimators,
+                                     self.strategies)]
+
     def record(self) -> dict:
         """The configuration as written to run.json."""
         return {f.name: getattr(self, f.name) for f in fields(self) if f.name != "command"}
@@ -78,32 +118,69 @@ class RunConfig:
 
 @dataclass(frozen=True, eq=False)
 class RunResult:
-    rows: list[ResultRow]
-    table: pd.DataFrame  # this run's rows
+    rows: list[ResultRow]  # the rows this run computed
+    table: pd.DataFrame  # every row of the run's sequences, reused ones included
     store: ResultStore
+    reused: tuple[str, ...] = ()  # sequence keys taken from earlier runs
 
     @property
     def failed(self) -> list[ResultRow]:
         return [r for r in self.rows if r.status == STATUS_FAILED]
 
 
-def run(config: RunConfig, on_level: Callable[[LevelResult], None] | None = None) -> RunResult:
-    """Run every combination of ``config`` into ``config.out``: results.{parquet,csv} (each
-    level as it finishes), run.json, truth.json, artifacts/ and rates.{csv,md}. Raises
-    ``bench.truth.TruthError`` before any run if a reference cannot judge the runs."""
-    # every truth first: a reference that cannot judge these runs is refused before any run
-    truths = {name: truth_for(get_scene(name), config.reference_dofs, config.max_dofs)
-              for name in config.scenes}
+class RunRefused(ValueError):
+    """A run refused before any sequence started: a bad sweep value or option, or a reference
+    that cannot judge the runs (the message says which)."""
+
+
+def prepare_truths(specs: list[SequenceSpec], out) -> dict:
+    """Every truth the specs need, built (or loaded) before any sequence runs, so that a bad
+    scene parameter or formulation option, or a reference that cannot judge the runs, is
+    refused first (RunRefused)."""
+    try:
+        return _truths(specs, out)
+    except ValueError as error:  # SceneError, TruthError, unknown parameters
+        raise RunRefused(str(error)) from None
+
+
+def _truths(specs: list[SequenceSpec], out) -> dict:
+    truths = {}
+    for spec in specs:
+        check_formulation_options(spec)
+        name = truth_name(spec)
+        if name not in truths:
+            truths[name] = truth_for(build_scene(spec), spec.reference_dofs, spec.max_dofs)
+            write_truth_summary(out, name, truths[name])
+    return truths
+
+
+def run(config: RunConfig, on_level: Callable[[LevelResult], None] | None = None,
+        on_sequence: Callable[[SequenceSpec, str], None] | None = None) -> RunResult:
+    """Run every sequence of ``config`` into ``config.out``: sequences/ (a partition per
+    sequence), results.{parquet,csv}, run.json, truth.json, artifacts/ and rates.{csv,md}.
+    Raises RunRefused before any sequence runs for a bad parameter or an untrustworthy
+    reference."""
+    if config.cache is not None:
+        os.environ["SIGNORINI_BENCH_CACHE"] = str(config.cache)
     store = ResultStore(config.out, overwrite=config.overwrite)
+    specs = config.specs()
+    finished = store.finished_keys()
+    todo = [s for s in specs if s.key not in finished]
+    reused = tuple(s.key for s in specs if s.key in finished)
+    identity = new_run_identity()
+    truths = prepare_truths(todo, store.out)
     (store.out / "run.json").write_text(json.dumps(
-        {"command": config.command, "configuration": config.record()}, indent=1, default=str))
-    rows = run_matrix(config.scenes, config.formulations, config.solvers, config.estimators,
-                      config.strategies, store, config.loop_config(config.strategies[0]),
-                      on_level=on_level, reference_dofs=config.reference_dofs,
-                      crosscheck_dofs=config.crosscheck_dofs, truths=truths)
-    table = store.run_table()
+        {"command": config.command, "configuration": config.record(),
+         "run_id": identity["run_id"], "reused": list(reused)}, indent=1, default=str))
+    if config.workers or config.scheduler:
+        from bench.matrix.distributed import run_on_dask
+
+        rows = run_on_dask(todo, store, identity, config, on_sequence)
+    else:
+        rows = run_specs(todo, store, identity, on_level, truths, config.max_memory_gib,
+                         on_sequence)
+    table = store.consolidate()
+    keys = {s.key for s in specs}
+    table = table[table["sequence_key"].isin(keys)].reindex(columns=COLUMNS)
     write_rates(table, store.out)
-    return RunResult(rows, table, store)
-
-
-__all__ = ["RunConfig", "RunResult", "run"]
+    return RunResult(rows, table.reset_index(drop=True), store, reused)

@@ -1,19 +1,28 @@
-"""The result store: ``results.csv`` and ``results.parquet`` in an output folder.
+"""The result store of an output folder: one partition per sequence, and the consolidated
+``results.parquet`` and ``results.csv`` derived from them.
 
-Every finished row is written immediately (CSV appended, parquet rewritten atomically), so an
-interrupted run loses no finished result. Rows of earlier runs in the same folder are kept
-(``run_id`` tells runs apart) unless ``overwrite`` is set.
+Each sequence writes only its own partition, ``sequences/<sequence key>.parquet``, rewritten
+atomically (a temporary file of the writing process, then a rename) after every finished level,
+so concurrent runs and Dask workers never write the same file and an interrupted run loses no
+finished level. ``consolidate`` rebuilds the two tables from all partitions under a file lock,
+each atomically: no row is lost or duplicated, and a rerun of a sequence replaces its own
+partition. Rows of earlier runs are kept unless ``overwrite`` is set; a folder written by an
+older version (tables, no partitions) is taken over as one partition.
 """
 
 from __future__ import annotations
 
+import fcntl
+import hashlib
 import os
+import shutil
 import sys
+from contextlib import contextmanager
 from pathlib import Path
 
 import pandas as pd
 
-from bench.sequence.rows import COLUMNS, ResultRow
+from bench.sequence.rows import COLUMNS, FINISHED, ResultRow, with_labels
 
 
 class ResultsError(ValueError):
@@ -43,35 +52,118 @@ def read_results(folder: str | Path) -> pd.DataFrame | None:
     return table
 
 
+def atomic_write(frame: pd.DataFrame, path: Path, kind: str) -> None:
+    """Write ``frame`` to ``path`` as parquet or csv through a temporary file of this process."""
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    if kind == "parquet":
+        frame.to_parquet(tmp, index=False)
+    else:
+        frame.to_csv(tmp, index=False)
+    os.replace(tmp, path)
+
+
+@contextmanager
+def folder_lock(folder: Path):
+    """An exclusive lock on ``folder`` (a lock file in it) across processes."""
+    with open(folder / ".lock", "a") as handle:
+        fcntl.flock(handle, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(handle, fcntl.LOCK_UN)
+
+
+class SequenceWriter:
+    """The partition of one sequence: every row as it finishes, then its end reason."""
+
+    def __init__(self, path: Path):
+        self.path, self.rows = path, []
+
+    def append(self, row: ResultRow) -> None:
+        self.rows.append(row.as_dict())
+        self._write()
+
+    def finish(self, end: str) -> None:
+        for row in self.rows:
+            row["sequence_end"] = end
+        self._write()
+
+    def _write(self) -> None:
+        atomic_write(pd.DataFrame(self.rows, columns=COLUMNS), self.path, "parquet")
+
+
 class ResultStore:
     def __init__(self, out: str | Path, overwrite: bool = False):
         self.out = Path(out)
         self.out.mkdir(parents=True, exist_ok=True)
         self.csv, self.parquet = self.out / "results.csv", self.out / "results.parquet"
-        if overwrite:
-            for path in (self.csv, self.parquet):
-                path.unlink(missing_ok=True)
-        self.previous = read_results(self.out)
-        if self.previous is not None and list(self.previous.columns) != COLUMNS:
-            # written by a version with fewer columns: new columns are added, never renamed
-            self.previous = self.previous.reindex(columns=COLUMNS)
-            self.previous.to_csv(self.csv, index=False)
+        self.partitions = self.out / "sequences"
+        with folder_lock(self.out):
+            if overwrite:
+                for path in (self.csv, self.parquet):
+                    path.unlink(missing_ok=True)
+                shutil.rmtree(self.partitions, ignore_errors=True)
+            self.partitions.mkdir(exist_ok=True)
+            self._adopt_tables()
         self.rows: list[dict] = []
+        self.writers: dict[str, SequenceWriter] = {}
+
+    def _adopt_tables(self) -> None:
+        """Tables without partitions (an older version wrote them) become one partition."""
+        if any(self.partitions.glob("*.parquet")):
+            return
+        previous = read_results(self.out)
+        if previous is not None and len(previous):
+            digest = hashlib.sha256(previous.to_csv().encode()).hexdigest()[:12]
+            frame = with_labels(previous.reindex(columns=COLUMNS))
+            atomic_write(frame, self.partitions / f"adopted-{digest}.parquet", "parquet")
+
+    def sequence(self, key: str) -> SequenceWriter:
+        return SequenceWriter(self.partitions / f"{key}.parquet")
 
     def append(self, row: ResultRow) -> None:
+        """Store one finished row in its sequence's partition and consolidate."""
+        key = row.sequence_key or "unkeyed"
+        if key not in self.writers:
+            self.writers[key] = self.sequence(key)
+        self.writers[key].append(row)
         self.rows.append(row.as_dict())
-        frame = pd.DataFrame([row.as_dict()], columns=COLUMNS)
-        frame.to_csv(self.csv, mode="a", header=not self.csv.exists(), index=False)
-        tmp = self.parquet.with_suffix(".parquet.tmp")
-        self.table().to_parquet(tmp, index=False)
-        os.replace(tmp, self.parquet)
+        self.consolidate()
+
+    def finish(self, key: str, end: str) -> None:
+        """Record why the sequence ``key`` ended, in its partition and this run's rows."""
+        if key in self.writers:
+            self.writers[key].finish(end)
+        for row in self.rows:
+            if row["sequence_key"] == key:
+                row["sequence_end"] = end
+        self.consolidate()
+
+    def partition_table(self) -> pd.DataFrame:
+        frames = [pd.read_parquet(path) for path in sorted(self.partitions.glob("*.parquet"))]
+        frames = [f for f in frames if len(f)]
+        if not frames:
+            return pd.DataFrame(columns=COLUMNS)
+        return with_labels(pd.concat(frames, ignore_index=True).reindex(columns=COLUMNS))
+
+    def consolidate(self) -> pd.DataFrame:
+        """results.parquet and results.csv from every partition (under the folder's lock)."""
+        with folder_lock(self.out):
+            table = self.partition_table().sort_values(["run_id"], kind="stable")
+            atomic_write(table, self.parquet, "parquet")
+            atomic_write(table, self.csv, "csv")
+        return table
+
+    def finished_keys(self) -> set[str]:
+        """Keys of the sequences in this folder that ended (not cut short): a rerun with the
+        same spec reuses them."""
+        table = self.partition_table()
+        done = table[table["sequence_end"].isin(FINISHED + ("skipped",))]
+        return set(done["sequence_key"]) - {""}
 
     def table(self) -> pd.DataFrame:
-        """All rows in the folder: earlier runs, then this run's."""
-        current = pd.DataFrame(self.rows, columns=COLUMNS)
-        if self.previous is None or self.previous.empty:
-            return current
-        return pd.concat([self.previous, current], ignore_index=True)
+        """All rows in the folder: earlier runs and this run's."""
+        return self.partition_table()
 
     def run_table(self) -> pd.DataFrame:
         """This run's rows only."""

@@ -22,7 +22,7 @@ from bench.report.tables import (
     rate_verdicts,
     timing_table,
 )
-from bench.sequence.rows import COLUMNS, KEYS
+from bench.sequence.rows import COLUMNS, KEYS, with_labels
 
 TEMPLATES = Path(__file__).with_name("templates")
 HARD_CAPTION = ("Hard cases: the mixed method's inf-sup constant beta_h against ndofs for "
@@ -31,10 +31,20 @@ HARD_CAPTION = ("Hard cases: the mixed method's inf-sup constant beta_h against 
                 "loss against eps_0, with the bar for 'accurate'.")
 
 
+def cut_short(table: pd.DataFrame) -> pd.Series:
+    """Per row: its sequence did not finish (interrupted, or running or killed: a keyed
+    sequence without an end). Rows of older tables carry no key and count as finished."""
+    end, key = table["sequence_end"], table["sequence_key"]
+    return (end == "interrupted") | ((end == "") & (key != ""))
+
+
 def latest_run(table: pd.DataFrame) -> pd.DataFrame:
-    """Keep, per combination, the rows of the most recent run that produced it."""
-    last = table.groupby(KEYS)["run_id"].transform("max")
-    return table[table["run_id"] == last]
+    """Keep, per combination, the rows of its most recent finished run; a cut-short run only
+    where no finished run of that combination exists."""
+    table = with_labels(table)
+    rank = (~cut_short(table)).astype(int).astype(str) + "|" + table["run_id"].astype(str)
+    best = rank.groupby([table[k] for k in KEYS]).transform("max")
+    return table[rank == best]
 
 
 def _read_json(results: Path | None, name: str) -> dict:
@@ -102,4 +112,15 @@ def write_report(table: pd.DataFrame, out: str | Path, results: str | Path | Non
         "hard_run": hard is not None, "hard_figures": hard_figures,
         "n_rows": len(everything), "n_too_coarse": int(rows["reference_too_coarse"]
                                                         .fillna(False).astype(bool).sum()),
+        **_provenance_of_rows(everything, run_info),
     }, out)
+
+
+def _provenance_of_rows(everything: pd.DataFrame, run_info: dict) -> dict:
+    """Which rows an earlier run computed (reused), and which sequences were cut short."""
+    current = run_info.get("run_id")
+    reused = everything[everything["run_id"] != current] if current else everything.iloc[:0]
+    short = everything[cut_short(everything)] if len(everything) else everything
+    return {"n_reused": len(reused), "reused_runs": ", ".join(sorted(set(reused["run_id"]))),
+            "cut_short": ", ".join(sorted({"/".join(str(r[k]) for k in KEYS[:5])
+                                           for _, r in short.iterrows()}))}

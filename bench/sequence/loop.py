@@ -3,8 +3,9 @@
 
 from __future__ import annotations
 
+import functools
 import time
-from collections.abc import Iterator
+from collections.abc import Generator
 from dataclasses import dataclass, field
 
 from skfem import MeshTri
@@ -111,26 +112,28 @@ def memory_refusal(level: int, ndofs: int, solver: str, config: LoopConfig) -> s
 
 def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
                  config: LoopConfig, identity: dict | None = None,
-                 mesh: MeshTri | None = None, truth=None,
-                 crosscheck_dofs: int = 0) -> Iterator[LevelResult]:
+                 mesh: MeshTri | None = None, truth=None, crosscheck_dofs: int = 0,
+                 formulation_options: dict | None = None) -> Generator[LevelResult, None, str]:
     """Yield one ``LevelResult`` per level until the DOF budget or the level count is reached,
-    or a level fails (its row says why). With a ``truth`` (``bench.truth``) every level also
-    gets its errors and effectivity indices; ``identity``: the run's columns (run id,
-    provenance)."""
-    discretise, estimate = get_formulation(formulation), get_estimator(estimator)
+    or a level fails (its row says why); return why it ended (``budget``, ``max_levels``,
+    ``memory``, ``failed``). With a ``truth`` (``bench.truth``) every level also gets its
+    errors and effectivity indices; ``identity``: the run's columns (run id, provenance, sweep
+    labels); ``formulation_options`` go to the formulation's ``discretise``."""
+    discretise = functools.partial(get_formulation(formulation), **(formulation_options or {}))
+    estimate = get_estimator(estimator)
     ident = identity_columns(scene.name, formulation, solver, estimator, config, identity)
     mesh = scene.mesh if mesh is None else mesh
     t_refine, previous = 0.0, None
     for level in range(config.max_levels):
         ndofs = count_free_dofs(scene, mesh)  # the budgets are checked before any assembly
         if level > 0 and ndofs > config.max_dofs:
-            return
+            return "budget"
         refusal = memory_refusal(level, ndofs, solver, config)
         if refusal is not None:
             yield LevelResult(ResultRow(**ident, level=level, ndofs=ndofs,
                                         n_elements=mesh.t.shape[1], status=STATUS_FAILED,
                                         reason=refusal), None, None)
-            return
+            return "memory"
         scene.check_mesh(mesh, level)
         start = time.perf_counter()
         disc = discretise(scene, mesh)
@@ -157,9 +160,12 @@ def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
             if solver != "reference" and disc.ndofs <= crosscheck_dofs:
                 numbers.update(crosscheck_columns(disc, sol))
         yield LevelResult(ResultRow(**ident, **numbers), sol, est)
-        if failed or (config.strategy == "uniform"
-                      and predict_uniform_free_dofs(scene, mesh) > config.max_dofs):
-            return
+        if failed:
+            return "failed"
+        if config.strategy == "uniform" and predict_uniform_free_dofs(scene, mesh) > \
+                config.max_dofs:
+            return "budget"
         start = time.perf_counter()
         mesh = refine(mesh, sol, est, config)
         t_refine = time.perf_counter() - start
+    return "max_levels"

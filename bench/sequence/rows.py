@@ -69,6 +69,10 @@ class ResultRow:
     inf_sup: float = math.nan
     pressure_oscillation: float = math.nan
     t_diagnostics: float = math.nan
+    scene_parameters: str = ""  # a sweep's scene parameters, "name=value:name=value"
+    formulation_options: str = ""  # a sweep's formulation options, the same way
+    sequence_key: str = ""  # hash of everything that determines the sequence
+    sequence_end: str = ""  # why it ended: budget, max_levels, memory, failed, interrupted
     run_id: str = ""
     commit: str = ""
     python: str = ""
@@ -80,7 +84,11 @@ class ResultRow:
 
 
 COLUMNS = [f.name for f in fields(ResultRow)]
-KEYS = ["scene", "formulation", "solver", "estimator", "strategy"]  # identity of a combination
+# identity of a combination (the sweep labels are empty outside sweeps)
+KEYS = ["scene", "formulation", "solver", "estimator", "strategy", "scene_parameters",
+        "formulation_options"]
+LABELS = ["scene_parameters", "formulation_options"]
+FINISHED = ("budget", "max_levels", "memory", "failed")  # sequence_end of a complete sequence
 # the phases of a level whose wall times add up to the level's time
 PHASE_TIMES = ["t_assemble", "t_solve", "t_estimate", "t_refine"]
 
@@ -88,10 +96,21 @@ PHASE_TIMES = ["t_assemble", "t_solve", "t_estimate", "t_refine"]
 def identity_columns(scene: str, formulation: str, solver: str, estimator: str, config,
                      run: dict | None = None) -> dict:
     """The columns that name a sequence: the combination, its marking (``config`` is a
-    ``bench.sequence.loop.LoopConfig``) and the run's identity and provenance (``run``)."""
+    ``bench.sequence.loop.LoopConfig``) and the run's identity, sweep labels and provenance
+    (``run``)."""
     return dict(scene=scene, formulation=formulation, solver=solver, estimator=estimator,
                 strategy=config.strategy, marking=config.marking, theta=config.theta,
                 **(run or {}))
+
+
+def with_labels(frame):
+    """A result table with the sweep label columns present and empty strings for missing
+    labels (rows of older tables), so that grouping by KEYS keeps every row."""
+    frame = frame.copy()
+    for column in LABELS + ["sequence_key", "sequence_end"]:
+        frame[column] = (frame[column].astype(object).fillna("").astype(str) if column in frame
+                         else "")
+    return frame
 
 
 def level_time(row: ResultRow) -> float:

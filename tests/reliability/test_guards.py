@@ -141,9 +141,10 @@ def test_a_truncated_parquet_falls_back_to_its_csv_mirror(small_results, tmp_pat
     parquet.write_bytes(parquet.read_bytes()[:200])
     assert main(["report", "--results", str(small_results), "--out", str(tmp_path / "rep")]) == 0
     assert "using its CSV mirror" in capsys.readouterr().err
+    # a run into the folder rebuilds the tables from the sequences' partitions
+    rows = len(pd.read_csv(small_results / "results.csv"))
     assert main(["run", "--max-dofs", "300", "--out", str(small_results)]) == 0
-    assert len(pd.read_parquet(parquet)) == 2 * len(pd.read_csv(small_results / "results.csv")
-                                                    .query("run_id == run_id.iloc[0]"))
+    assert len(pd.read_parquet(parquet)) == rows
 
 
 def test_a_results_folder_with_both_tables_broken_is_named(small_results, tmp_path, capsys):

@@ -105,8 +105,11 @@ def test_store_adds_new_columns_to_results_of_an_older_version(tmp_path):
     old.to_parquet(tmp_path / "results.parquet")
     old.to_csv(tmp_path / "results.csv", index=False)
     store = ResultStore(tmp_path)
-    assert list(store.previous.columns) == COLUMNS
-    assert list(pd.read_csv(tmp_path / "results.csv").columns) == COLUMNS
+    # taken over as a partition with every column, kept in the consolidated tables
+    assert list(store.table().columns) == COLUMNS and len(store.table()) == 1
+    store.consolidate()
+    table = pd.read_csv(tmp_path / "results.csv")
+    assert list(table.columns) == COLUMNS and table["energy"].tolist() == [1.0]
 
 
 def test_every_row_carries_the_stability_diagnostics(tmp_path):

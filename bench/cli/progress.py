@@ -1,0 +1,43 @@
+"""A live progress line for the whole matrix on standard error: sequences done, running and
+left, the most DOFs reached, elapsed and estimated remaining time. Quiet when standard error is
+not a terminal."""
+
+from __future__ import annotations
+
+import sys
+import time
+
+
+class Progress:
+    def __init__(self, total: int, stream=None):
+        self.stream = sys.stderr if stream is None else stream
+        self.live = self.stream.isatty()
+        self.total, self.done, self.dofs = total, 0, 0
+        self.start = time.perf_counter()
+
+    def level(self, then):
+        """A per-level callback that also updates the line (``then``: the per-level printer)."""
+        def on_level(result) -> None:
+            then(result)
+            self.dofs = max(self.dofs, int(result.row.ndofs))
+            self.show()
+        return on_level
+
+    def sequence(self, spec, end: str) -> None:
+        self.done += 1
+        self.show()
+
+    def show(self) -> None:
+        if not self.live:
+            return
+        elapsed = time.perf_counter() - self.start
+        left = self.total - self.done
+        eta = f"{elapsed / self.done * left:6.0f} s" if self.done else "     ?"
+        self.stream.write(f"\r[matrix] {self.done}/{self.total} sequences done, {left} left, "
+                          f"max {self.dofs} DOFs, {elapsed:6.0f} s elapsed, ~{eta} to go ")
+        self.stream.flush()
+
+    def close(self) -> None:
+        if self.live:
+            self.stream.write("\n")
+            self.stream.flush()

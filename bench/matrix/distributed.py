@@ -1,0 +1,83 @@
+"""The matrix on Dask (``dask.distributed``): one task per sequence, on a local cluster of
+``workers`` processes with one thread each (so that BLAS and the factorisations do not
+oversubscribe the cores) or on an existing cluster at ``scheduler``. Every task writes only its
+own partition of the store; the driver consolidates as tasks finish. A task whose worker dies is
+rerun by Dask and rewrites the same partition, so nothing is lost or duplicated. References are
+built by the driver before any task starts (``run.prepare_truths``); tasks load them from the
+cache, which must be shared storage for a remote cluster (``--cache``)."""
+
+from __future__ import annotations
+
+import os
+from dataclasses import replace
+from pathlib import Path
+
+from bench.matrix.spec import SequenceSpec
+from bench.matrix.store import ResultStore, SequenceWriter
+from bench.matrix.task import Outcome, run_spec
+from bench.sequence.memory import available_gib
+from bench.truth import truth_for
+
+SINGLE_THREAD = {name: "1" for name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS",
+                                        "MKL_NUM_THREADS")}
+
+
+def sequence_task(spec: SequenceSpec, out: str, run: dict, cache: str | None,
+                  max_memory_gib: float | None) -> Outcome:
+    """One sequence on a worker: its rows go to its own partition as they finish."""
+    if cache is not None:
+        os.environ["SIGNORINI_BENCH_CACHE"] = cache
+    writer = SequenceWriter(Path(out) / "sequences" / f"{spec.key}.parquet")
+    rows = []
+
+    def record(result) -> None:
+        writer.append(result.row)
+        rows.append(result.row)
+
+    end = run_spec(spec, run, out, lambda scene: truth_for(scene, spec.reference_dofs,
+                                                           spec.max_dofs), record,
+                   max_memory_gib)
+    writer.finish(end)
+    return Outcome(spec.key, end, tuple(replace(r, sequence_end=end) for r in rows))
+
+
+def client_for(config):
+    """A client of the cluster at ``config.scheduler``, or of a new local cluster."""
+    from dask.distributed import Client, LocalCluster
+
+    if config.scheduler:
+        return Client(config.scheduler), None
+    cluster = LocalCluster(n_workers=config.workers, threads_per_worker=1, processes=True,
+                           env=SINGLE_THREAD, dashboard_address=":0")
+    client = Client(cluster)
+    print(f"Dask dashboard: {client.dashboard_link}", flush=True)
+    return client, cluster
+
+
+def run_on_dask(specs: list[SequenceSpec], store: ResultStore, run: dict, config,
+                on_sequence=None) -> list:
+    """Run ``specs`` as Dask tasks; returns the rows they computed."""
+    from dask.distributed import as_completed
+
+    client, cluster = client_for(config)
+    workers = max(len(client.scheduler_info()["workers"]), 1)
+    memory = config.max_memory_gib
+    if memory is None and not config.scheduler:  # the local workers share this machine
+        memory = available_gib() / workers
+    cache = config.cache or os.environ.get("SIGNORINI_BENCH_CACHE")
+    try:
+        futures = {client.submit(sequence_task, spec, str(store.out), run, cache, memory,
+                                 key=f"sequence-{spec.key}-{run['run_id']}", pure=False): spec
+                   for spec in specs}
+        rows = []
+        for future in as_completed(futures):
+            outcome = future.result()
+            rows += outcome.rows
+            store.consolidate()
+            if on_sequence is not None:
+                on_sequence(futures[future], outcome.end)
+        return rows
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()

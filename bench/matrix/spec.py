@@ -1,0 +1,106 @@
+"""One sequence of a run, fully specified: ``SequenceSpec``. Its ``key`` hashes everything that
+determines its rows, so a rerun can tell a finished sequence from one to compute, and its
+partition of the result store is named by it. Parameter sweeps (``paper:poisson_ratio=0.3|0.45``)
+are parsed here into one spec per value."""
+
+from __future__ import annotations
+
+import hashlib
+import inspect
+import itertools
+import json
+from dataclasses import asdict, dataclass
+
+from bench.sequence.loop import LoopConfig
+from formulations import get_formulation
+from scenes import get_scene
+from scenes.registry import SCENES
+
+SPEC_VERSION = 1  # bump when the rows of an unchanged spec would change
+
+
+@dataclass(frozen=True)
+class SequenceSpec:
+    scene: str
+    formulation: str
+    solver: str
+    estimator: str
+    strategy: str
+    scene_parameters: tuple[tuple[str, object], ...] = ()
+    formulation_options: tuple[tuple[str, object], ...] = ()
+    max_dofs: int = 20000
+    max_levels: int = 40
+    marking: str = "doerfler"
+    theta: float = 0.5
+    nested: bool = True
+    backend: str | None = None
+    reference_dofs: int | None = None
+    crosscheck_dofs: int = 0
+
+    @property
+    def key(self) -> str:
+        text = json.dumps({**asdict(self), "version": SPEC_VERSION}, sort_keys=True, default=str)
+        return hashlib.sha256(text.encode()).hexdigest()[:20]
+
+    def loop_config(self, max_memory_gib: float | None = None) -> LoopConfig:
+        return LoopConfig(strategy=self.strategy, max_dofs=self.max_dofs,
+                          max_levels=self.max_levels, marking=self.marking, theta=self.theta,
+                          nested=self.nested, max_memory_gib=max_memory_gib,
+                          solver_options={"backend": self.backend} if self.backend else {})
+
+    @property
+    def labels(self) -> dict[str, str]:
+        """The sweep columns of the rows: 'name=value:name=value', empty for the defaults."""
+        return {"scene_parameters": label(self.scene_parameters),
+                "formulation_options": label(self.formulation_options)}
+
+
+def label(pairs) -> str:
+    return ":".join(f"{k}={v}" for k, v in pairs)
+
+
+def parse_value(text: str):
+    """A sweep value as written: int, else float, else the string."""
+    for kind in (int, float):
+        try:
+            return kind(text)
+        except ValueError:
+            pass
+    return text
+
+
+def parse_item(item: str, kind: str) -> list[tuple[str, tuple]]:
+    """'name:key=v1|v2:other=w' -> one (name, ((key, v), (other, w))) per combination of
+    values; the name alone gives (name, ())."""
+    name, *parts = item.split(":")
+    names, values = [], []
+    for part in parts:
+        key, sep, choices = part.partition("=")
+        if not sep or not key or not choices:
+            raise ValueError(f"{kind}={item!r}: {part!r} is not key=value or key=v1|v2")
+        names.append(key.strip())
+        values.append([parse_value(v.strip()) for v in choices.split("|")])
+    return [(name.strip(), tuple(zip(names, combo, strict=True)))
+            for combo in itertools.product(*values)]
+
+
+def check_parameters(kind: str, name: str, pairs, function) -> None:
+    """Refuse a parameter the scene factory or ``discretise`` does not take, listing those
+    it does."""
+    accepted = [p for p in inspect.signature(function).parameters
+                if p not in ("scene", "mesh")]
+    unknown = [k for k, _ in pairs if k not in accepted]
+    if unknown:
+        raise ValueError(f"{kind} {name!r} has no parameter {', '.join(map(repr, unknown))}; "
+                         f"its parameters: {', '.join(accepted) or '(none)'}")
+
+
+def build_scene(spec: SequenceSpec):
+    """The spec's scene, its parameters checked by name here and by value by the scene."""
+    check_parameters("scene", spec.scene, spec.scene_parameters, SCENES.get(spec.scene))
+    return get_scene(spec.scene, **dict(spec.scene_parameters))
+
+
+def check_formulation_options(spec: SequenceSpec) -> None:
+    check_parameters("formulation", spec.formulation, spec.formulation_options,
+                     get_formulation(spec.formulation))

@@ -1,0 +1,85 @@
+"""One sequence of a run as a task: build its scene, run it, record every level, and return
+why it ended. The same function runs in-process and on a Dask worker."""
+
+from __future__ import annotations
+
+import traceback
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from bench.matrix.artifacts import save_artifact
+from bench.matrix.spec import SequenceSpec, build_scene, check_formulation_options
+from bench.sequence.loop import LevelResult, run_sequence
+from bench.sequence.rows import ResultRow, identity_columns
+from estimators.base import ESTIMATORS
+from formulations import STATUS_FAILED, STATUS_SKIPPED
+from formulations.registry import FORMULATIONS
+from formulations.solvers.registry import SOLVERS
+from scenes import Scene
+
+SKIPPED, INTERRUPTED = "skipped", "interrupted"
+
+
+@dataclass(frozen=True)
+class Outcome:
+    key: str
+    end: str
+    rows: tuple[ResultRow, ...] = ()
+
+
+def why_skipped(scene: Scene, formulation: str, solver: str, estimator: str) -> str | None:
+    """The reason a combination is impossible (declared by the registrations), or None."""
+    return (FORMULATIONS.why_not(formulation, scene=scene)
+            or SOLVERS.why_not(solver, scene=scene, formulation=formulation)
+            or ESTIMATORS.why_not(estimator, scene=scene, formulation=formulation))
+
+
+def sequence_identity(spec: SequenceSpec, run: dict) -> dict:
+    return identity_columns(spec.scene, spec.formulation, spec.solver, spec.estimator,
+                            spec.loop_config(), {**run, **spec.labels, "sequence_key": spec.key})
+
+
+def drain(sequence, record: Callable[[LevelResult], None]) -> tuple[str, LevelResult | None]:
+    """Record every level of a ``run_sequence`` generator; its end reason and last solved
+    level."""
+    last = None
+    while True:
+        try:
+            result = next(sequence)
+        except StopIteration as stop:
+            return stop.value, last
+        record(result)
+        last = result if result.solution is not None else last
+
+
+def run_spec(spec: SequenceSpec, run: dict, out, truth_of: Callable[[Scene], object],
+             record: Callable[[LevelResult], None], max_memory_gib: float | None = None) -> str:
+    """Run ``spec`` (``run``: the run's identity columns; ``truth_of(scene)``: its truth);
+    every level goes to ``record``; the last solved level is saved as an artifact. An
+    impossible combination is one ``skipped`` row, an exception one ``failed`` row (level -1)
+    with its type and message. Returns why the sequence ended."""
+    names = sequence_identity(spec, run)
+    try:
+        scene = build_scene(spec)
+        check_formulation_options(spec)
+        reason = why_skipped(scene, spec.formulation, spec.solver, spec.estimator)
+        if reason is not None:
+            record(whole_sequence_row(names, STATUS_SKIPPED, reason))
+            return SKIPPED
+        end, last = drain(run_sequence(
+            scene, spec.formulation, spec.solver, spec.estimator,
+            spec.loop_config(max_memory_gib), run | spec.labels | {"sequence_key": spec.key},
+            truth=truth_of(scene), crosscheck_dofs=spec.crosscheck_dofs,
+            formulation_options=dict(spec.formulation_options)), record)
+        if last is not None:
+            save_artifact(out, last)
+        return end
+    except Exception as error:  # recorded, never silent: the row carries type and message
+        record(whole_sequence_row(names, STATUS_FAILED, f"{type(error).__name__}: {error}"))
+        traceback.print_exc()
+        return STATUS_FAILED
+
+
+def whole_sequence_row(names: dict, status: str, reason: str) -> LevelResult:
+    """One row (level -1) standing for a whole sequence that was skipped or crashed."""
+    return LevelResult(ResultRow(level=-1, status=status, reason=reason, **names), None, None)
