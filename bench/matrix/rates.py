@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from bench.sequence.rows import KEYS
+from bench.sequence.rows import KEYS, with_labels
 from formulations import STATUS_OK
 
 RATE_LEVELS = 4
@@ -29,7 +29,7 @@ def slope(group: pd.DataFrame, column: str, levels: int = RATE_LEVELS) -> float:
 
 def rates_table(table: pd.DataFrame, levels: int = RATE_LEVELS) -> pd.DataFrame:
     rows = []
-    table = table[table["level"] >= 0]
+    table = with_labels(table[table["level"] >= 0])
     for key, group in table.groupby(KEYS, sort=True):
         group = group.sort_values("level")
         ok = group[group["status"] == STATUS_OK]

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from bench.sequence.rows import KEYS, phase_time
+from bench.sequence.rows import KEYS, LABELS, phase_time
 from bench.verify import claims
 from formulations import STATUS_OK
 
@@ -36,27 +36,35 @@ def rate_verdicts(rates: pd.DataFrame) -> pd.DataFrame:
         measured = r["error_rate"] if np.isfinite(r["error_rate"]) else r["eta_rate"]
         rows.append({"scene": r["scene"], "formulation": r["formulation"],
                      "estimator": r["estimator"], "strategy": r["strategy"],
+                     **{c: r.get(c, "") for c in LABELS},
                      "error rate": _fmt(r["error_rate"]), "eta rate": _fmt(r["eta_rate"]),
                      "pressure error rate": _fmt(r["pressure_error_rate"]),
                      "claimed": _fmt(claimed), "source": source,
                      "verdict": _verdict(measured, claimed) if np.isfinite(claimed) else ""})
-    return pd.DataFrame(rows)
+    return without_empty_labels(pd.DataFrame(rows))
 
 
 def effectivity_table(rates: pd.DataFrame) -> pd.DataFrame:
     if rates.empty:
         return pd.DataFrame()
-    return pd.DataFrame({
+    return without_empty_labels(pd.DataFrame({
         "scene": rates["scene"], "formulation": rates["formulation"],
         "estimator": rates["estimator"], "strategy": rates["strategy"],
+        **{c: rates[c] for c in LABELS if c in rates},
         "last": rates["effectivity_last"].map(_fmt), "min": rates["effectivity_min"].map(_fmt),
         "max": rates["effectivity_max"].map(_fmt),
         "max/min": rates["effectivity_variation"].map(_fmt),
-        "rows with too coarse reference": rates["too_coarse_rows"]})
+        "rows with too coarse reference": rates["too_coarse_rows"]}))
 
 
 def _total_time(group: pd.DataFrame) -> float:
     return float(phase_time(group).sum())
+
+
+def without_empty_labels(table: pd.DataFrame) -> pd.DataFrame:
+    """The table without sweep label columns that are empty in every row."""
+    empty = [c for c in LABELS if c in table and not table[c].astype(str).str.len().any()]
+    return table.drop(columns=empty)
 
 
 def accuracy_table(rows: pd.DataFrame) -> pd.DataFrame:
@@ -76,7 +84,7 @@ def accuracy_table(rows: pd.DataFrame) -> pd.DataFrame:
                     "pressure oscillation": _fmt(last.get("pressure_oscillation")),
                     "inf-sup": _fmt(last.get("inf_sup")),
                     "total time [s]": _fmt(_total_time(group), ".3g"), "status": last["status"]})
-    return pd.DataFrame(out)
+    return without_empty_labels(pd.DataFrame(out))
 
 
 def timing_table(rows: pd.DataFrame) -> pd.DataFrame:
@@ -118,4 +126,4 @@ def agreement_table(rows: pd.DataFrame) -> pd.DataFrame:
 def failure_table(everything: pd.DataFrame) -> pd.DataFrame:
     bad = everything[everything["status"].fillna("missing") != STATUS_OK]
     cols = [*KEYS, "level", "status", "reason"]
-    return bad[cols].astype(str) if len(bad) else pd.DataFrame()
+    return without_empty_labels(bad[cols].astype(str)) if len(bad) else pd.DataFrame()

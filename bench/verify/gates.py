@@ -62,7 +62,7 @@ def check_gates(expected: dict, rates: pd.DataFrame,
             verdicts.append(Verdict(gate["name"], "(no rows)", np.nan, low, high, False, source))
         for row in selected:
             value = float(row[gate["quantity"]])
-            label = "/".join(str(row[k]) for k in KEYS if k in row)
+            label = "/".join(str(row[k]) for k in KEYS if k in row and str(row[k]))
             verdicts.append(Verdict(gate["name"], label, value, low, high,
                                     bool(low <= value <= high), source))
     return verdicts
