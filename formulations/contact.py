@@ -49,9 +49,8 @@ class ContactTrace:
 
     def coordinates_at(self, t: np.ndarray) -> np.ndarray:
         """Contact coordinates at local coordinates t in [0, 1] on each facet; shape
-        (n, len(t)) (the coordinate is affine along a facet of a straight Gamma_C)."""
-        s0, s1 = self.coordinate
-        return s0[:, None] + (s1 - s0)[:, None] * np.asarray(t)[None, :]
+        (n, len(t))."""
+        return facet_coordinates(self.coordinate, t)
 
     def normal_displacement(self, u_nodal: np.ndarray, t: np.ndarray) -> np.ndarray:
         """u_h . n at local coordinates t (P1: linear along each facet); shape (n, len(t))."""
@@ -62,6 +61,13 @@ class ContactTrace:
     def integrate(self, values: np.ndarray, w: np.ndarray) -> np.ndarray:
         """Per-facet integrals of ``values`` (n, nq) given at points with weights w on [0, 1]."""
         return (values * w[None, :]).sum(axis=1) * self.length
+
+
+def facet_coordinates(coordinate: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """Contact coordinates at local coordinates t in [0, 1] of facets whose end points are
+    ``coordinate`` (2, n); shape (n, len(t)) (affine along a facet of a straight Gamma_C)."""
+    s0, s1 = coordinate
+    return s0[:, None] + (s1 - s0)[:, None] * np.asarray(t)[None, :]
 
 
 def outer_normals(mesh: MeshTri, v0: np.ndarray, v1: np.ndarray, element: np.ndarray):

@@ -141,6 +141,9 @@ def discretise(scene: Scene, mesh: MeshTri,
     qp = slack_qp(elasticity, P, gap.ravel(), young / epsilon_0 * np.tile(w, nf), young)
     epsilon = epsilon_0 * trace.length / young
     s_points = trace.coordinates_at(t)
+    # per slack row: eps, and Gauss weight x facet length (the row's share of Gamma_C)
+    row_epsilon, row_length = np.repeat(epsilon, nq), np.tile(w, nf) * np.repeat(trace.length, nq)
+    pressure_floor = young * np.abs(gap).max(initial=0.0) / trace.length.sum()
 
     def transfer(previous: DiscreteSolution) -> np.ndarray:
         pressing = previous.pressure_at(s_points.ravel()) > 0  # u_n - s <= g active
@@ -149,10 +152,9 @@ def discretise(scene: Scene, mesh: MeshTri,
     def recover(answer: QPSolution, residuals: Residuals, status: str,
                 reason: str) -> DiscreteSolution:
         u_free = answer.u[:n]
-        mismatch = pressure_mismatch(P @ u_free - gap.ravel(), np.repeat(epsilon, nq),
-                                     answer.multipliers[:ns], np.tile(w, nf)
-                                     * np.repeat(trace.length, nq), young
-                                     * np.abs(gap).max(initial=0.0) / trace.length.sum())
+        penetration_at_points = P @ u_free - gap.ravel()
+        mismatch = pressure_mismatch(penetration_at_points, row_epsilon,
+                                     answer.multipliers[:ns], row_length, pressure_floor)
         if status == STATUS_OK and mismatch > PRESSURE_CONSISTENCY:
             status, reason = STATUS_INACCURATE, (
                 f"penalty pressure (u_hn - g_h)_+/eps disagrees with the QP multipliers by "
@@ -164,7 +166,7 @@ def discretise(scene: Scene, mesh: MeshTri,
             penetration = trace.normal_displacement(u_nodal, tt) - gap_h(tt)
             return np.maximum(penetration, 0.0) / epsilon[:, None]
 
-        penetrating = int((P @ u_free - gap.ravel() > 0).sum())
+        penetrating = int((penetration_at_points > 0).sum())
         return discrete_solution(
             "penalty", elasticity, trace, answer, residuals, status, reason, u_free=u_free,
             pressure=pressure, multiplier_breaks=np.append(trace.coordinate[0],

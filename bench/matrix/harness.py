@@ -3,7 +3,6 @@ run, in this process (``run_specs``); ``bench.matrix.distributed`` runs the same
 
 from __future__ import annotations
 
-import itertools
 import json
 import secrets
 import time
@@ -11,11 +10,11 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from bench.matrix.provenance import provenance
-from bench.matrix.spec import SequenceSpec
+from bench.matrix.spec import SequenceSpec, cross_product
 from bench.matrix.store import ResultStore
-from bench.matrix.task import INTERRUPTED, run_spec
+from bench.matrix.task import run_spec
 from bench.sequence.loop import LevelResult, LoopConfig
-from bench.sequence.rows import ResultRow
+from bench.sequence.rows import INTERRUPTED, ResultRow
 from bench.truth import truth_for
 
 
@@ -47,16 +46,13 @@ def specs_for(scenes: Sequence[str], formulations: Sequence[str], solvers: Seque
               reference_dofs: int | None = None, crosscheck_dofs: int = 0,
               scene_parameters: dict | None = None) -> list[SequenceSpec]:
     """The cross product as specs (``config`` gives the loop settings)."""
-    backend = config.solver_options.get("backend")
-    return [SequenceSpec(scene=scene, formulation=formulation, solver=solver,
-                         estimator=estimator, strategy=strategy,
-                         scene_parameters=tuple(sorted((scene_parameters or {}).items())),
-                         max_dofs=config.max_dofs, max_levels=config.max_levels,
-                         marking=config.marking, theta=config.theta, nested=config.nested,
-                         backend=backend, reference_dofs=reference_dofs,
-                         crosscheck_dofs=crosscheck_dofs)
-            for scene, formulation, solver, estimator, strategy in itertools.product(
-                scenes, formulations, solvers, estimators, strategies)]
+    parameters = tuple((scene_parameters or {}).items())
+    return cross_product([(s, parameters) for s in scenes], [(f, ()) for f in formulations],
+                         solvers, estimators, strategies, max_dofs=config.max_dofs,
+                         max_levels=config.max_levels, marking=config.marking,
+                         theta=config.theta, nested=config.nested,
+                         backend=config.solver_options.get("backend"),
+                         reference_dofs=reference_dofs, crosscheck_dofs=crosscheck_dofs)
 
 
 def run_specs(specs: Sequence[SequenceSpec], store: ResultStore, run: dict,
@@ -78,9 +74,9 @@ def run_specs(specs: Sequence[SequenceSpec], store: ResultStore, run: dict,
         name = truth_name(spec)
 
         def truth_of(scene, name=name, spec=spec):
-            if name not in truths:
+            if name not in truths:  # run() prepares them; run_matrix builds them here
                 truths[name] = truth_for(scene, spec.reference_dofs, spec.max_dofs)
-            write_truth_summary(store.out, name, truths[name])
+                write_truth_summary(store.out, name, truths[name])
             return truths[name]
         try:
             end = run_spec(spec, run, store.out, truth_of, record, max_memory_gib)

@@ -8,7 +8,6 @@ recomputed, unless ``overwrite``."""
 
 from __future__ import annotations
 
-import itertools
 import json
 import os
 from collections.abc import Callable
@@ -22,10 +21,11 @@ from bench.matrix.spec import (
     SequenceSpec,
     build_scene,
     check_formulation_options,
+    cross_product,
     parse_item,
 )
 from bench.matrix.store import ResultStore
-from bench.sequence.loop import STRATEGIES, LevelResult, LoopConfig
+from bench.sequence.loop import STRATEGIES, LevelResult
 from bench.sequence.rows import COLUMNS, ResultRow
 from bench.truth import truth_for
 from estimators import estimator_names
@@ -87,29 +87,16 @@ class RunConfig:
                 raise ValueError(f"{name}={value!r} is not an integer >= 0")
         if self.backend is not None:
             check_backend(self.backend)
-        self.loop_config(self.strategies[0])  # validates the loop's options
-
-    def loop_config(self, strategy: str) -> LoopConfig:
-        return LoopConfig(strategy=strategy, max_dofs=self.max_dofs, max_levels=self.max_levels,
-                          marking=self.marking, theta=self.theta, nested=self.nested,
-                          solver_options={"backend": self.backend} if self.backend else {},
-                          max_memory_gib=self.max_memory_gib)
+        self.specs()[0].loop_config(self.max_memory_gib)  # validates the loop's options
 
     def specs(self) -> list[SequenceSpec]:
-        scenes = [s for item in self.scenes for s in parse_item(item, "scenes")]
-        formulations = [f for item in self.formulations
-                        for f in parse_item(item, "formulations")]
-        return [SequenceSpec(scene=scene, formulation=formulation, solver=solver,
-                             estimator=estimator, strategy=strategy,
-                             scene_parameters=tuple(sorted(parameters)),
-                             formulation_options=tuple(sorted(options)),
-                             max_dofs=self.max_dofs, max_levels=self.max_levels,
-                             marking=self.marking, theta=self.theta, nested=self.nested,
-                             backend=self.backend, reference_dofs=self.reference_dofs,
-                             crosscheck_dofs=self.crosscheck_dofs)
-                for (scene, parameters), (formulation, options), solver, estimator, strategy
-                in itertools.product(scenes, formulations, self.solvers, self.estimators,
-                                     self.strategies)]
+        return cross_product(
+            [s for item in self.scenes for s in parse_item(item, "scenes")],
+            [f for item in self.formulations for f in parse_item(item, "formulations")],
+            self.solvers, self.estimators, self.strategies, max_dofs=self.max_dofs,
+            max_levels=self.max_levels, marking=self.marking, theta=self.theta,
+            nested=self.nested, backend=self.backend, reference_dofs=self.reference_dofs,
+            crosscheck_dofs=self.crosscheck_dofs)
 
     def record(self) -> dict:
         """The configuration as written to run.json."""

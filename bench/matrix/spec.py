@@ -55,6 +55,18 @@ class SequenceSpec:
                 "formulation_options": label(self.formulation_options)}
 
 
+def cross_product(scenes, formulations, solvers, estimators, strategies,
+                  **settings) -> list[SequenceSpec]:
+    """Every combination as a spec; ``scenes`` and ``formulations`` are (name, parameter
+    pairs) as ``parse_item`` gives them, ``settings`` the remaining fields."""
+    return [SequenceSpec(scene=scene, formulation=formulation, solver=solver,
+                         estimator=estimator, strategy=strategy,
+                         scene_parameters=tuple(sorted(parameters)),
+                         formulation_options=tuple(sorted(options)), **settings)
+            for (scene, parameters), (formulation, options), solver, estimator, strategy
+            in itertools.product(scenes, formulations, solvers, estimators, strategies)]
+
+
 def label(pairs) -> str:
     return ":".join(f"{k}={v}" for k, v in pairs)
 

@@ -17,8 +17,6 @@ from formulations.registry import FORMULATIONS
 from formulations.solvers.registry import SOLVERS
 from scenes import Scene
 
-SKIPPED, INTERRUPTED = "skipped", "interrupted"
-
 
 @dataclass(frozen=True)
 class Outcome:
@@ -34,9 +32,14 @@ def why_skipped(scene: Scene, formulation: str, solver: str, estimator: str) -> 
             or ESTIMATORS.why_not(estimator, scene=scene, formulation=formulation))
 
 
+def run_columns(spec: SequenceSpec, run: dict) -> dict:
+    """The run's identity columns with the spec's sweep labels and key."""
+    return {**run, **spec.labels, "sequence_key": spec.key}
+
+
 def sequence_identity(spec: SequenceSpec, run: dict) -> dict:
     return identity_columns(spec.scene, spec.formulation, spec.solver, spec.estimator,
-                            spec.loop_config(), {**run, **spec.labels, "sequence_key": spec.key})
+                            spec.loop_config(), run_columns(spec, run))
 
 
 def drain(sequence, record: Callable[[LevelResult], None]) -> tuple[str, LevelResult | None]:
@@ -65,10 +68,10 @@ def run_spec(spec: SequenceSpec, run: dict, out, truth_of: Callable[[Scene], obj
         reason = why_skipped(scene, spec.formulation, spec.solver, spec.estimator)
         if reason is not None:
             record(whole_sequence_row(names, STATUS_SKIPPED, reason))
-            return SKIPPED
+            return STATUS_SKIPPED  # also its end reason
         end, last = drain(run_sequence(
             scene, spec.formulation, spec.solver, spec.estimator,
-            spec.loop_config(max_memory_gib), run | spec.labels | {"sequence_key": spec.key},
+            spec.loop_config(max_memory_gib), run_columns(spec, run),
             truth=truth_of(scene), crosscheck_dofs=spec.crosscheck_dofs,
             formulation_options=dict(spec.formulation_options)), record)
         if last is not None:

@@ -1,5 +1,5 @@
-"""Contact quantities of a discrete solution: samples of lambda_h along Gamma_C, the contact
-zone, its distance to a true zone, and the penetration of the obstacle."""
+"""Contact quantities of a discrete solution: the contact zone, its distance to a true zone,
+and the penetration of the obstacle."""
 
 from __future__ import annotations
 
@@ -7,13 +7,6 @@ import numpy as np
 
 from formulations import DiscreteSolution
 from formulations.kkt import ACTIVE_FRACTION
-
-
-def facet_samples(coordinate: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """Contact coordinates of the local points ``t`` in [0, 1] of every facet, shape
-    (n_facets, len(t)); ``coordinate`` (2, n_facets) are the facets' end points."""
-    s0, s1 = coordinate
-    return s0[:, None] + (s1 - s0)[:, None] * np.asarray(t)[None, :]
 
 
 def contact_zone(solution: DiscreteSolution) -> tuple[float, float]:

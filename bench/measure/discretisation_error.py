@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 from skfem import Basis, ElementTriP1, ElementVector
 
-from bench.measure.contact import contact_zone, facet_samples, zone_error
+from bench.measure.contact import contact_zone, zone_error
 from formulations import DiscreteSolution
 from formulations.contact import gauss_legendre
 from formulations.elasticity import stress_from_gradient
@@ -50,7 +50,7 @@ def pressure_error(solution: DiscreteSolution, true_pressure, trace=None) -> flo
     u_h's), with ``true_pressure(s)`` a function of the contact coordinate."""
     trace = solution.trace if trace is None else trace
     t, w = gauss_legendre(PRESSURE_POINTS)
-    s = facet_samples(trace.coordinate, t)
+    s = trace.coordinates_at(t)
     diff = true_pressure(s) - solution.pressure_at(s.ravel()).reshape(s.shape)
     return float(np.sqrt(trace.integrate(diff**2, w).sum()))
 

@@ -14,11 +14,11 @@ from matplotlib.collections import LineCollection
 from matplotlib.figure import Figure
 from matplotlib.tri import Triangulation
 
-from bench.measure.contact import facet_samples
 from bench.sequence.loop import STRATEGIES
 from bench.sequence.rows import phase_time
 from estimators import estimator_names
 from formulations import STATUS_OK, formulation_names
+from formulations.contact import facet_coordinates
 
 COLOUR_CYCLE = [f"C{k}" for k in range(10)]
 STYLE_CYCLE = ["-", "--", ":", "-."]
@@ -192,7 +192,8 @@ def pressures(artifacts: dict, reference_curve=None):
     fig = Figure(figsize=(8, 4))
     ax = fig.subplots()
     for formulation, data in chosen.items():
-        s = facet_samples(data["trace_coordinate"], np.linspace(0, 1, data["pressure"].shape[1]))
+        s = facet_coordinates(data["trace_coordinate"],
+                              np.linspace(0, 1, data["pressure"].shape[1]))
         segments = np.stack([s, data["pressure"]], axis=-1)
         ax.add_collection(LineCollection(segments, colors=colour(formulation), linewidths=1,
                                          label=f"{formulation} ({int(data['ndofs'])} DOFs)"))

@@ -22,7 +22,7 @@ from bench.report.tables import (
     rate_verdicts,
     timing_table,
 )
-from bench.sequence.rows import COLUMNS, KEYS, with_labels
+from bench.sequence.rows import COLUMNS, INTERRUPTED, KEYS, with_labels
 
 TEMPLATES = Path(__file__).with_name("templates")
 HARD_CAPTION = ("Hard cases: the mixed method's inf-sup constant beta_h against ndofs for "
@@ -35,7 +35,7 @@ def cut_short(table: pd.DataFrame) -> pd.Series:
     """Per row: its sequence did not finish (interrupted, or running or killed: a keyed
     sequence without an end). Rows of older tables carry no key and count as finished."""
     end, key = table["sequence_end"], table["sequence_key"]
-    return (end == "interrupted") | ((end == "") & (key != ""))
+    return (end == INTERRUPTED) | ((end == "") & (key != ""))
 
 
 def latest_run(table: pd.DataFrame) -> pd.DataFrame:

@@ -88,7 +88,9 @@ COLUMNS = [f.name for f in fields(ResultRow)]
 KEYS = ["scene", "formulation", "solver", "estimator", "strategy", "scene_parameters",
         "formulation_options"]
 LABELS = ["scene_parameters", "formulation_options"]
-FINISHED = ("budget", "max_levels", "memory", "failed")  # sequence_end of a complete sequence
+# sequence_end of a complete sequence; INTERRUPTED (or no end at all) marks one cut short
+FINISHED = ("budget", "max_levels", "memory", "failed", "skipped")
+INTERRUPTED = "interrupted"
 # the phases of a level whose wall times add up to the level's time
 PHASE_TIMES = ["t_assemble", "t_solve", "t_estimate", "t_refine"]
 

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 from skfem import MeshTri
 
-from bench.measure.contact import contact_zone, facet_samples
+from bench.measure.contact import contact_zone
 from bench.measure.discretisation_error import Errors, errors_from
 from bench.measure.nonnested import P1Field, energy_error_on
 from bench.sequence.loop import LoopConfig, run_sequence
@@ -72,7 +72,7 @@ def reference_key(scene, max_dofs: int) -> str:
 
 def _sampled_pressure(solution: DiscreteSolution):
     t = np.linspace(0.0, 1.0, 9)
-    return facet_samples(solution.trace.coordinate, t).ravel(), solution.pressure(t).ravel()
+    return solution.trace.coordinates_at(t).ravel(), solution.pressure(t).ravel()
 
 
 class TruthError(ValueError):
