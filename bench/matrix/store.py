@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import fcntl
 import hashlib
+import io
 import os
 import shutil
 import sys
@@ -38,7 +39,7 @@ def read_results(folder: str | Path) -> pd.DataFrame | None:
     if not parquet.exists():
         return None
     try:
-        return pd.read_parquet(parquet)
+        return read_snapshot(parquet)
     except Exception as error:  # pyarrow raises several types for a damaged file
         why = f"{parquet} is unreadable ({type(error).__name__}: {error})"
     try:
@@ -50,6 +51,12 @@ def read_results(folder: str | Path) -> pd.DataFrame | None:
                            "away or rerun with --overwrite") from None
     print(f"note: {why}; using its CSV mirror {csv} ({len(table)} rows)", file=sys.stderr)
     return table
+
+
+def read_snapshot(path: Path) -> pd.DataFrame:
+    """A parquet file read from one open: pyarrow opens a path again for its pages after the
+    footer, so a file replaced in between by another writer would be read half old, half new."""
+    return pd.read_parquet(io.BytesIO(path.read_bytes()))
 
 
 def atomic_write(frame: pd.DataFrame, path: Path, kind: str) -> None:
@@ -105,7 +112,6 @@ class ResultStore:
                 shutil.rmtree(self.partitions, ignore_errors=True)
             self.partitions.mkdir(exist_ok=True)
             self._adopt_tables()
-        self.rows: list[dict] = []
         self.writers: dict[str, SequenceWriter] = {}
 
     def _adopt_tables(self) -> None:
@@ -127,20 +133,17 @@ class ResultStore:
         if key not in self.writers:
             self.writers[key] = self.sequence(key)
         self.writers[key].append(row)
-        self.rows.append(row.as_dict())
         self.consolidate()
 
     def finish(self, key: str, end: str) -> None:
-        """Record why the sequence ``key`` ended, in its partition and this run's rows."""
+        """Record why the sequence ``key`` ended, in its partition."""
         if key in self.writers:
             self.writers[key].finish(end)
-        for row in self.rows:
-            if row["sequence_key"] == key:
-                row["sequence_end"] = end
         self.consolidate()
 
-    def partition_table(self) -> pd.DataFrame:
-        frames = [pd.read_parquet(path) for path in sorted(self.partitions.glob("*.parquet"))]
+    def table(self) -> pd.DataFrame:
+        """All rows in the folder, from every partition: earlier runs and this run's."""
+        frames = [read_snapshot(path) for path in sorted(self.partitions.glob("*.parquet"))]
         frames = [f for f in frames if len(f)]
         if not frames:
             return pd.DataFrame(columns=COLUMNS)
@@ -149,7 +152,7 @@ class ResultStore:
     def consolidate(self) -> pd.DataFrame:
         """results.parquet and results.csv from every partition (under the folder's lock)."""
         with folder_lock(self.out):
-            table = self.partition_table().sort_values(["run_id"], kind="stable")
+            table = self.table().sort_values(["run_id"], kind="stable")
             atomic_write(table, self.parquet, "parquet")
             atomic_write(table, self.csv, "csv")
         return table
@@ -157,14 +160,6 @@ class ResultStore:
     def finished_keys(self) -> set[str]:
         """Keys of the sequences in this folder that ended (not cut short): a rerun with the
         same spec reuses them."""
-        table = self.partition_table()
-        done = table[table["sequence_end"].isin(FINISHED + ("skipped",))]
+        table = self.table()
+        done = table[table["sequence_end"].isin(FINISHED)]
         return set(done["sequence_key"]) - {""}
-
-    def table(self) -> pd.DataFrame:
-        """All rows in the folder: earlier runs and this run's."""
-        return self.partition_table()
-
-    def run_table(self) -> pd.DataFrame:
-        """This run's rows only."""
-        return pd.DataFrame(self.rows, columns=COLUMNS)
