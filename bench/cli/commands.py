@@ -15,6 +15,7 @@ from bench.hard import (
     check_expected,
     hard_case_descriptions,
     hard_markdown,
+    hard_scene_names,
     run_hard,
     write_hard,
 )
@@ -29,12 +30,11 @@ from bench.verify import load_expected, verdict_table, verify
 from estimators import estimator_descriptions, estimator_names
 from formulations import formulation_descriptions, formulation_names, solver_descriptions
 from formulations.solvers.backends import check_backend
-from scenes import get_scene, scene_descriptions, scene_names
+from scenes import scene_descriptions, scene_names
 
 SUMMARY_COLUMNS = ["level", "ndofs", "energy", "contact_force", "active_constraints", "eta",
                    "eta_0", "eta_geometric", "eta_complementarity", "energy_error",
                    "effectivity_index", "iterations", "t_solve", "status"]
-HARD_TAG = "hard"
 
 
 def progress(result: LevelResult) -> None:
@@ -125,15 +125,13 @@ def compare_command(args) -> int:
     estimator x {uniform, adaptive} with the active-set solver, then the hard cases into the
     same folder, then the report."""
     config = configured(
-        scenes=[n for n in scene_names() if HARD_TAG not in get_scene(n).tags],
+        scenes=[n for n in scene_names() if n not in hard_scene_names()],
         formulations=formulation_names(), solvers=("active-set",),
         estimators=estimator_names(), strategies=("uniform", "adaptive"),
         max_dofs=args.max_dofs, reference_dofs=args.reference_dofs,
         crosscheck_dofs=args.crosscheck_dofs, max_memory_gib=args.max_memory, out=args.out,
         overwrite=True, workers=args.workers, scheduler=args.scheduler, cache=args.cache,
-        command=f"python -m bench compare --max-dofs {args.max_dofs} --reference-dofs "
-                f"{args.reference_dofs} --crosscheck-dofs {args.crosscheck_dofs} --out "
-                f"{args.out} --reports {args.reports}")
+        command=" ".join(["python -m bench", *args.argv]))
     status = run_config(config)
     if config is None:
         return status
