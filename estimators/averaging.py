@@ -1,25 +1,31 @@
 """``averaging``: stress recovery by nodal averaging (Zienkiewicz-Zhu; Bartels and Carstensen use
 it for obstacle problems) plus the contact terms of the paper's (8).
 
-A sigma_h is the continuous P1 field whose value at a vertex is the area-weighted mean of the
-(constant) P1 stresses of the elements around it, and
+A sigma_h is the continuous P_p field (p the displacement order) whose value at a Lagrange node is
+the area-weighted mean of the values of sigma_h there from the elements around it (for P1: the
+constant stresses of the elements at a vertex), and
 
     eta_A^2 = sum_T ||C^{-1/2} (sigma_h - A sigma_h)||_{0,T}^2,
     sigma : C^{-1} sigma = (sigma : sigma - lambda/(2 (lambda + mu)) (tr sigma)^2) / (2 mu)
 
 with the 2D Lame constants of the scene (lambda* in plane stress). This is in energy-norm units
-already (no weighting needed, unlike ``residual``). The integrand is quadratic on each triangle,
-so the edge-midpoint rule integrates it exactly. eta_A is reported as ``eta_0`` (the volume part)
+already (no weighting needed, unlike ``residual``). The integrand has degree 2p on each
+triangle, integrated exactly. A sigma_h is one degree above sigma_h (degree p - 1), as for P1,
+which is what lets it approximate sigma to the order sigma_h does (docs/theory.md, section 9).
+eta_A is reported as ``eta_0`` (the volume part)
 and the geometric and complementarity terms are the shared ``contact_terms``.
 """
 
 from __future__ import annotations
 
 import numpy as np
+from skfem import Basis
 
 from estimators.base import Estimate, combine, register_estimator
 from estimators.contact_terms import contact_terms
 from formulations import DiscreteSolution
+from formulations.elasticity import ELEMENTS, stress_from_gradient
+from formulations.evaluation import gradients_at
 
 
 def element_areas(mesh) -> np.ndarray:
@@ -28,12 +34,21 @@ def element_areas(mesh) -> np.ndarray:
     return 0.5 * np.abs(a[0] * b[1] - a[1] * b[0])
 
 
-def averaged_stress(mesh, stress: np.ndarray, area: np.ndarray) -> np.ndarray:
-    """Vertex values (3, n_vertices) of A sigma_h from element stresses (3, n_elements)."""
-    nv = mesh.p.shape[1]
-    weight = np.bincount(mesh.t.ravel(), np.tile(area, 3), nv)
-    return np.array([np.bincount(mesh.t.ravel(), np.tile(area * s, 3), nv) for s in stress]) \
-        / weight
+def averaged_stress(solution: DiscreteSolution, scalar: Basis) -> np.ndarray:
+    """The DOF values (3, scalar.N) of A sigma_h in the continuous scalar P_p space ``scalar``:
+    at each Lagrange node, the area-weighted mean of the values of sigma_h at that node from
+    the elements around it (for P1: of their constant stresses)."""
+    elasticity = solution.elasticity
+    mesh = elasticity.mesh
+    nodes = scalar.mapping.F(scalar.elem.doflocs.T)  # (2, n_elements, n_local)
+    n_local = nodes.shape[2]
+    cells = np.repeat(np.arange(mesh.t.shape[1]), n_local)
+    grad = gradients_at(elasticity.basis, solution.u, nodes.reshape(2, -1), cells)
+    stress = stress_from_gradient(grad, *elasticity.lame)  # (3, n_elements * n_local)
+    dofs = scalar.element_dofs.T.ravel()  # element-major, as ``nodes``
+    weight = np.repeat(element_areas(mesh), n_local)
+    total = np.bincount(dofs, weight, scalar.N)
+    return np.array([np.bincount(dofs, weight * s, scalar.N) for s in stress]) / total
 
 
 def compliance_energy(stress: np.ndarray, lam: float, mu: float) -> np.ndarray:
@@ -44,17 +59,16 @@ def compliance_energy(stress: np.ndarray, lam: float, mu: float) -> np.ndarray:
 
 
 def averaging_indicators(solution: DiscreteSolution) -> np.ndarray:
-    """||C^{-1/2}(sigma_h - A sigma_h)||_T^2 per element."""
-    mesh = solution.elasticity.mesh
-    lam, mu = solution.elasticity.lame
-    stress = solution.elasticity.element_stress(solution.u)
-    area = element_areas(mesh)
-    vertex = averaged_stress(mesh, stress, area)[:, mesh.t]  # (3 components, 3 vertices, nT)
-    total = np.zeros(area.size)
-    for i, j in ((0, 1), (1, 2), (2, 0)):  # edge midpoints, weight area / 3 each
-        difference = stress - 0.5 * (vertex[:, i] + vertex[:, j])
-        total += compliance_energy(difference, lam, mu)
-    return total * area / 3.0
+    """||C^{-1/2}(sigma_h - A sigma_h)||_T^2 per element, integrated exactly (degree 2p)."""
+    elasticity = solution.elasticity
+    lam, mu = elasticity.lame
+    order = elasticity.order
+    scalar = Basis(elasticity.mesh, ELEMENTS[order](), intorder=2 * order)
+    recovered = averaged_stress(solution, scalar)
+    at_points = np.array([scalar.interpolate(r).value for r in recovered])
+    grad = Basis(elasticity.mesh, elasticity.basis.elem, quadrature=scalar.quadrature)
+    stress = stress_from_gradient(grad.interpolate(solution.u).grad, lam, mu)
+    return (compliance_energy(stress - at_points, lam, mu) * scalar.dx).sum(axis=1)
 
 
 @register_estimator("averaging", "Zienkiewicz-Zhu nodal stress averaging in the energy norm "

@@ -23,6 +23,7 @@ import numpy as np
 
 from formulations import DiscreteSolution
 from formulations.contact import gauss_legendre
+from formulations.evaluation import evaluate_on_trace
 
 # w has kinks where u_hn crosses g inside a facet; 10 Gauss points keep that quadrature error far
 # below the discretisation error the term measures.
@@ -41,16 +42,20 @@ class ContactTerms:
 def contact_terms(scene, solution: DiscreteSolution) -> ContactTerms:
     trace = solution.trace
     t, w = gauss_legendre(QUADRATURE_POINTS)
-    u_nodal = solution.elasticity.nodal(solution.u)
-    u_n = trace.normal_displacement(u_nodal, t)
+    at_points = evaluate_on_trace(solution.elasticity.basis, trace, t)
+    nq = t.size
+    normal, tangent = (np.repeat(v, nq, axis=1) for v in (trace.normal, trace.tangent))
+    u_n = np.einsum("in,in->n", at_points.value(solution.u), normal).reshape(trace.size, nq)
     g = scene.gap(trace.points(t))
     d = g - u_n
     inside = d < 0
     wval = np.where(inside, d, 0.0)
-    # d/ds (g - u_hn): g by central differences along the facet, u_hn is linear on it
-    dg = (scene.gap(trace.points(t + _DT)) - scene.gap(trace.points(t - _DT))) / (2 * _DT)
-    du = (u_n[:, -1:] - u_n[:, :1]) / (t[-1] - t[0])
-    dw = np.where(inside, (dg - du) / trace.length[:, None], 0.0)
+    # d/ds (g - u_hn): g by central differences along the facet, u_hn from grad u_h exactly
+    dg = (scene.gap(trace.points(t + _DT)) - scene.gap(trace.points(t - _DT))) / (
+        2 * _DT * trace.length[:, None])
+    du = np.einsum("in,ijn,jn->n", normal, at_points.gradient(solution.u),
+                   tangent).reshape(trace.size, nq)
+    dw = np.where(inside, dg - du, 0.0)
 
     l2 = trace.integrate(wval**2, w)
     h1 = l2 + trace.integrate(dw**2, w)

@@ -1,11 +1,12 @@
 """``residual``: the paper's eta of (8) with the residual eta_0 of its section 5.
 
-eta_0^2 = sum_T ( h_T^2 R_{0,T}^2 + sum_{e in E_T} h_e R_{0,e}^2 ),
+eta_0^2 = sum_T ( (h_T/p)^2 R_{0,T}^2 + sum_{e in E_T} (h_e/p) R_{0,e}^2 ),
 R_{0,T} = ||f + div sigma(u_h)||_{0,T},
 R_{0,e} = 1/2 ||[sigma_n(u_h)]||_e (interior), ||sigma_n(u_h) - q||_e (Gamma_N),
           ||sigma_nn(u_h) + lambda_h||_e + ||sigma_nt(u_h)||_e (Gamma_C), 0 on Gamma_D.
 For P1, sigma(u_h) is constant per element, so div sigma(u_h) = 0 and the jumps are constant
-along each edge. h_T is the element diameter, h_e the edge length.
+along each edge. h_T is the element diameter, h_e the edge length, p the polynomial order (the
+hp weights of Melenk and Wohlmuth; docs/theory.md, section 9).
 
 Units: the residuals are stresses, so sum h^2 R^2 scales like E ||u - u_h||^2. We report
 eta_0^2 = (1/E) sum_T (...) so that eta_0 is in energy-norm units and the effectivity index does
@@ -16,15 +17,16 @@ material constants, so rates and marking are unaffected by the weight).
 from __future__ import annotations
 
 import numpy as np
-from skfem import Functional
+from skfem import Basis, ElementDG
 
 from estimators.base import Estimate, combine, register_estimator
 from estimators.contact_terms import contact_terms
 from formulations import DiscreteSolution
 from formulations.contact import gauss_legendre, outer_normals
-from formulations.elasticity import element_diameters
+from formulations.elasticity import ELEMENTS, element_diameters, stress_from_gradient
+from formulations.evaluation import gradients_at
 
-EDGE_QUADRATURE_POINTS = 4
+EDGE_QUADRATURE_POINTS = 4  # Neumann and contact edges: q and lambda_h are not polynomials
 
 
 def _tensor(stress: np.ndarray) -> np.ndarray:
@@ -32,49 +34,100 @@ def _tensor(stress: np.ndarray) -> np.ndarray:
     return np.array([[s11, s12], [s12, s22]])
 
 
+def stress_at(solution: DiscreteSolution, x: np.ndarray, cells: np.ndarray) -> np.ndarray:
+    """sigma(u_h) (2, 2, n) at points x (2, n) of elements ``cells``."""
+    grad = gradients_at(solution.elasticity.basis, solution.u, x, cells)
+    return _tensor(stress_from_gradient(grad, *solution.elasticity.lame))
+
+
+def stress_divergence(solution: DiscreteSolution, basis: Basis) -> np.ndarray:
+    """div sigma(u_h) (2, n_elements, n_points) at the quadrature points of ``basis``: grad u_h
+    is written exactly in the discontinuous P_(p-1) space (its values at that element's nodes)
+    and differentiated there."""
+    elasticity = solution.elasticity
+    mesh, order = elasticity.mesh, elasticity.order
+    dg = Basis(mesh, ElementDG(ELEMENTS[order - 1]()), quadrature=basis.quadrature)
+    nodes = dg.mapping.F(dg.elem.doflocs.T)  # (2, n_elements, n_local)
+    cells = np.repeat(np.arange(mesh.t.shape[1]), nodes.shape[2])
+    grad = gradients_at(elasticity.basis, solution.u, nodes.reshape(2, -1), cells)
+    dofs = dg.element_dofs.T.ravel()  # element-major, as ``nodes``
+    sigma = _tensor(stress_from_gradient(grad, *elasticity.lame))  # (2, 2, n_el * n_local)
+    div = np.zeros((2, mesh.t.shape[1], basis.quadrature[0].shape[1]))
+    for i in (0, 1):
+        for j in (0, 1):
+            values = np.zeros(dg.N)
+            values[dofs] = sigma[i, j]
+            div[i] += dg.interpolate(values).grad[j]
+    return div
+
+
 def element_residual(scene, solution: DiscreteSolution) -> np.ndarray:
-    """h_T^2 ||f + div sigma(u_h)||_T^2 per element (div sigma(u_h) = 0 for P1)."""
-    mesh = solution.elasticity.mesh
+    """(h_T / p)^2 ||f + div sigma(u_h)||_T^2 per element (div sigma(u_h) = 0 for P1)."""
+    elasticity = solution.elasticity
+    mesh, order = elasticity.mesh, elasticity.order
+    if scene.body_force is None and order == 1:
+        return np.zeros(mesh.t.shape[1])
+    basis = Basis(mesh, elasticity.basis.elem, intorder=2 * order)  # scikit-fem default
+    residual = np.zeros((2,) + basis.dx.shape)
+    if scene.body_force is not None:
+        residual += scene.body_force(np.asarray(basis.global_coordinates()))
+    if order > 1:
+        residual += stress_divergence(solution, basis)
+    norm2 = ((residual**2).sum(axis=0) * basis.dx).sum(axis=1)
+    return (element_diameters(mesh) / order) ** 2 * norm2
+
+
+def edge_points(mesh, facets: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """Points at local coordinates t of mesh facets, shape (2, n_facets * len(t))."""
+    a, b = mesh.p[:, mesh.facets[0, facets]], mesh.p[:, mesh.facets[1, facets]]
+    return (a[:, :, None] + (b - a)[:, :, None] * t[None, None, :]).reshape(2, -1)
+
+
+def interior_jumps(solution: DiscreteSolution) -> np.ndarray:
+    """(h_e / p) (1/2 ||[sigma_n]||_e)^2 added to both elements of every interior edge, with
+    p Gauss points per edge (exact: the jump has degree p - 1)."""
+    mesh, order = solution.elasticity.mesh, solution.elasticity.order
     n_elements = mesh.t.shape[1]
-    if scene.body_force is None:
-        return np.zeros(n_elements)
-    diameter = element_diameters(mesh)
-    f_squared = Functional(lambda w: (scene.body_force(w.x) ** 2).sum(axis=0))
-    return diameter**2 * f_squared.elemental(solution.elasticity.basis)
-
-
-def edge_residuals(scene, solution: DiscreteSolution) -> np.ndarray:
-    """sum_{e in E_T} h_e R_{0,e}^2 per element."""
-    mesh = solution.elasticity.mesh
-    n_elements = mesh.t.shape[1]
-    sigma = _tensor(solution.elasticity.element_stress(solution.u))  # (2, 2, n_elements)
-    out = np.zeros(n_elements)
-
     interior = np.flatnonzero(mesh.f2t[1] >= 0)
     t1, t2 = mesh.f2t[:, interior]
     h, n = outer_normals(mesh, *mesh.facets[:, interior], t1)  # sign irrelevant for the jump
-    jump = np.einsum("ijn,jn->in", sigma[:, :, t1] - sigma[:, :, t2], n)
-    share = h * 0.25 * (jump**2).sum(axis=0) * h       # h_e (1/2 ||[sigma_n]||_e)^2
-    out += np.bincount(t1, share, n_elements) + np.bincount(t2, share, n_elements)
+    t, w = gauss_legendre(order)
+    x = edge_points(mesh, interior, t)
+    jump = (stress_at(solution, x, np.repeat(t1, t.size))
+            - stress_at(solution, x, np.repeat(t2, t.size)))
+    jn = np.einsum("ijn,jn->in", jump, np.repeat(n, t.size, axis=1))
+    norm2 = ((jn**2).sum(axis=0).reshape(-1, t.size) * w).sum(axis=1) * h
+    share = h / order * 0.25 * norm2
+    return np.bincount(t1, share, n_elements) + np.bincount(t2, share, n_elements)
 
+
+def edge_residuals(scene, solution: DiscreteSolution) -> np.ndarray:
+    """sum_{e in E_T} (h_e / p) R_{0,e}^2 per element."""
+    mesh, order = solution.elasticity.mesh, solution.elasticity.order
+    n_elements = mesh.t.shape[1]
+    out = interior_jumps(solution)
     t, w = gauss_legendre(EDGE_QUADRATURE_POINTS)
+    nq = t.size
     neumann = scene.neumann_facets(mesh)
     if neumann.size:
         element = mesh.f2t[0, neumann]
         h, n = outer_normals(mesh, *mesh.facets[:, neumann], element)
-        sn = np.einsum("ijn,jn->in", sigma[:, :, element], n)[:, :, None]
+        sigma = stress_at(solution, edge_points(mesh, neumann, t), np.repeat(element, nq))
+        sn = np.einsum("ijn,jn->in", sigma, np.repeat(n, nq, axis=1)).reshape(2, -1, nq)
         if scene.traction is not None:
             sn = sn - scene.traction(scene.facet_points(neumann, t, mesh))
         norm2 = ((sn**2).sum(axis=0) * w).sum(axis=1) * h
-        out += np.bincount(element, h * norm2, n_elements)
+        out += np.bincount(element, h / order * norm2, n_elements)
 
     trace = solution.trace
-    sn = np.einsum("ijn,jn->in", sigma[:, :, trace.element], trace.normal)
-    snn = np.einsum("in,in->n", sn, trace.normal)
-    snt = np.linalg.norm(sn - snn * trace.normal, axis=0)
-    normal_part = np.sqrt(trace.integrate((snn[:, None] + solution.pressure(t)) ** 2, w))
-    r_e = normal_part + snt * np.sqrt(trace.length)
-    out += np.bincount(trace.element, trace.length * r_e**2, n_elements)
+    normal = np.repeat(trace.normal, nq, axis=1)
+    sigma = stress_at(solution, trace.points(t).reshape(2, -1), np.repeat(trace.element, nq))
+    sn = np.einsum("ijn,jn->in", sigma, normal)
+    snn = np.einsum("in,in->n", sn, normal)
+    snt2 = ((sn - snn * normal) ** 2).sum(axis=0).reshape(-1, nq)
+    normal_part = np.sqrt(trace.integrate((snn.reshape(-1, nq) + solution.pressure(t)) ** 2, w))
+    r_e = normal_part + np.sqrt(trace.integrate(snt2, w))
+    out += np.bincount(trace.element, trace.length / order * r_e**2, n_elements)
     return out
 
 

@@ -17,6 +17,7 @@ from scipy import sparse
 
 from formulations.contact import ContactTrace, gauss_legendre
 from formulations.elasticity import Elasticity
+from formulations.evaluation import normal_trace_matrix
 
 STATUS_OK, STATUS_INACCURATE, STATUS_FAILED = "ok", "inaccurate", "failed"
 STATUS_SKIPPED = "skipped"
@@ -129,6 +130,13 @@ class DiscreteSolution:
     @property
     def energy(self) -> float:
         return self.elasticity.energy(self.u)
+
+    def normal_displacement(self, t: np.ndarray) -> np.ndarray:
+        """u_h . n at local coordinates t in [0, 1] of every contact facet, for any order;
+        shape (n_facets, len(t))."""
+        t = np.asarray(t, dtype=float)
+        values = normal_trace_matrix(self.elasticity.basis, self.trace, t) @ self.u
+        return values.reshape(self.trace.size, t.size)
 
     def pressure_at(self, s: np.ndarray, samples: int = 17) -> np.ndarray:
         """lambda_h at contact coordinates ``s``: located in its facet, interpolated linearly

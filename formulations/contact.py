@@ -52,15 +52,38 @@ class ContactTrace:
         (n, len(t))."""
         return facet_coordinates(self.coordinate, t)
 
-    def normal_displacement(self, u_nodal: np.ndarray, t: np.ndarray) -> np.ndarray:
-        """u_h . n at local coordinates t (P1: linear along each facet); shape (n, len(t))."""
-        ua = np.einsum("in,in->n", u_nodal[:, self.vertices[0]], self.normal)
-        ub = np.einsum("in,in->n", u_nodal[:, self.vertices[1]], self.normal)
-        return ua[:, None] + (ub - ua)[:, None] * t[None, :]
+    @property
+    def tangent(self) -> np.ndarray:
+        """Unit tangents (2, n), pointing from ``start`` to ``end``."""
+        a, b = self.mesh.p[:, self.vertices[0]], self.mesh.p[:, self.vertices[1]]
+        return (b - a) / self.length
 
     def integrate(self, values: np.ndarray, w: np.ndarray) -> np.ndarray:
         """Per-facet integrals of ``values`` (n, nq) given at points with weights w on [0, 1]."""
         return (values * w[None, :]).sum(axis=1) * self.length
+
+
+def lagrange_nodes(order: int) -> np.ndarray:
+    """The equispaced nodes k / p (k = 0..p) on [0, 1] of the trace of a P_p Lagrange element
+    on one facet."""
+    return np.linspace(0.0, 1.0, order + 1)
+
+
+def lagrange_basis(nodes: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """The 1D Lagrange polynomials on ``nodes`` at t; shape (len(nodes), len(t))."""
+    t = np.asarray(t, dtype=float)
+    out = np.ones((nodes.size, t.size))
+    for k in range(nodes.size):
+        for j in range(nodes.size):
+            if j != k:
+                out[k] *= (t - nodes[j]) / (nodes[k] - nodes[j])
+    return out
+
+
+def lagrange_basis_1d(order: int, t: np.ndarray) -> np.ndarray:
+    """The 1D Lagrange polynomials of degree p on the nodes ``lagrange_nodes(p)`` at t;
+    shape (p + 1, len(t))."""
+    return lagrange_basis(lagrange_nodes(order), t)
 
 
 def facet_coordinates(coordinate: np.ndarray, t: np.ndarray) -> np.ndarray:

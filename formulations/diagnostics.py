@@ -47,7 +47,8 @@ def inf_sup_constant(discretisation, backend: str | None = None,
         condensed = qp.B @ X
     S = qp.objective_scale * np.asarray(condensed)
     S = 0.5 * (S + S.T)
-    smallest = linalg.eigh(S, np.diag(multiplier_gram), eigvals_only=True,
+    gram = np.asarray(multiplier_gram)
+    smallest = linalg.eigh(S, np.diag(gram) if gram.ndim == 1 else gram, eigvals_only=True,
                            subset_by_index=[0, 0])[0]
     return float(np.sqrt(max(smallest, 0.0)))
 

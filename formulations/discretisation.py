@@ -29,7 +29,7 @@ class Discretisation:
     recover: Callable[[QPSolution, Residuals, str, str], DiscreteSolution]
     row_coordinate: np.ndarray
     transfer: Callable[[DiscreteSolution], np.ndarray] | None = None
-    # diagonal Gram matrix of the mesh-dependent H^-1/2 norm of the multipliers, for
+    # Gram matrix (its diagonal if 1-D) of the mesh-dependent H^-1/2 norm of the multipliers, for
     # formulations whose constraint rows are a multiplier space (formulations.diagnostics)
     multiplier_gram: np.ndarray | None = None
 

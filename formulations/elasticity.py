@@ -1,5 +1,5 @@
-"""P1 (triangles) linear elasticity on scikit-fem: stiffness, loads, stresses
-(docs/theory.md, section 1).
+"""Lagrange P_p (p = 1, 2, 3; triangles) linear elasticity on scikit-fem: stiffness, loads,
+stresses (docs/theory.md, sections 1 and 9).
 
 Plane stress uses lambda* = E nu / (1 - nu^2), plane strain lambda = E nu / ((1+nu)(1-2nu)).
 Everything is vectorised over elements by scikit-fem's assembly.
@@ -11,11 +11,44 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy import sparse
-from skfem import Basis, ElementTriP1, ElementVector, FacetBasis, LinearForm, MeshTri, asm
+from skfem import (
+    Basis,
+    ElementTriP1,
+    ElementTriP2,
+    ElementTriP3,
+    ElementVector,
+    FacetBasis,
+    LinearForm,
+    MeshTri,
+    asm,
+)
 from skfem.helpers import dot
 from skfem.models.elasticity import linear_elasticity
 
+from formulations.load import body_load
 from scenes import Scene
+from scenes.base import is_integer
+
+ELEMENTS = {1: ElementTriP1, 2: ElementTriP2, 3: ElementTriP3}
+ORDERS = tuple(ELEMENTS)
+
+
+def order_descriptions() -> dict[str, str]:
+    """One line per polynomial order, for ``python -m bench list``."""
+    return {str(p): f"P{p} Lagrange displacements ({ELEMENTS[p].__name__}): energy error "
+                    f"O(h^{p}) for smooth solutions" for p in ORDERS}
+
+
+def check_order(order) -> int:
+    """``order`` as an int, or a one-line refusal naming the allowed orders."""
+    if not (is_integer(order) and int(order) in ELEMENTS):
+        raise ValueError(f"order={order!r} is not one of {', '.join(map(str, ORDERS))}")
+    return int(order)
+
+
+def vector_element(order: int = 1) -> ElementVector:
+    """The displacement element: vector Lagrange P_order on triangles."""
+    return ElementVector(ELEMENTS[check_order(order)]())
 
 
 @dataclass(frozen=True, eq=False)
@@ -29,6 +62,7 @@ class Elasticity:
     K: sparse.csr_matrix
     F: np.ndarray
     free: np.ndarray
+    order: int = 1
 
     @property
     def ndofs(self) -> int:
@@ -50,13 +84,16 @@ class Elasticity:
         return float(0.5 * u @ (self.K @ u) - self.F @ u)
 
     def nodal(self, u: np.ndarray) -> np.ndarray:
-        """Nodal displacement field, shape (2, n_vertices)."""
+        """Displacement at the mesh vertices, shape (2, n_vertices) (for every order: the
+        vertex DOFs of a Lagrange element are the values there)."""
         return u[self.basis.nodal_dofs]
 
     def element_stress(self, u: np.ndarray) -> np.ndarray:
-        """Constant stress (s11, s22, s12) per element for the P1 field u; shape (3, n_elements)."""
-        grad = self.basis.interpolate(u).grad[:, :, :, 0]  # P1: constant per element
-        return stress_from_gradient(grad, *self.lame)
+        """Stress (s11, s22, s12) per element at its centroid; shape (3, n_elements) (P1: the
+        constant stress of the element)."""
+        centroid = Basis(self.mesh, self.basis.elem,
+                         quadrature=(np.full((2, 1), 1.0 / 3.0), np.array([0.5])))
+        return stress_from_gradient(centroid.interpolate(u).grad[:, :, :, 0], *self.lame)
 
 
 def element_diameters(mesh: MeshTri) -> np.ndarray:
@@ -80,42 +117,54 @@ def von_mises(stress: np.ndarray) -> np.ndarray:
     return np.sqrt(s11**2 + s22**2 - s11 * s22 + 3 * s12**2)
 
 
-def assemble_elasticity(scene: Scene, mesh: MeshTri) -> Elasticity:
-    """Stiffness K, load F = (f, v) + (q, v)_{Gamma_N}, and the free DOFs for ``mesh``."""
-    basis = Basis(mesh, ElementVector(ElementTriP1()))
+def assemble_elasticity(scene: Scene, mesh: MeshTri, order: int = 1) -> Elasticity:
+    """Stiffness K, load F = (f, v) + (q, v)_{Gamma_N}, and the free DOFs for ``mesh`` with
+    P_order displacements."""
+    order = check_order(order)
+    basis = Basis(mesh, vector_element(order))  # loads: scikit-fem's rule of order 2p
     lam, mu = scene.material.lame
-    # P1 strains are constant per element: the centroid rule is exact and 3x cheaper
-    centroid = Basis(mesh, basis.elem, quadrature=(np.full((2, 1), 1.0 / 3.0), np.array([0.5])))
-    K = asm(linear_elasticity(lam, mu), centroid).tocsr()
+    if order == 1:  # P1 strains are constant per element: the centroid rule is exact, 3x cheaper
+        stiffness_basis = Basis(mesh, basis.elem,
+                                quadrature=(np.full((2, 1), 1.0 / 3.0), np.array([0.5])))
+    else:  # strain products have degree 2(p - 1): a rule of that order is exact
+        stiffness_basis = Basis(mesh, basis.elem, intorder=2 * (order - 1))
+    K = asm(linear_elasticity(lam, mu), stiffness_basis).tocsr()
     F = np.zeros(basis.N)
     if scene.body_force is not None:
-        @LinearForm
-        def body(v, w):
-            return dot(scene.body_force(w.x), v)
-
-        F += asm(body, basis)
+        F += body_load(scene.body_force, basis)
     neumann = scene.neumann_facets(mesh)
     if scene.traction is not None and neumann.size:
         @LinearForm
         def surface(v, w):
             return dot(scene.traction(w.x), v)
 
-        F += asm(surface, FacetBasis(mesh, basis.elem, facets=neumann, intorder=4))
+        F += asm(surface, FacetBasis(mesh, basis.elem, facets=neumann,
+                                     intorder=max(4, 2 * order)))
     clamped = basis.get_dofs(scene.dirichlet_facets(mesh)).all()
     free = np.setdiff1d(np.arange(basis.N), clamped)
-    return Elasticity(mesh=mesh, basis=basis, lame=(lam, mu), K=K, F=F, free=free)
+    return Elasticity(mesh=mesh, basis=basis, lame=(lam, mu), K=K, F=F, free=free, order=order)
 
 
-def count_free_dofs(scene: Scene, mesh: MeshTri) -> int:
+def lagrange_dofs(vertices: int, edges: int, triangles: int, order: int) -> int:
+    """Scalar P_order DOFs of a mesh: one per vertex, p - 1 per edge, (p-1)(p-2)/2 inside."""
+    return vertices + (order - 1) * edges + (order - 1) * (order - 2) // 2 * triangles
+
+
+def count_free_dofs(scene: Scene, mesh: MeshTri, order: int = 1) -> int:
     """The number of unknowns ``assemble_elasticity`` would give on ``mesh``, without
-    assembling: two per vertex, none on a vertex of a clamped facet."""
-    clamped = np.unique(mesh.facets[:, scene.dirichlet_facets(mesh)])
-    return int(2 * (mesh.p.shape[1] - clamped.size))
-
-
-def predict_uniform_free_dofs(scene: Scene, mesh: MeshTri) -> int:
-    """``count_free_dofs`` of ``mesh.refined()``, without refining: uniform refinement adds one
-    vertex per edge, and each clamped facet adds one clamped vertex (its midpoint)."""
+    assembling: two per Lagrange node, none on a node of a clamped facet."""
     dirichlet = scene.dirichlet_facets(mesh)
-    clamped = np.unique(mesh.facets[:, dirichlet]).size + dirichlet.size
-    return int(2 * (mesh.p.shape[1] + mesh.facets.shape[1] - clamped))
+    clamped = np.unique(mesh.facets[:, dirichlet]).size + (order - 1) * dirichlet.size
+    nodes = lagrange_dofs(mesh.p.shape[1], mesh.facets.shape[1], mesh.t.shape[1], order)
+    return int(2 * (nodes - clamped))
+
+
+def predict_uniform_free_dofs(scene: Scene, mesh: MeshTri, order: int = 1) -> int:
+    """``count_free_dofs`` of ``mesh.refined()``, without refining: uniform refinement adds one
+    vertex per edge, splits every edge in two and adds three inside every triangle (which
+    becomes four); each clamped facet adds one clamped vertex and becomes two facets."""
+    dirichlet = scene.dirichlet_facets(mesh)
+    nv, ne, nt = mesh.p.shape[1], mesh.facets.shape[1], mesh.t.shape[1]
+    clamped = (np.unique(mesh.facets[:, dirichlet]).size + dirichlet.size
+               + (order - 1) * 2 * dirichlet.size)
+    return int(2 * (lagrange_dofs(nv + ne, 2 * ne + 3 * nt, 4 * nt, order) - clamped))

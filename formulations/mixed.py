@@ -1,8 +1,11 @@
 """``mixed``: Haslinger's mixed method, the seed paper's (3) (docs/theory.md, section 3).
 
-lambda_H is piecewise constant on a contact mesh T_{C,H} coarser than the trace of T_h. The QP is
-min 1/2 u'Ku - F'u s.t. Bu <= G with B_ij = int_{S_i} phi_j . n ds and G_i = int_{S_i} g ds, so
-the KKT multiplier of row i is the value of lambda_H on segment S_i.
+For P1, lambda_H is piecewise constant on a contact mesh T_{C,H} coarser than the trace of T_h.
+The QP is min 1/2 u'Ku - F'u s.t. Bu <= G with B_ij = int_{S_i} phi_j . n ds and
+G_i = int_{S_i} g ds, so the KKT multiplier of row i is the value of lambda_H on segment S_i.
+For P_p (p = 2, 3), lambda_H has degree p - 1 on each segment, written in the Bernstein basis
+B_k of the segment, and the rows are int_S B_k phi_j . n ds: the multipliers are the Bernstein
+coefficients, so lambda_H >= 0 wherever they are (docs/theory.md, section 9).
 
 Contact mesh (h/H <= 1/2 by construction, on uniform and adaptive meshes alike): the segments
 are runs of consecutive contact facets, each as short as possible subject to every facet in it
@@ -16,6 +19,7 @@ the refinement by a dozen levels.)
 from __future__ import annotations
 
 from dataclasses import dataclass
+from math import comb
 
 import numpy as np
 from scipy import sparse
@@ -24,11 +28,12 @@ from skfem import MeshTri
 from formulations.base import ContactQP, DiscreteSolution, QPSolution, Residuals
 from formulations.contact import contact_trace, gauss_legendre
 from formulations.discretisation import Discretisation, discrete_solution
-from formulations.elasticity import assemble_elasticity
+from formulations.elasticity import assemble_elasticity, check_order
+from formulations.evaluation import normal_trace_matrix
 from formulations.kkt import count_active
 from formulations.registry import register_formulation
 from scenes import Scene
-from scenes.base import is_number
+from scenes.base import is_integer, is_number
 
 GAP_QUADRATURE_POINTS = 6  # G_i = int g: g is smooth on each facet; 6 Gauss points is plenty
 
@@ -67,45 +72,99 @@ def multiplier_segments(lengths: np.ndarray, h_over_H: float = 0.5) -> np.ndarra
     return np.cumsum(starts)
 
 
-@register_formulation("mixed", "Haslinger's mixed method: piecewise constant multiplier on a "
-                               "coarser contact mesh, h/H <= 1/2 (seed paper, eq. (3))")
-def discretise(scene: Scene, mesh: MeshTri, h_over_H: float = 0.5) -> Discretisation:
+def bernstein(degree: int, tau: np.ndarray) -> np.ndarray:
+    """The Bernstein polynomials C(q, k) tau^k (1 - tau)^(q - k), k = 0..q, at tau in [0, 1];
+    shape (q + 1,) + tau.shape. Non-negative, summing to 1."""
+    tau = np.asarray(tau, dtype=float)
+    return np.array([comb(degree, k) * tau**k * (1 - tau) ** (degree - k)
+                     for k in range(degree + 1)])
+
+
+def bernstein_gram(degree: int) -> np.ndarray:
+    """int_0^1 B_i B_j (the Bernstein mass matrix on [0, 1])."""
+    i, j = np.meshgrid(np.arange(degree + 1), np.arange(degree + 1), indexing="ij")
+    return np.vectorize(comb)(degree, i) * np.vectorize(comb)(degree, j) / (
+        np.vectorize(comb)(2 * degree, i + j) * (2 * degree + 1))
+
+
+def segment_basis(trace, segment: np.ndarray, breaks: np.ndarray, degree: int,
+                  t: np.ndarray) -> np.ndarray:
+    """The Bernstein polynomials of each facet's segment (in the segment's contact coordinate,
+    ``breaks``: segment end points) at local coordinates t of every facet; shape
+    (q + 1, n_facets, len(t))."""
+    a, b = breaks[:-1][segment], breaks[1:][segment]
+    tau = (trace.coordinates_at(np.asarray(t, dtype=float)) - a[:, None]) / (b - a)[:, None]
+    return bernstein(degree, np.clip(tau, 0.0, 1.0))
+
+
+def segment_weights(trace, segment: np.ndarray, breaks: np.ndarray, degree: int,
+                    t: np.ndarray, w: np.ndarray) -> sparse.csr_matrix:
+    """W with (W v)_(S, k) = int_S B_k v ds for v given at the points ``t`` (weights ``w``) of
+    every contact facet (column f * len(t) + q)."""
+    psi = segment_basis(trace, segment, breaks, degree, t)  # (q + 1, n_facets, nq)
+    vals = psi * (trace.length[:, None] * w[None, :])[None]
+    nf, nq = psi.shape[1:]
+    rows = (segment[None, :, None] * (degree + 1) + np.arange(degree + 1)[:, None, None])
+    cols = np.arange(nf * nq).reshape(nf, nq)[None]
+    m = (int(segment.max()) + 1) * (degree + 1)
+    return sparse.csr_matrix((vals.ravel(), (np.broadcast_to(rows, vals.shape).ravel(),
+                                             np.broadcast_to(cols, vals.shape).ravel())),
+                             shape=(m, nf * nq))
+
+
+@register_formulation("mixed", "Haslinger's mixed method: multiplier of degree p - 1 "
+                               "(piecewise constant for P1) on a coarser contact mesh, "
+                               "h/H <= 1/2 (seed paper, eq. (3))")
+def discretise(scene: Scene, mesh: MeshTri, h_over_H: float = 0.5, order: int = 1,
+               multiplier_degree: int | None = None) -> Discretisation:
     """``h_over_H``: the largest allowed ratio of a facet to its multiplier segment. The
     paper's 1/2 (default) keeps the pair uniformly inf-sup stable; 1 (multiplier mesh = trace
-    mesh) is not guaranteed to be (a hard case, see ``formulations.diagnostics``)."""
+    mesh) is not guaranteed to be (a hard case, see ``formulations.diagnostics``).
+    ``multiplier_degree``: the polynomial degree q of lambda_H on each segment (default
+    p - 1, docs/theory.md, section 9)."""
     if not (is_number(h_over_H) and 0.0 < h_over_H <= 1.0):
         raise ValueError(f"h_over_H={h_over_H!r} is not in (0, 1]")
-    elasticity = assemble_elasticity(scene, mesh)
+    order = check_order(order)
+    degree = order - 1 if multiplier_degree is None else multiplier_degree
+    if not (is_integer(degree) and 0 <= degree <= order):
+        raise ValueError(f"multiplier_degree={multiplier_degree!r} is not an integer in "
+                         f"[0, order={order}]")
+    elasticity = assemble_elasticity(scene, mesh, order)
     trace = contact_trace(scene, mesh)
     segment = multiplier_segments(trace.length, h_over_H)
-    m = int(segment.max()) + 1
-    H = np.bincount(segment, weights=trace.length, minlength=m)
+    H = np.bincount(segment, weights=trace.length)
     h_over_H = float((trace.length / H[segment]).max())
 
-    # B_ij = int_{S_i} phi_j . n ds: phi_j is linear on a facet, so each end gets h/2 * n
-    dofs = elasticity.basis.nodal_dofs
-    rows = np.tile(segment, 4)
-    cols = np.concatenate([dofs[c, trace.vertices[k]] for k in (0, 1) for c in (0, 1)])
-    vals = np.concatenate([0.5 * trace.length * trace.normal[c] for _ in (0, 1) for c in (0, 1)])
-    B = sparse.csr_matrix((vals, (rows, cols)), shape=(m, elasticity.basis.N))
-    t, w = gauss_legendre(GAP_QUADRATURE_POINTS)
-    G = np.bincount(segment, weights=trace.integrate(scene.gap(trace.points(t)), w), minlength=m)
-
-    qp = ContactQP(K=elasticity.K_free, F=elasticity.F[elasticity.free],
-                   B=B[:, elasticity.free].tocsr(), G=G, row_scale=H,
-                   objective_scale=float(scene.material.young_modulus))
     first = np.flatnonzero(np.diff(np.concatenate([[-1], segment])))
     breaks = np.append(trace.coordinate[0, first], trace.coordinate[1, -1])
+    # B_(S,k) j = int_S B_k phi_j . n ds: degree q + p on a facet, exact with p + 1 points
+    t, w = gauss_legendre(order + 1)
+    B = segment_weights(trace, segment, breaks, degree, t, w) @ normal_trace_matrix(
+        elasticity.basis, trace, t)
+    t, w = gauss_legendre(GAP_QUADRATURE_POINTS)
+    G = segment_weights(trace, segment, breaks, degree, t, w) @ np.ravel(
+        scene.gap(trace.points(t)))
+    qp = ContactQP(K=elasticity.K_free, F=elasticity.F[elasticity.free],
+                   B=B[:, elasticity.free].tocsr(), G=G, row_scale=np.repeat(H, degree + 1),
+                   objective_scale=float(scene.material.young_modulus))
+    # each coefficient sits at its Greville point k / q of the segment (the middle for q = 0)
+    greville = np.array([0.5]) if degree == 0 else np.linspace(0.0, 1.0, degree + 1)
+    row_coordinate = (breaks[:-1, None] + np.diff(breaks)[:, None] * greville).ravel()
 
     def recover(answer: QPSolution, residuals: Residuals, status: str,
                 reason: str) -> DiscreteSolution:
         lam = np.maximum(answer.multipliers, 0.0)
         return discrete_solution(
             "mixed", elasticity, trace, answer, residuals, status, reason, u_free=answer.u,
-            pressure=lambda tt: np.repeat(lam[segment][:, None], len(tt), axis=1),
+            pressure=lambda tt: np.einsum("kft,fk->ft",
+                                          segment_basis(trace, segment, breaks, degree, tt),
+                                          lam.reshape(-1, degree + 1)[segment]),
             multiplier_breaks=breaks, active_constraints=count_active(qp, answer.u, lam),
             max_h_over_H=h_over_H, details=MixedDetails(segment_of_facet=segment))
 
+    # Gram matrix of sum_S H_S ||mu||_{0,S}^2: H_S^2 times the Bernstein mass matrix per segment
+    gram = sparse.kron(sparse.diags(H**2), bernstein_gram(degree)).toarray() if degree else H**2
     return Discretisation(formulation="mixed", elasticity=elasticity, trace=trace, qp=qp,
-                          recover=recover, row_coordinate=0.5 * (breaks[:-1] + breaks[1:]),
-                          multiplier_gram=H**2)  # sum_S H_S ||mu||_{0,S}^2 = sum H_S^2 mu_S^2
+                          recover=recover, row_coordinate=row_coordinate,
+                          multiplier_gram=gram)
+

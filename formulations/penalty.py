@@ -49,14 +49,23 @@ from formulations.base import (
     QPSolution,
     Residuals,
 )
-from formulations.contact import contact_trace, gauss_legendre
+from formulations.contact import (
+    contact_trace,
+    gauss_legendre,
+    lagrange_basis,
+    lagrange_basis_1d,
+    lagrange_nodes,
+)
 from formulations.discretisation import Discretisation, discrete_solution
-from formulations.elasticity import assemble_elasticity
+from formulations.elasticity import assemble_elasticity, check_order
+from formulations.evaluation import normal_trace_matrix
 from formulations.registry import register_formulation
 from scenes import Scene
+from scenes.base import is_number
 
 DEFAULT_EPSILON_0 = 1e-3
-QUADRATURE_POINTS = 2  # per contact facet
+# Gauss points per contact facet: p + 1, exact for the (degree 2p) penalty integrand where the
+# penetration keeps its sign on a facet
 # the largest relative mismatch between the two readings of the pressure (see recover) for
 # status "ok". Measured on the paper scene: ~1e-12 for the active-set solver at the default
 # eps_0 (growing like 1/eps_0 to 2.5e-3 at 1e-12); for the reference 6.5e-6 (uniform, 2112
@@ -72,21 +81,6 @@ class PenaltyDetails:
     epsilon_0: float
     epsilon: np.ndarray
     slacks: np.ndarray
-
-
-def normal_trace_operator(elasticity, trace, t: np.ndarray) -> sparse.csr_matrix:
-    """P: u_h . n at the local points ``t`` of every contact facet, on the free DOFs (facet f,
-    point q -> row f * len(t) + q)."""
-    nf, nq = trace.size, t.size
-    dofs = elasticity.basis.nodal_dofs
-    rows = np.repeat(np.arange(nf * nq).reshape(nf, nq), 4, axis=1).ravel()
-    shape = np.stack([1 - t, 1 - t, t, t], axis=1)  # (nq, 4): end 0 (x, y), end 1 (x, y)
-    cols = np.stack([dofs[0, trace.vertices[0]], dofs[1, trace.vertices[0]],
-                     dofs[0, trace.vertices[1]], dofs[1, trace.vertices[1]]], axis=1)
-    normal = np.stack([trace.normal[0], trace.normal[1]] * 2, axis=1)  # (nf, 4)
-    vals = (normal[:, None, :] * shape[None, :, :]).ravel()
-    return sparse.csr_matrix((vals, (rows, np.repeat(cols, nq, axis=0).ravel())),
-                             shape=(nf * nq, elasticity.basis.N))[:, elasticity.free]
 
 
 def pressure_mismatch(penetration: np.ndarray, epsilon: np.ndarray, multipliers: np.ndarray,
@@ -117,29 +111,59 @@ def slack_qp(elasticity, P: sparse.csr_matrix, gap: np.ndarray, D: np.ndarray,
                      objective_scale=young)
 
 
-@register_formulation("penalty", "primal penalty, eps = eps_0 h_e / E (eps_0 = 1e-3), "
+def gap_interpolant(scene: Scene, trace, order: int):
+    """g_h: the P_order Lagrange interpolant of g on each contact facet, as a function of the
+    local coordinates t (n_facets, len(t)) (module docstring)."""
+    nodes = lagrange_nodes(order)
+    values = np.asarray(scene.gap(trace.points(nodes).reshape(2, -1)),
+                        dtype=float).reshape(trace.size, nodes.size)
+    return lambda t: values @ lagrange_basis_1d(order, np.asarray(t, dtype=float))
+
+
+def penalty_pressure(elasticity, trace, gap_h, epsilon: np.ndarray, u_free: np.ndarray,
+                     penetration_at_points: np.ndarray, t: np.ndarray):
+    """lambda_h(t) on every contact facet (module docstring): (u_hn - g_h)_+ / eps for P1; for
+    p >= 2 the degree-p interpolant of its values at the p + 1 Gauss points ``t``, clipped at 0
+    (the same polynomial where a facet penetrates throughout)."""
+    if elasticity.order == 1:
+        u_full = elasticity.expand(u_free)
+
+        def formula(tt):
+            tt = np.asarray(tt, dtype=float)
+            u_n = (normal_trace_matrix(elasticity.basis, trace, tt) @ u_full).reshape(
+                trace.size, -1)
+            return np.maximum(u_n - gap_h(tt), 0.0) / epsilon[:, None]
+
+        return formula
+    at_points = penetration_at_points / epsilon[:, None]  # (n_facets, p + 1)
+
+    def interpolant(tt):
+        return np.maximum(at_points @ lagrange_basis(t, np.asarray(tt, dtype=float)), 0.0)
+
+    return interpolant
+
+
+@register_formulation("penalty", "primal penalty, eps = eps_0 h_e / (p^2 E) (eps_0 = 1e-3), "
                                  "lambda_h = (u_hn - g_h)_+ / eps")
-def discretise(scene: Scene, mesh: MeshTri,
-               epsilon_0: float = DEFAULT_EPSILON_0) -> Discretisation:
-    if not (np.isfinite(epsilon_0) and epsilon_0 > 0):
+def discretise(scene: Scene, mesh: MeshTri, epsilon_0: float = DEFAULT_EPSILON_0,
+               order: int = 1) -> Discretisation:
+    if not (is_number(epsilon_0) and np.isfinite(epsilon_0) and epsilon_0 > 0):
         raise ValueError(f"epsilon_0={epsilon_0!r} is not a finite number > 0")
-    elasticity = assemble_elasticity(scene, mesh)
+    elasticity = assemble_elasticity(scene, mesh, check_order(order))
+    order = elasticity.order
     trace = contact_trace(scene, mesh)
     young = float(scene.material.young_modulus)
-    t, w = gauss_legendre(QUADRATURE_POINTS)
+    t, w = gauss_legendre(order + 1)
     nf, nq = trace.size, t.size
     n = elasticity.free.size
     ns = nf * nq
-    ends = np.asarray(scene.gap(trace.points(np.array([0.0, 1.0])).reshape(2, -1)),
-                      dtype=float).reshape(nf, 2)
-
-    def gap_h(tt):  # the P1 interpolant of g on each facet, at local coordinates tt
-        return ends[:, :1] + (ends[:, 1:] - ends[:, :1]) * np.asarray(tt)[None, :]
-
+    gap_h = gap_interpolant(scene, trace, order)
     gap = gap_h(t)
-    P = normal_trace_operator(elasticity, trace, t)
-    qp = slack_qp(elasticity, P, gap.ravel(), young / epsilon_0 * np.tile(w, nf), young)
-    epsilon = epsilon_0 * trace.length / young
+    P = normal_trace_matrix(elasticity.basis, trace, t)[:, elasticity.free]
+    # D_q = w_q h_e / eps_e = p^2 E w_q / eps_0
+    qp = slack_qp(elasticity, P, gap.ravel(), order**2 * young / epsilon_0 * np.tile(w, nf),
+                  young)
+    epsilon = epsilon_0 * trace.length / (order**2 * young)
     s_points = trace.coordinates_at(t)
     # per slack row: eps, and Gauss weight x facet length (the row's share of Gamma_C)
     row_epsilon, row_length = np.repeat(epsilon, nq), np.tile(w, nf) * np.repeat(trace.length, nq)
@@ -159,13 +183,8 @@ def discretise(scene: Scene, mesh: MeshTri,
             status, reason = STATUS_INACCURATE, (
                 f"penalty pressure (u_hn - g_h)_+/eps disagrees with the QP multipliers by "
                 f"{mismatch:.1e} (relative): u is not accurate enough for eps_0={epsilon_0:g}")
-        u_nodal = elasticity.nodal(elasticity.expand(u_free))
-
-        def pressure(tt):
-            tt = np.asarray(tt, dtype=float)
-            penetration = trace.normal_displacement(u_nodal, tt) - gap_h(tt)
-            return np.maximum(penetration, 0.0) / epsilon[:, None]
-
+        pressure = penalty_pressure(elasticity, trace, gap_h, epsilon, u_free,
+                                    np.maximum(penetration_at_points, 0.0).reshape(nf, nq), t)
         penetrating = int((penetration_at_points > 0).sum())
         return discrete_solution(
             "penalty", elasticity, trace, answer, residuals, status, reason, u_free=u_free,

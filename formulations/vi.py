@@ -21,9 +21,10 @@ from scipy import sparse
 from skfem import MeshTri
 
 from formulations.base import ContactQP, DiscreteSolution, QPSolution, Residuals
-from formulations.contact import contact_trace
+from formulations.contact import contact_trace, gauss_legendre, lagrange_basis_1d, lagrange_nodes
 from formulations.discretisation import Discretisation, discrete_solution
-from formulations.elasticity import assemble_elasticity
+from formulations.elasticity import assemble_elasticity, check_order
+from formulations.evaluation import evaluate_on_trace
 from formulations.kkt import count_active
 from formulations.registry import register_formulation
 from scenes import Scene
@@ -39,41 +40,98 @@ class NodalDetails:
     contact_nodes: np.ndarray
 
 
-@register_formulation("vi", "primal variational inequality: nodal constraints "
-                            "u_h(x_i).n_i <= g(x_i), lambda_h from the nodal reactions")
-def discretise(scene: Scene, mesh: MeshTri) -> Discretisation:
-    elasticity = assemble_elasticity(scene, mesh)
-    trace = contact_trace(scene, mesh)
-    nodes, local = np.unique(trace.vertices, return_inverse=True)
-    local = local.reshape(trace.vertices.shape)  # (2, n_facets): row of each facet end
-    m = nodes.size
-    weight = np.bincount(local.ravel(), np.tile(0.5 * trace.length, 2), m)  # int phi_i ds
-    normal = np.array([np.bincount(local.ravel(), np.tile(0.5 * trace.length * trace.normal[c],
-                                                           2), m) for c in (0, 1)])
-    normal /= np.linalg.norm(normal, axis=0)
+def newton_cotes(order: int) -> np.ndarray:
+    """int_0^1 L_k dt for the 1D Lagrange polynomials L_k on the equispaced nodes k / p (the
+    lumped boundary mass per unit facet length: 1/2, 1/2 for P1; 1/6, 2/3, 1/6 for P2 --
+    Simpson; 1/8, 3/8, 3/8, 1/8 for P3); all positive for p <= 3."""
+    t, w = gauss_legendre(order + 1)
+    return lagrange_basis_1d(order, t) @ w
 
-    dofs = elasticity.basis.nodal_dofs[:, nodes]  # (2, m)
-    B = sparse.csr_matrix((normal.ravel(), (np.tile(np.arange(m), 2), dofs.ravel())),
-                          shape=(m, elasticity.basis.N))
-    points = mesh.p[:, nodes]
-    G = np.asarray(scene.gap(points), dtype=float)
+
+@dataclass(frozen=True, eq=False)
+class TraceNodes:
+    """The Lagrange nodes of the displacement on Gamma_C: the facet end vertices, then the
+    p - 1 nodes inside every facet. ``facet_rows`` (n_facets, p + 1) gives, per facet, the row
+    of each node in order of t = k / p."""
+
+    points: np.ndarray        # (2, m)
+    normal: np.ndarray        # (2, m) unit, length-weighted mean at a vertex
+    weight: np.ndarray        # (m,) int_{Gamma_C} phi_i ds (lumped boundary mass)
+    facet_rows: np.ndarray    # (n_facets, p + 1)
+    vertices: np.ndarray      # mesh vertex of each of the first rows
+
+
+def trace_nodes(mesh: MeshTri, trace, order: int) -> TraceNodes:
+    """The constraint nodes of ``vi`` for P_order (module docstring)."""
+    vertices, local = np.unique(trace.vertices, return_inverse=True)
+    local = local.reshape(trace.vertices.shape)  # (2, n_facets): row of each facet end
+    nv, nf, inner = vertices.size, trace.size, order - 1
+    inside = nv + np.arange(nf * inner).reshape(nf, inner)
+    facet_rows = np.column_stack([local[0], inside, local[1]])
+    m = nv + nf * inner
+    mass = newton_cotes(order)[None, :] * trace.length[:, None]  # (n_facets, p + 1)
+    weight = np.bincount(facet_rows.ravel(), mass.ravel(), m)
+    normal = np.array([np.bincount(facet_rows.ravel(), (mass * trace.normal[c][:, None]).ravel(),
+                                   m) for c in (0, 1)])
+    normal /= np.linalg.norm(normal, axis=0)
+    t_inside = lagrange_nodes(order)[1:-1]
+    points = np.concatenate([mesh.p[:, vertices], trace.points(t_inside).reshape(2, -1)], axis=1)
+    return TraceNodes(points=points, normal=normal, weight=weight, facet_rows=facet_rows,
+                      vertices=vertices)
+
+
+def constraint_rows(elasticity, trace, nodes: TraceNodes) -> sparse.csr_matrix:
+    """B_i = n_i' u_h(x_i): the vertex DOFs directly, the nodes inside facets by evaluating the
+    basis there (other basis functions vanish at a Lagrange node up to round-off, dropped)."""
+    nv = nodes.vertices.size
+    dofs = elasticity.basis.nodal_dofs[:, nodes.vertices]  # (2, nv)
+    vertex_rows = sparse.csr_matrix((nodes.normal[:, :nv].ravel(),
+                                     (np.tile(np.arange(nv), 2), dofs.ravel())),
+                                    shape=(nv, elasticity.basis.N))
+    inner = elasticity.order - 1
+    if inner == 0:
+        return vertex_rows
+    t_inside = lagrange_nodes(elasticity.order)[1:-1]
+    inside = evaluate_on_trace(elasticity.basis, trace, t_inside).matrix(nodes.normal[:, nv:])
+    inside.data[np.abs(inside.data) < 1e-12] = 0.0
+    inside.eliminate_zeros()
+    return sparse.vstack([vertex_rows, inside], format="csr")
+
+
+@register_formulation("vi", "primal variational inequality: nodal constraints "
+                            "u_h(x_i).n_i <= g(x_i) at every Lagrange node of Gamma_C, "
+                            "lambda_h from the nodal reactions")
+def discretise(scene: Scene, mesh: MeshTri, order: int = 1) -> Discretisation:
+    elasticity = assemble_elasticity(scene, mesh, check_order(order))
+    trace = contact_trace(scene, mesh)
+    nodes = trace_nodes(mesh, trace, elasticity.order)
+    m = nodes.weight.size
+    B = constraint_rows(elasticity, trace, nodes)
+    G = np.asarray(scene.gap(nodes.points), dtype=float)
     # rows of B are dimensionless (a normal), so the multipliers are forces; row_scale 1
     qp = ContactQP(K=elasticity.K_free, F=elasticity.F[elasticity.free],
                    B=B[:, elasticity.free].tocsr(), G=G, row_scale=np.ones(m),
                    objective_scale=float(scene.material.young_modulus))
-    coordinate = np.asarray(scene.contact_coordinate(points), dtype=float)
+    coordinate = np.asarray(scene.contact_coordinate(nodes.points), dtype=float)
+    pieces = elasticity.order  # lambda_h is linear between consecutive nodes of a facet
 
     def recover(answer: QPSolution, residuals: Residuals, status: str,
                 reason: str) -> DiscreteSolution:
         reaction = np.maximum(answer.multipliers, 0.0)
-        lam = reaction / weight
-        a, b = lam[local[0]][:, None], lam[local[1]][:, None]
+        lam = reaction / nodes.weight
+        values = lam[nodes.facet_rows]  # (n_facets, p + 1)
+
+        def pressure(t):
+            x = np.clip(np.asarray(t, dtype=float), 0.0, 1.0) * pieces
+            k = np.minimum(np.floor(x).astype(int), pieces - 1)
+            return values[:, k] + (values[:, k + 1] - values[:, k]) * (x - k)[None, :]
+
         return discrete_solution(
             "vi", elasticity, trace, answer, residuals, status, reason, u_free=answer.u,
-            pressure=lambda t: a + (b - a) * np.asarray(t)[None, :],
-            multiplier_breaks=np.sort(coordinate),
+            pressure=pressure, multiplier_breaks=np.sort(coordinate),
             active_constraints=count_active(qp, answer.u, reaction),
-            details=NodalDetails(reactions=reaction, nodal_pressure=lam, contact_nodes=nodes))
+            details=NodalDetails(reactions=reaction, nodal_pressure=lam,
+                                 contact_nodes=nodes.vertices))
 
     return Discretisation(formulation="vi", elasticity=elasticity, trace=trace, qp=qp,
                           recover=recover, row_coordinate=coordinate)

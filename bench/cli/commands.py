@@ -29,6 +29,7 @@ from bench.sequence.rows import KEYS, level_time
 from bench.verify import load_expected, verdict_table, verify
 from estimators import estimator_descriptions, estimator_names
 from formulations import formulation_descriptions, formulation_names, solver_descriptions
+from formulations.elasticity import order_descriptions
 from formulations.solvers.backends import check_backend
 from scenes import scene_descriptions, scene_names
 
@@ -58,6 +59,7 @@ def list_command(args) -> int:
                          ("formulations", formulation_descriptions()),
                          ("solvers", solver_descriptions()),
                          ("estimators", estimator_descriptions()),
+                         ("orders (--order)", order_descriptions()),
                          ("hard cases", hard_case_descriptions())):
         print(f"{title}:")
         for name, text in items.items():
@@ -92,7 +94,8 @@ def run_config(config: RunConfig | None) -> int:
 def run_command(args) -> int:
     config = configured(
         scenes=args.scene, formulations=args.formulation, solvers=args.solver,
-        estimators=args.estimator, strategies=args.strategy, max_dofs=args.max_dofs,
+        estimators=args.estimator, strategies=args.strategy, orders=args.order,
+        max_dofs=args.max_dofs,
         max_levels=args.max_levels, marking=args.marking, theta=args.theta,
         backend=args.backend, nested=not args.cold_start, reference_dofs=args.reference_dofs,
         crosscheck_dofs=args.crosscheck_dofs, max_memory_gib=args.max_memory, out=args.out,
@@ -162,14 +165,16 @@ def verify_command(args) -> int:
 
 def scaling_command(args) -> int:
     def show(row):
-        print(f"{row['size']}: ndofs {row['ndofs']}  fast {row['t_fast_solve']:.2f} s  "
+        print(f"{row['size']} P{row['order']}: ndofs {row['ndofs']}  "
+              f"fast {row['t_fast_solve']:.2f} s  "
               f"linear {row['t_linear_solve']:.2f} s  reference "
               f"{row['t_reference_solve']:.2f} s  peak {row['peak_gib']:.2f} GiB", flush=True)
     try:
         check_backend(args.backend)
     except ValueError as error:
         raise InputError(f"--backend: {error}") from None
-    frame = run_scaling(args.sizes, args.backend, args.reference_max_dofs, on_row=show)
+    frame = run_scaling(args.sizes, args.backend, args.reference_max_dofs, on_row=show,
+                        orders=args.order)
     print(f"wrote {write_scaling(frame, args.out, args.readme)}")
     return 0
 

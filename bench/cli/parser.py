@@ -14,6 +14,7 @@ from bench.sequence.loop import STRATEGIES
 from bench.sequence.marking import MARKINGS
 from estimators import estimator_names
 from formulations import formulation_names, solver_names
+from formulations.elasticity import ORDERS
 from formulations.solvers.backends import BACKENDS
 from scenes import scene_names
 
@@ -41,6 +42,21 @@ def _names(kind: str, valid: list[str], plural: str | None = None, sweep: bool =
                   file=sys.stderr)
         return once
     return parse
+
+
+def _orders(text: str) -> list[int]:
+    """A comma-separated list of polynomial orders from ``ORDERS``."""
+    items = [item.strip() for item in text.split(",") if item.strip()]
+    values = [integer_value(item) for item in items]
+    if not items or any(v not in ORDERS for v in values):
+        raise argparse.ArgumentTypeError(
+            f"order={text!r} is not a comma-separated list of orders from "
+            f"{', '.join(map(str, ORDERS))}")
+    once = list(dict.fromkeys(values))
+    if len(once) < len(values):
+        print(f"note: order given more than once in {text!r}; running each once",
+              file=sys.stderr)
+    return once
 
 
 def integer_value(text: str) -> int | None:
@@ -140,6 +156,10 @@ def _run_parser(sub) -> None:
     run.add_argument("--strategy", type=_names("strategy", list(STRATEGIES), "strategies"),
                      default=["adaptive"],
                      help="refinement strategy(ies): uniform, adaptive (default: adaptive)")
+    run.add_argument("--order", type=_orders, default=[1],
+                     help="polynomial order(s) p of the displacements, comma-separated, from "
+                          f"{', '.join(map(str, ORDERS))}; every formulation and estimator "
+                          "runs at each (default: 1)")
     run.add_argument("--max-dofs", type=_positive_int("max_dofs"), default=20000,
                      help="DOF budget: stop before a level with more unknowns (default: 20000)")
     run.add_argument("--max-levels", type=_positive_int("max_levels"), default=40,
@@ -190,6 +210,8 @@ def _scaling_parser(sub) -> None:
                          help=f"sizes, comma-separated: {', '.join(SIZES)} (default: all)")
     scaling.add_argument("--backend", choices=BACKENDS, default=None,
                          help="sparse back-end (default: cholmod when installed)")
+    scaling.add_argument("--order", type=_orders, default=[1],
+                         help="polynomial order(s) of the displacements (default: 1)")
     scaling.add_argument("--reference-max-dofs", type=_positive_int("reference_max_dofs"),
                          default=200_000, help="run the reference solver only up to this "
                          "many DOFs (default: 200000)")

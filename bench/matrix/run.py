@@ -30,6 +30,7 @@ from bench.sequence.rows import COLUMNS, ResultRow
 from bench.truth import truth_for
 from estimators import estimator_names
 from formulations import STATUS_FAILED, formulation_names, solver_names
+from formulations.elasticity import ORDERS, check_order
 from formulations.solvers.backends import check_backend
 from scenes import scene_names
 from scenes.base import is_integer
@@ -51,6 +52,7 @@ class RunConfig:
     solvers: tuple[str, ...] = ("reference",)
     estimators: tuple[str, ...] = ("residual",)
     strategies: tuple[str, ...] = ("adaptive",)
+    orders: tuple[int, ...] = (1,)  # polynomial orders of the displacements, a matrix dimension
     max_dofs: int = 20000
     max_levels: int = 40
     marking: str = "doerfler"
@@ -81,6 +83,12 @@ class RunConfig:
             if name in SWEPT:
                 for item in items:
                     parse_item(item, name)
+        object.__setattr__(self, "orders", tuple(self.orders))
+        if not self.orders or len(set(self.orders)) < len(self.orders):
+            raise ValueError(f"orders={list(self.orders)!r}: give each order once, from "
+                             f"{', '.join(map(str, ORDERS))}")
+        for order in self.orders:
+            check_order(order)
         for name in ("reference_dofs", "crosscheck_dofs", "workers"):
             value = getattr(self, name)
             if value is not None and not (is_integer(value) and value >= 0):
@@ -93,7 +101,7 @@ class RunConfig:
         return cross_product(
             [s for item in self.scenes for s in parse_item(item, "scenes")],
             [f for item in self.formulations for f in parse_item(item, "formulations")],
-            self.solvers, self.estimators, self.strategies, max_dofs=self.max_dofs,
+            self.solvers, self.estimators, self.strategies, self.orders, max_dofs=self.max_dofs,
             max_levels=self.max_levels, marking=self.marking, theta=self.theta,
             nested=self.nested, backend=self.backend, reference_dofs=self.reference_dofs,
             crosscheck_dofs=self.crosscheck_dofs)

@@ -16,7 +16,7 @@ from formulations import get_formulation
 from scenes import get_scene
 from scenes.registry import SCENES
 
-SPEC_VERSION = 1  # bump when the rows of an unchanged spec would change
+SPEC_VERSION = 2  # bump when the rows of an unchanged spec would change
 
 
 @dataclass(frozen=True)
@@ -26,6 +26,7 @@ class SequenceSpec:
     solver: str
     estimator: str
     strategy: str
+    order: int = 1
     scene_parameters: tuple[tuple[str, object], ...] = ()
     formulation_options: tuple[tuple[str, object], ...] = ()
     max_dofs: int = 20000
@@ -43,7 +44,7 @@ class SequenceSpec:
         return hashlib.sha256(text.encode()).hexdigest()[:20]
 
     def loop_config(self, max_memory_gib: float | None = None) -> LoopConfig:
-        return LoopConfig(strategy=self.strategy, max_dofs=self.max_dofs,
+        return LoopConfig(strategy=self.strategy, order=self.order, max_dofs=self.max_dofs,
                           max_levels=self.max_levels, marking=self.marking, theta=self.theta,
                           nested=self.nested, max_memory_gib=max_memory_gib,
                           solver_options={"backend": self.backend} if self.backend else {})
@@ -55,16 +56,17 @@ class SequenceSpec:
                 "formulation_options": label(self.formulation_options)}
 
 
-def cross_product(scenes, formulations, solvers, estimators, strategies,
+def cross_product(scenes, formulations, solvers, estimators, strategies, orders=(1,),
                   **settings) -> list[SequenceSpec]:
     """Every combination as a spec; ``scenes`` and ``formulations`` are (name, parameter
     pairs) as ``parse_item`` gives them, ``settings`` the remaining fields."""
     return [SequenceSpec(scene=scene, formulation=formulation, solver=solver,
-                         estimator=estimator, strategy=strategy,
+                         estimator=estimator, strategy=strategy, order=order,
                          scene_parameters=tuple(sorted(parameters)),
                          formulation_options=tuple(sorted(options)), **settings)
-            for (scene, parameters), (formulation, options), solver, estimator, strategy
-            in itertools.product(scenes, formulations, solvers, estimators, strategies)]
+            for (scene, parameters), (formulation, options), solver, estimator, strategy, order
+            in itertools.product(scenes, formulations, solvers, estimators, strategies,
+                                 orders)]
 
 
 def label(pairs) -> str:
@@ -114,5 +116,9 @@ def build_scene(spec: SequenceSpec):
 
 
 def check_formulation_options(spec: SequenceSpec) -> None:
+    """Refuse an option ``discretise`` does not take; the order is its own dimension."""
+    if any(k == "order" for k, _ in spec.formulation_options):
+        raise ValueError(f"formulation {spec.formulation!r}: give the polynomial order with "
+                         "--order (RunConfig.orders), not as a formulation option")
     check_parameters("formulation", spec.formulation, spec.formulation_options,
                      get_formulation(spec.formulation))

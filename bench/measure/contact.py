@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from formulations import DiscreteSolution
+from formulations.contact import lagrange_nodes
 from formulations.kkt import ACTIVE_FRACTION
 
 
@@ -27,8 +28,8 @@ def zone_error(zone: tuple[float, float], true_zone: tuple[float, float]) -> flo
 
 
 def penetration(scene, solution: DiscreteSolution) -> float:
-    """max over the contact nodes of (u_h . n - g)^+ (a length)."""
-    trace, ends = solution.trace, np.array([0.0, 1.0])
-    u_n = trace.normal_displacement(solution.elasticity.nodal(solution.u), ends)
-    gap = np.asarray(scene.gap(trace.points(ends)))
+    """max over the Lagrange nodes of Gamma_C of (u_h . n - g)^+ (a length)."""
+    trace, nodes = solution.trace, lagrange_nodes(solution.elasticity.order)
+    u_n = solution.normal_displacement(nodes)
+    gap = np.asarray(scene.gap(trace.points(nodes)))
     return float(np.maximum(u_n - gap, 0.0).max(initial=0.0))

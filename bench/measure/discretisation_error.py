@@ -4,8 +4,9 @@
 * contact-pressure error ||lambda - lambda_h||_{0, Gamma_C};
 * contact-zone error: the larger distance between computed and true zone end points.
 
-Against an exact solution the integrals run over the mesh of u_h with a 6th-order rule (exact
-for u_h, accurate for the smooth u); against a reference on another mesh see
+Against an exact solution the integrals run over the mesh of u_h with a rule of order
+6 + 2(p - 1) (exact for u_h of order p, accurate for the smooth u); against a reference on
+another mesh see
 ``bench.measure.nonnested``.
 """
 
@@ -14,14 +15,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from skfem import Basis, ElementTriP1, ElementVector
+from skfem import Basis
 
 from bench.measure.contact import contact_zone, zone_error
 from formulations import DiscreteSolution
 from formulations.contact import gauss_legendre
 from formulations.elasticity import stress_from_gradient
 
-EXACT_INTORDER = 6
+EXACT_INTORDER = 6  # plus 2 (p - 1) for P_p: the u_h part of the integrand stays exact
 PRESSURE_POINTS = 6  # Gauss points per contact facet for ||lambda - lambda_h||
 
 
@@ -65,8 +66,9 @@ def errors_from(energy_error: float, solution: DiscreteSolution, true_pressure,
 
 def exact_errors(scene, solution: DiscreteSolution) -> Errors:
     exact = scene.exact
-    basis = Basis(solution.elasticity.mesh, ElementVector(ElementTriP1()),
-                  intorder=EXACT_INTORDER)
+    order = solution.elasticity.order
+    basis = Basis(solution.elasticity.mesh, solution.elasticity.basis.elem,
+                  intorder=EXACT_INTORDER + 2 * (order - 1))
     grad_h = basis.interpolate(solution.u).grad
     diff = exact.gradient(np.asarray(basis.global_coordinates())) - grad_h
     energy = float((energy_density(diff, *solution.elasticity.lame) * basis.dx).sum())

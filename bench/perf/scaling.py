@@ -10,6 +10,7 @@ pytest-benchmark module ``tests/benchmarks``.
 
 from __future__ import annotations
 
+import itertools
 import multiprocessing
 import platform
 import resource
@@ -24,15 +25,21 @@ SIZES = {"1e4": (9, 3), "1e5": (14, 4), "1e6": (11, 6)}
 README_START, README_END = "<!-- scaling:start -->", "<!-- scaling:end -->"
 
 
-def paper_problem(size: str):
-    """(scene, mesh) of the paper scene with about ``size`` DOFs."""
+def paper_problem(size: str, order: int = 1):
+    """(scene, mesh) of the paper scene with about ``size`` DOFs of order ``order`` (for
+    order > 1: the uniform level of the P1 size's mesh whose DOF count is nearest to it)."""
+    from formulations.elasticity import count_free_dofs
     from scenes import get_scene
 
     if size not in SIZES:
         raise ValueError(f"size={size!r} is not one of {', '.join(SIZES)}")
     divisions, refinements = SIZES[size]
     scene = get_scene("paper", initial_divisions=divisions)
-    return scene, scene.mesh.refined(refinements)
+    target = count_free_dofs(scene, scene.mesh.refined(refinements))
+    levels = range(refinements + 1) if order > 1 else [refinements]
+    best = min(levels, key=lambda r: abs(np.log(count_free_dofs(
+        scene, scene.mesh.refined(r), order) / target)))
+    return scene, scene.mesh.refined(best)
 
 
 def linear_rhs(qp) -> np.ndarray:
@@ -45,17 +52,19 @@ def _peak_gib() -> float:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20  # KiB on Linux
 
 
-def measure(size: str, backend: str | None = None, reference: bool = True) -> dict:
+def measure(size: str, backend: str | None = None, reference: bool = True,
+            order: int = 1) -> dict:
     """Time every phase once at ``size``; run in a fresh process for a meaningful peak."""
     from estimators import get_estimator
     from formulations import get_formulation, solve
     from formulations.solvers.backends import check_backend, factorise
 
     backend = check_backend(backend)
-    scene, mesh = paper_problem(size)
+    scene, mesh = paper_problem(size, order)
     start = time.perf_counter()
-    disc = get_formulation("mixed")(scene, mesh)
-    row = {"size": size, "ndofs": disc.ndofs, "n_constraints": disc.qp.m, "backend": backend,
+    disc = get_formulation("mixed")(scene, mesh, order=order)
+    row = {"size": size, "order": order, "ndofs": disc.ndofs, "n_constraints": disc.qp.m,
+           "backend": backend,
            "t_assemble": time.perf_counter() - start}
     start = time.perf_counter()
     factorise(disc.qp.K, backend)(linear_rhs(disc.qp))
@@ -86,17 +95,20 @@ def _measure_star(args):
     return measure(*args)
 
 
-def run_scaling(sizes, backend=None, reference_max_dofs=200_000, on_row=None) -> pd.DataFrame:
-    """``measure`` every size in its own spawned process; the reference only up to
+def run_scaling(sizes, backend=None, reference_max_dofs=200_000, on_row=None,
+                orders=(1,)) -> pd.DataFrame:
+    """``measure`` every size (and order) in its own spawned process; the reference only up to
     ``reference_max_dofs`` (its time grows fastest; see the README for where it stops)."""
+    from formulations.elasticity import count_free_dofs
+
     rows = []
     context = multiprocessing.get_context("spawn")
-    for size in sizes:
-        scene, mesh = paper_problem(size)  # cheap: the DOF count decides the reference
-        ndofs_estimate = 2 * mesh.p.shape[1]
+    for size, order in itertools.product(sizes, orders):
+        scene, mesh = paper_problem(size, order)  # cheap: the DOF count decides the reference
+        ndofs = count_free_dofs(scene, mesh, order)
         with context.Pool(1) as pool:
             row = pool.apply(_measure_star,
-                             ((size, backend, ndofs_estimate <= reference_max_dofs),))
+                             ((size, backend, ndofs <= reference_max_dofs, order),))
         rows.append(row)
         if on_row is not None:
             on_row(row)
@@ -115,6 +127,7 @@ def machine_line() -> str:
 
 def markdown_table(frame: pd.DataFrame) -> str:
     table = pd.DataFrame({
+        "order": frame["order"] if "order" in frame else 1,
         "N (DOFs)": frame["ndofs"],
         "contact rows": frame["n_constraints"],
         "assembly [s]": frame["t_assemble"].map("{:.2f}".format),

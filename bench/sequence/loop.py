@@ -22,6 +22,7 @@ from bench.sequence.rows import ResultRow, identity_columns
 from estimators import get_estimator
 from formulations import STATUS_FAILED, get_formulation, solve
 from formulations.elasticity import (
+    check_order,
     count_free_dofs,
     element_diameters,
     predict_uniform_free_dofs,
@@ -38,6 +39,7 @@ class LoopConfig:
     """How a refinement sequence is run; validated on construction."""
 
     strategy: str = "adaptive"
+    order: int = 1  # polynomial order p of the displacements (formulations.elasticity.ORDERS)
     max_dofs: int = 20000
     max_levels: int = 40
     marking: str = "doerfler"
@@ -55,6 +57,7 @@ class LoopConfig:
     def __post_init__(self):
         if self.strategy not in STRATEGIES:
             raise ValueError(f"strategy={self.strategy!r} is not one of {', '.join(STRATEGIES)}")
+        check_order(self.order)
         for name in ("max_dofs", "max_levels"):
             value = getattr(self, name)
             if not (is_integer(value) and value > 0):
@@ -102,7 +105,7 @@ def memory_refusal(level: int, ndofs: int, solver: str, config: LoopConfig) -> s
     """Why a level of ``ndofs`` unknowns must not be built (its predicted peak memory does not
     fit), or None."""
     backend = check_backend(config.solver_options.get("backend"))
-    need = predict_peak_gib(ndofs, solver, backend)
+    need = predict_peak_gib(ndofs, solver, backend, config.order)
     limit = config.max_memory_gib if config.max_memory_gib is not None else available_gib()
     if need <= limit:
         return None
@@ -118,14 +121,16 @@ def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
     or a level fails (its row says why); return why it ended (``budget``, ``max_levels``,
     ``memory``, ``failed``). With a ``truth`` (``bench.truth``) every level also gets its
     errors and effectivity indices; ``identity``: the run's columns (run id, provenance, sweep
-    labels); ``formulation_options`` go to the formulation's ``discretise``."""
-    discretise = functools.partial(get_formulation(formulation), **(formulation_options or {}))
+    labels); ``formulation_options`` go to the formulation's ``discretise``, with the
+    configuration's ``order``."""
+    discretise = functools.partial(get_formulation(formulation), order=config.order,
+                                   **(formulation_options or {}))
     estimate = get_estimator(estimator)
     ident = identity_columns(scene.name, formulation, solver, estimator, config, identity)
     mesh = scene.mesh if mesh is None else mesh
     t_refine, previous = 0.0, None
     for level in range(config.max_levels):
-        ndofs = count_free_dofs(scene, mesh)  # the budgets are checked before any assembly
+        ndofs = count_free_dofs(scene, mesh, config.order)  # budgets: before any assembly
         if level > 0 and ndofs > config.max_dofs:
             return "budget"
         refusal = memory_refusal(level, ndofs, solver, config)
@@ -162,8 +167,8 @@ def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
         yield LevelResult(ResultRow(**ident, **numbers), sol, est)
         if failed:
             return "failed"
-        if config.strategy == "uniform" and predict_uniform_free_dofs(scene, mesh) > \
-                config.max_dofs:
+        if config.strategy == "uniform" and predict_uniform_free_dofs(
+                scene, mesh, config.order) > config.max_dofs:
             return "budget"
         start = time.perf_counter()
         mesh = refine(mesh, sol, est, config)

@@ -18,6 +18,11 @@ on the 2-core reference machine:
   the peak at 1e5 or 1e6, so the cholmod line is used as its bound.
 
 Formulations differ by a few slack unknowns per contact point, which the model ignores.
+
+Higher order: a P_p DOF couples to more DOFs (stiffness nonzeros per row 12 / 22 / 33 for
+p = 1 / 2 / 3; CHOLMOD's factor about the same per DOF), so the per-DOF slope is scaled by
+ORDER_FACTOR, measured with ``python -m bench scaling --sizes 1e4,1e5 --order 1,2,3`` (cholmod):
+peak 0.83 GiB at 100 800 P2 DOFs (1.4 x the P1 slope) and 0.62 GiB at 56 784 P3 DOFs (1.7 x).
 """
 
 from __future__ import annotations
@@ -40,15 +45,17 @@ class MemoryLine:
 
 CHOLMOD = MemoryLine(0.1713, 4.754e-6)
 MODEL = {"cholmod": CHOLMOD, "splu": MemoryLine(0.1612, 7.851e-6), "reference": CHOLMOD}
+ORDER_FACTOR = {1: 1.0, 2: 1.4, 3: 1.7}  # per-DOF memory of P_p relative to P1 (docstring)
 
 
 def route(solver: str, backend: str) -> str:
     return "reference" if solver == "reference" else backend
 
 
-def predict_peak_gib(ndofs: int, solver: str, backend: str) -> float:
-    """The predicted peak memory of a level with ``ndofs`` unknowns (GiB)."""
-    return MODEL[route(solver, backend)].peak_gib(ndofs)
+def predict_peak_gib(ndofs: int, solver: str, backend: str, order: int = 1) -> float:
+    """The predicted peak memory of a level with ``ndofs`` unknowns of order ``order`` (GiB)."""
+    line = MODEL[route(solver, backend)]
+    return line.base_gib + ORDER_FACTOR[order] * line.per_dof_gib * ndofs
 
 
 def available_gib(meminfo: str | Path = "/proc/meminfo") -> float:

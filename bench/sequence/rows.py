@@ -18,6 +18,7 @@ class ResultRow:
     estimator: str
     strategy: str
     level: int
+    order: int = 1  # polynomial order p of the displacements
     ndofs: int = 0
     n_elements: int = 0
     h_max: float = math.nan
@@ -85,7 +86,7 @@ class ResultRow:
 
 COLUMNS = [f.name for f in fields(ResultRow)]
 # identity of a combination (the sweep labels are empty outside sweeps)
-KEYS = ["scene", "formulation", "solver", "estimator", "strategy", "scene_parameters",
+KEYS = ["scene", "formulation", "solver", "estimator", "strategy", "order", "scene_parameters",
         "formulation_options"]
 LABELS = ["scene_parameters", "formulation_options"]
 # sequence_end of a complete sequence; INTERRUPTED (or no end at all) marks one cut short
@@ -101,14 +102,17 @@ def identity_columns(scene: str, formulation: str, solver: str, estimator: str, 
     ``bench.sequence.loop.LoopConfig``) and the run's identity, sweep labels and provenance
     (``run``)."""
     return dict(scene=scene, formulation=formulation, solver=solver, estimator=estimator,
-                strategy=config.strategy, marking=config.marking, theta=config.theta,
+                strategy=config.strategy, order=config.order, marking=config.marking,
+                theta=config.theta,
                 **(run or {}))
 
 
 def with_labels(frame):
     """A result table with the sweep label columns present and empty strings for missing
-    labels (rows of older tables), so that grouping by KEYS keeps every row."""
+    labels (rows of older tables; their order is 1), so that grouping by KEYS keeps every
+    row."""
     frame = frame.copy()
+    frame["order"] = (frame["order"].fillna(1).astype(int) if "order" in frame else 1)
     for column in LABELS + ["sequence_key", "sequence_end"]:
         frame[column] = (frame[column].astype(object).fillna("").astype(str) if column in frame
                          else "")

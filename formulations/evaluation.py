@@ -1,0 +1,85 @@
+"""Values and gradients of a finite element field at given points, each point in a known element
+(docs/theory.md, section 9). For every Lagrange order alike: the element's own basis functions
+(scikit-fem's ``gbasis``) at the points' reference coordinates, so that nothing here assumes that
+a field is linear on a facet or constant on an element.
+
+Facet points are found in the element the facet belongs to (``ContactTrace.element``), never by
+point location: a point on the boundary is inside its element exactly, and a field continuous
+across elements has one value there anyway.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import sparse
+from skfem import Basis
+
+CHUNK = 200_000  # points per block when summing gradients (bounds the temporary arrays)
+
+
+@dataclass(frozen=True, eq=False)
+class PointEvaluation:
+    """The basis functions of ``basis`` at points x (2, n), point i in element ``cells[i]``:
+    ``values[k]`` (2, n) and ``gradients[k]`` (2, 2, n) of local basis function k."""
+
+    basis: Basis
+    cells: np.ndarray
+    values: tuple[np.ndarray, ...]
+    gradients: tuple[np.ndarray, ...]
+
+    @property
+    def size(self) -> int:
+        return int(self.cells.size)
+
+    def matrix(self, direction: np.ndarray) -> sparse.csr_matrix:
+        """The sparse operator u -> u_h(x_i) . direction_i (rows: points; columns: all DOFs)."""
+        vals = np.concatenate([np.einsum("in,in->n", v, direction) for v in self.values])
+        rows = np.tile(np.arange(self.size), len(self.values))
+        cols = self.basis.element_dofs[:, self.cells].ravel()
+        return sparse.csr_matrix((vals, (rows, cols)), shape=(self.size, self.basis.N))
+
+    def value(self, u: np.ndarray) -> np.ndarray:
+        """u_h at the points, shape (2, n)."""
+        dofs = self.basis.element_dofs[:, self.cells]
+        return sum(v * u[dofs[k]] for k, v in enumerate(self.values))
+
+    def gradient(self, u: np.ndarray) -> np.ndarray:
+        """grad u_h at the points, grad[i, j] = d u_i / d x_j; shape (2, 2, n)."""
+        dofs = self.basis.element_dofs[:, self.cells]
+        return sum(g * u[dofs[k]] for k, g in enumerate(self.gradients))
+
+
+def evaluate_at(basis: Basis, x: np.ndarray, cells: np.ndarray) -> PointEvaluation:
+    """The basis functions of ``basis`` at points ``x`` (2, n) lying in elements ``cells``."""
+    X = basis.mapping.invF(x[:, :, None], tind=cells)
+    fields = [basis.elem.gbasis(basis.mapping, X, k, tind=cells)[0]
+              for k in range(basis.Nbfun)]
+    return PointEvaluation(basis=basis, cells=cells,
+                           values=tuple(f.value[..., 0] for f in fields),
+                           gradients=tuple(f.grad[..., 0] for f in fields))
+
+
+def evaluate_on_trace(basis: Basis, trace, t: np.ndarray) -> PointEvaluation:
+    """The basis functions at local coordinates ``t`` of every contact facet of ``trace``
+    (facet f, point q -> point f * len(t) + q)."""
+    t = np.asarray(t, dtype=float)
+    return evaluate_at(basis, trace.points(t).reshape(2, -1), np.repeat(trace.element, t.size))
+
+
+def normal_trace_matrix(basis: Basis, trace, t: np.ndarray) -> sparse.csr_matrix:
+    """u -> u_h . n at local coordinates ``t`` of every contact facet (row f * len(t) + q), on
+    all DOFs."""
+    t = np.asarray(t, dtype=float)
+    return evaluate_on_trace(basis, trace, t).matrix(np.repeat(trace.normal, t.size, axis=1))
+
+
+def gradients_at(basis: Basis, u: np.ndarray, x: np.ndarray, cells: np.ndarray) -> np.ndarray:
+    """grad u_h at many points (2, n) in elements ``cells``, in blocks of CHUNK points;
+    shape (2, 2, n)."""
+    out = np.empty((2, 2, x.shape[1]))
+    for start in range(0, x.shape[1], CHUNK):
+        block = slice(start, start + CHUNK)
+        out[:, :, block] = evaluate_at(basis, x[:, block], cells[block]).gradient(u)
+    return out

@@ -1,0 +1,111 @@
+"""The load vector (f, v) of a body force that may be only piecewise smooth (docs/theory.md,
+section 9).
+
+A Gauss rule integrates a body force that jumps inside an element with an error of order
+|T| [f] whatever its degree, which in the energy norm is an O(h) consistency error along the
+jump: harmless for P1 (its own error is O(h)), but it stops P2 and P3 from converging (measured
+on ``free-boundary``, whose f jumps across |x| = a: the P3 energy error at 74 112 DOFs is
+8.1e-5 with scikit-fem's rule and 1.5e-5 with a rule of order 19). So the rule is refined
+adaptively where f is rough: a (sub-)triangle whose rule and the same rule on its four children
+disagree about int f by more than ROUGH_TOLERANCE max|f| |T| is split, up to MAX_DEPTH times
+(the jump's error then shrinks like 2^-depth); elsewhere the element's own rule stays.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from skfem import Basis, LinearForm, asm
+from skfem.helpers import dot
+
+from formulations.evaluation import evaluate_at
+
+MAX_DEPTH = 5  # a rough element ends in sub-triangles down to 1/32 of its size
+ROUGH_TOLERANCE = 1e-4
+CHUNK = 100_000  # points per block when adding the refined rule's contributions
+_REFERENCE = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
+
+
+def children(corners: np.ndarray) -> np.ndarray:
+    """The four sub-triangles (4 n, 3, 2) of triangles ``corners`` (n, 3, 2) (reference
+    coordinates), children of triangle i at rows 4 i .. 4 i + 3."""
+    a, b, c = corners[:, 0], corners[:, 1], corners[:, 2]
+    ab, bc, ca = (a + b) / 2, (b + c) / 2, (c + a) / 2
+    return np.stack([np.stack(s, axis=1) for s in
+                     ((a, ab, ca), (ab, b, bc), (ca, bc, c), (bc, ca, ab))], axis=1).reshape(
+        -1, 3, 2)
+
+
+def mapped_rule(corners: np.ndarray, rule) -> tuple[np.ndarray, np.ndarray]:
+    """The reference rule on every sub-triangle: points (2, n, nq) (reference coordinates of
+    the parent element) and weights (n, nq)."""
+    X, W = rule
+    a, e1, e2 = corners[:, 0], corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]
+    points = a.T[:, :, None] + e1.T[:, :, None] * X[0] + e2.T[:, :, None] * X[1]
+    return points, np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])[:, None] * W
+
+
+def integrals(body_force, mapping, cells, corners, rule) -> np.ndarray:
+    """int f over sub-triangles (2, n) of elements ``cells``."""
+    X, W = mapped_rule(corners, rule)
+    det = np.abs(mapping.detDF(np.zeros((2, 1)), tind=cells))[:, 0]
+    return (body_force(physical(mapping, cells, X)) * (W * det[:, None])).sum(axis=-1)
+
+
+def physical(mapping, cells, X: np.ndarray) -> np.ndarray:
+    """Physical points (2, n, nq) of reference points X (2, n, nq), row i in element cells[i]."""
+    A, b = mapping.A[:, :, cells], mapping.b[:, cells]
+    return np.einsum("ijn,jnq->inq", A, X) + b[:, :, None]
+
+
+def refined_rule(body_force, basis: Basis):
+    """(cells, reference points (2, m), weights (m,)) of the adaptive rule on the rough
+    elements, and the rough elements (module docstring)."""
+    mapping, rule = basis.mapping, basis.quadrature
+    n = basis.mesh.t.shape[1]
+    cells, corners = np.arange(n), np.broadcast_to(_REFERENCE, (n, 3, 2))
+    scale = np.abs(body_force(np.asarray(basis.global_coordinates()))).max()
+    kept, rough = [], None
+    for depth in range(MAX_DEPTH + 1):
+        if cells.size == 0:
+            break
+        sub = children(corners)
+        whole = integrals(body_force, mapping, cells, corners, rule)
+        parts = integrals(body_force, mapping, np.repeat(cells, 4), sub, rule)
+        area = np.abs(mapping.detDF(np.zeros((2, 1)), tind=cells))[:, 0] / 2 / 4**depth
+        split = (np.abs(whole - parts.reshape(2, -1, 4).sum(axis=-1)).max(axis=0)
+                 > ROUGH_TOLERANCE * scale * area)
+        if depth == 0:
+            rough = cells[split]
+        elif depth == MAX_DEPTH:
+            split[:] = False
+        kept.append((cells[~split], corners[~split]))
+        cells, corners = np.repeat(cells[split], 4), sub.reshape(-1, 4, 3, 2)[split].reshape(
+            -1, 3, 2)
+    kept = kept[1:] if len(kept) > 1 else []  # depth 0 unsplit elements keep skfem's rule
+    return rough, kept
+
+
+def body_load(body_force, basis: Basis) -> np.ndarray:
+    """(f, v) for every basis function, the rough elements on the refined rule."""
+    @LinearForm
+    def form(v, w):
+        return dot(body_force(w.x), v)
+
+    F = asm(form, basis)
+    rough, kept = refined_rule(body_force, basis)
+    if rough.size == 0:
+        return F
+    F -= asm(form, Basis(basis.mesh, basis.elem, quadrature=basis.quadrature, elements=rough))
+    det = np.abs(basis.mapping.detDF(np.zeros((2, 1))))[:, 0]
+    for cells, corners in kept:
+        X, W = mapped_rule(corners, basis.quadrature)
+        x = physical(basis.mapping, cells, X).reshape(2, -1)
+        fw = body_force(x) * (W * det[cells, None]).ravel()
+        at = np.repeat(cells, W.shape[1])
+        for start in range(0, at.size, CHUNK):
+            block = slice(start, start + CHUNK)
+            values = evaluate_at(basis, x[:, block], at[block]).values
+            dofs = basis.element_dofs[:, at[block]]
+            for k, v in enumerate(values):
+                F += np.bincount(dofs[k], (v * fw[:, block]).sum(axis=0), F.size)
+    return F
