@@ -65,7 +65,7 @@ def averaging_indicators(solution: DiscreteSolution) -> np.ndarray:
     order = elasticity.order
     scalar = Basis(elasticity.mesh, ELEMENTS[order](), intorder=2 * order)
     recovered = averaged_stress(solution, scalar)
-    at_points = np.array([scalar.interpolate(r).value for r in recovered])
+    at_points = np.array([np.asarray(scalar.interpolate(r)) for r in recovered])
     grad = Basis(elasticity.mesh, elasticity.basis.elem, quadrature=scalar.quadrature)
     stress = stress_from_gradient(grad.interpolate(solution.u).grad, lam, mu)
     return (compliance_energy(stress - at_points, lam, mu) * scalar.dx).sum(axis=1)

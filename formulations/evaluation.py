@@ -57,7 +57,7 @@ def evaluate_at(basis: Basis, x: np.ndarray, cells: np.ndarray) -> PointEvaluati
     fields = [basis.elem.gbasis(basis.mapping, X, k, tind=cells)[0]
               for k in range(basis.Nbfun)]
     return PointEvaluation(basis=basis, cells=cells,
-                           values=tuple(f.value[..., 0] for f in fields),
+                           values=tuple(np.asarray(f)[..., 0] for f in fields),
                            gradients=tuple(f.grad[..., 0] for f in fields))
 
 
