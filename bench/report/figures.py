@@ -45,13 +45,13 @@ def marker(strategy: str) -> str:
 
 
 def _line(ax, group: pd.DataFrame, x: str, y: str, key: tuple, label: bool = True):
-    formulation, estimator, strategy = key
+    formulation, estimator, strategy = key[:3]
     ok = group[(group["status"] == STATUS_OK) & (group[y] > 0)].sort_values(x)
     if ok.empty:
         return
     ax.loglog(ok[x], ok[y], color=colour(formulation), linestyle=line_style(estimator),
               marker=marker(strategy), markersize=3, linewidth=1,
-              label=f"{formulation}/{estimator}/{strategy}" if label else None)
+              label=_name(key) if label else None)
 
 
 def _slope_triangle(ax, x0: float, y0: float, slope: float, text: str):
@@ -63,7 +63,19 @@ def _slope_triangle(ax, x0: float, y0: float, slope: float, text: str):
 
 
 def _keys(table):
-    return table.groupby(["formulation", "estimator", "strategy"], sort=True)
+    """Groups of one sequence's levels: formulation, estimator, strategy (and the order where
+    the table has several)."""
+    return table.groupby(["formulation", "estimator", "strategy", *_order_key(table)],
+                         sort=True)
+
+
+def _order_key(table) -> list[str]:
+    return ["order"] if "order" in table and table["order"].nunique() > 1 else []
+
+
+def _name(key: tuple) -> str:
+    """'formulation/estimator/strategy', with '/P<order>' when the key carries one."""
+    return "/".join(str(k) for k in key[:3]) + (f"/P{key[3]}" if len(key) > 3 else "")
 
 
 def convergence(table: pd.DataFrame):
@@ -103,7 +115,7 @@ def effectivity(table: pd.DataFrame):
         ok = group[group["effectivity_index"] > 0].sort_values("ndofs")
         look = dict(color=colour(key[0]), linestyle=line_style(key[1]),
                      marker=marker(key[2]), markersize=3, linewidth=1)
-        ax.semilogx(ok["ndofs"], ok["effectivity_index"], label="/".join(key), **look)
+        ax.semilogx(ok["ndofs"], ok["effectivity_index"], label=_name(key), **look)
         coarse = ok[ok["reference_too_coarse"].astype(bool)]
         ax.semilogx(coarse["ndofs"], coarse["effectivity_index"], "x", color="k", markersize=5)
     ax.axhline(1.0, color="k", linewidth=0.6)
@@ -121,12 +133,13 @@ def work_precision(table: pd.DataFrame):
     y = "energy_error" if table["energy_error"].gt(0).any() else "eta"
     fig = Figure(figsize=(11, 4.2))
     axes = fig.subplots(1, 2, sharey=True)
-    for key, group in table.groupby(["formulation", "solver", "estimator", "strategy"]):
+    for key, group in table.groupby(["formulation", "solver", "estimator", "strategy",
+                                     *_order_key(table)]):
         group = group[group["status"] == STATUS_OK].sort_values("level")
         times = phase_time(group)
         look = dict(color=colour(key[0]), linestyle=line_style(key[2]),
                      marker=marker(key[3]), markersize=3, linewidth=1)
-        axes[0].loglog(times.cumsum(), group[y], label="/".join(key), **look)
+        axes[0].loglog(times.cumsum(), group[y], label="/".join(map(str, key)), **look)
         axes[1].loglog(group["t_solve"], group[y], **look)
     axes[0].set_xlabel("cumulative wall time of the sequence [s]")
     axes[1].set_xlabel("solve time of the level [s]")
@@ -279,5 +292,36 @@ def hard_stability(hard: pd.DataFrame, pressure_bar: float):
         ax.title.set_fontsize(10)
     for ax in axes[1:]:
         ax.invert_xaxis()
+    fig.tight_layout()
+    return fig
+
+
+ORDER_COLOURS = ["tab:blue", "tab:orange", "tab:green", "tab:red"]
+
+
+def order_work_precision(table: pd.DataFrame, norm: float | None = None):
+    """Energy error (relative to ``norm`` when given) against the cumulative wall time of its
+    sequence, one line per sequence, coloured by polynomial order; uniform dashed, adaptive
+    solid. None unless the table has several orders and errors."""
+    if "order" not in table or table["order"].nunique() < 2 or \
+            not table["energy_error"].gt(0).any():
+        return None
+    fig = Figure(figsize=(8, 4.5))
+    ax = fig.subplots()
+    orders, labelled = sorted(table["order"].unique()), set()
+    for key, group in table.groupby(["formulation", "estimator", "strategy", "order"]):
+        group = group[group["status"] == STATUS_OK].sort_values("level")
+        ax.loglog(phase_time(group).cumsum(), group["energy_error"] / (norm or 1.0),
+                  linewidth=0.8, marker=marker(key[2]), markersize=2,
+                  color=ORDER_COLOURS[orders.index(key[3]) % len(ORDER_COLOURS)],
+                  linestyle="-" if key[2] == "adaptive" else "--",
+                  label=None if key[3] in labelled else f"P{key[3]}")
+        labelled.add(key[3])
+    if norm:
+        ax.axhline(1e-3, color="k", linewidth=0.6)
+    ax.set_xlabel("cumulative wall time of the sequence [s]")
+    ax.set_ylabel("||u - u_h|| / ||u||" if norm else "||u - u_h||")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
     fig.tight_layout()
     return fig

@@ -22,6 +22,7 @@ from bench.report.tables import (
     rate_verdicts,
     timing_table,
 )
+from bench.report.orders import order_section
 from bench.sequence.rows import COLUMNS, INTERRUPTED, KEYS, with_labels
 
 TEMPLATES = Path(__file__).with_name("templates")
@@ -109,6 +110,7 @@ def write_report(table: pd.DataFrame, out: str | Path, results: str | Path | Non
         "scenes": [scene_section(name, group, results, figs, truth)
                    for name, group in rows.groupby("scene", sort=True)],
         "tables": _tables(everything, rows, hard),
+        "orders": order_section(rows, figs),
         "hard_run": hard is not None, "hard_figures": hard_figures,
         "n_rows": len(everything), "n_too_coarse": int(rows["reference_too_coarse"]
                                                         .fillna(False).astype(bool).sum()),

@@ -32,11 +32,12 @@ def rate_verdicts(rates: pd.DataFrame) -> pd.DataFrame:
     """Measured slopes beside the claimed ones (``[[claim]]`` in expected.toml)."""
     rows, claimed_slopes = [], claims()
     for _, r in rates.iterrows():
-        claimed, source = claimed_slopes.get((r["scene"], r["strategy"]), (np.nan, "no claim"))
+        claimed, source = claimed_slopes.get((r["scene"], r["strategy"], int(r.get("order", 1))),
+                                             (np.nan, "no claim"))
         measured = r["error_rate"] if np.isfinite(r["error_rate"]) else r["eta_rate"]
         rows.append({"scene": r["scene"], "formulation": r["formulation"],
                      "estimator": r["estimator"], "strategy": r["strategy"],
-                     **{c: r.get(c, "") for c in LABELS},
+                     "order": int(r.get("order", 1)), **{c: r.get(c, "") for c in LABELS},
                      "error rate": _fmt(r["error_rate"]), "eta rate": _fmt(r["eta_rate"]),
                      "pressure error rate": _fmt(r["pressure_error_rate"]),
                      "claimed": _fmt(claimed), "source": source,
@@ -50,6 +51,7 @@ def effectivity_table(rates: pd.DataFrame) -> pd.DataFrame:
     return without_empty_labels(pd.DataFrame({
         "scene": rates["scene"], "formulation": rates["formulation"],
         "estimator": rates["estimator"], "strategy": rates["strategy"],
+        "order": rates["order"] if "order" in rates else 1,
         **{c: rates[c] for c in LABELS if c in rates},
         "last": rates["effectivity_last"].map(_fmt), "min": rates["effectivity_min"].map(_fmt),
         "max": rates["effectivity_max"].map(_fmt),

@@ -22,8 +22,10 @@ def load_expected(path: str | Path = EXPECTED) -> dict:
     return expected
 
 
-def claims(expected: dict | None = None) -> dict[tuple[str, str], tuple[float, str]]:
-    """(scene, strategy) -> (claimed slope of log(error) against log(ndofs), its source)."""
+def claims(expected: dict | None = None) -> dict[tuple[str, str, int], tuple[float, str]]:
+    """(scene, strategy, order) -> (claimed slope of log(error) against log(ndofs), its
+    source); a claim without an order is for P1."""
     expected = load_expected() if expected is None else expected
-    return {(c["scene"], c["strategy"]): (float(c["slope"]), c["source"])
+    return {(c["scene"], c["strategy"], int(c.get("order", 1))): (float(c["slope"]),
+                                                                   c["source"])
             for c in expected.get("claim", [])}

@@ -39,7 +39,8 @@ def run_gate_matrices(expected: dict, out: str | Path, on_level=None) -> pd.Data
     for k, entry in enumerate(expected["run"]):
         config = RunConfig(scenes=(entry["scene"],), formulations=entry["formulations"],
                            solvers=(entry["solver"],), estimators=entry["estimators"],
-                           strategies=entry["strategies"], max_dofs=entry["max_dofs"],
+                           strategies=entry["strategies"], orders=entry.get("orders", (1,)),
+                           max_dofs=entry["max_dofs"],
                            reference_dofs=entry.get("reference_dofs"), out=str(out),
                            overwrite=k == 0, command="python -m bench verify")
         tables.append(run(config, on_level=on_level).table)

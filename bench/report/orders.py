@@ -1,0 +1,73 @@
+"""The report's polynomial-order section (docs/theory.md, section 9): rates and effectivity per
+order, and which order reaches a relative energy-norm error of 1e-3 first, at what cost."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+from skfem import Basis, ElementTriP1
+
+from bench.measure.discretisation_error import energy_density
+from bench.sequence.rows import phase_time
+from formulations import STATUS_OK
+from scenes import get_scene
+
+TARGET = 1e-3  # relative energy-norm error
+NORM_REFINEMENTS = 5  # uniform refinements of the scene's mesh for ||u|| (exact scenes)
+
+
+def exact_energy_norm(scene_name: str) -> float | None:
+    """||u|| = a(u, u)^(1/2) of a scene's exact solution (None without one), integrated with a
+    rule of order 10 on its mesh refined NORM_REFINEMENTS times."""
+    try:
+        scene = get_scene(scene_name)
+    except KeyError:
+        return None
+    if scene.exact is None:
+        return None
+    basis = Basis(scene.mesh.refined(NORM_REFINEMENTS), ElementTriP1(), intorder=10)
+    grad = scene.exact.gradient(np.asarray(basis.global_coordinates()))
+    return float(np.sqrt((energy_density(grad, *scene.material.lame) * basis.dx).sum()))
+
+
+def first_to_target(rows: pd.DataFrame, norm: float) -> pd.DataFrame:
+    """Per order and strategy, the sequence (formulation/estimator) whose relative error first
+    falls to TARGET, with its DOFs and the cumulative wall time of its sequence up to there;
+    'not reached' within the budget otherwise."""
+    out = []
+    for (order, strategy), group in rows.groupby(["order", "strategy"], sort=True):
+        best = None
+        for key, sequence in group.groupby(["formulation", "estimator"], sort=True):
+            sequence = sequence[sequence["status"] == STATUS_OK].sort_values("level")
+            times = phase_time(sequence).cumsum()
+            hit = np.flatnonzero(sequence["energy_error"].to_numpy() / norm <= TARGET)
+            if hit.size and (best is None or times.iloc[hit[0]] < best[1]):
+                best = ("/".join(key), float(times.iloc[hit[0]]),
+                        int(sequence["ndofs"].iloc[hit[0]]))
+        smallest = (group["energy_error"] / norm).min()
+        out.append({"order": int(order), "strategy": strategy,
+                    "first to 1e-3": best[0] if best else "not reached",
+                    "ndofs": best[2] if best else "",
+                    "wall time [s]": f"{best[1]:.2f}" if best else "",
+                    "smallest relative error": f"{smallest:.2e}"})
+    return pd.DataFrame(out)
+
+
+def order_section(rows: pd.DataFrame, figs) -> list[dict]:
+    """One entry per exact scene with several orders: its work-precision figure and table."""
+    from bench.report import figures
+
+    if "order" not in rows or rows["order"].nunique() < 2:
+        return []
+    sections = []
+    for scene_name, group in rows.groupby("scene", sort=True):
+        norm = exact_energy_norm(scene_name)
+        if norm is None or group["order"].nunique() < 2:
+            continue
+        item = figs.add(figures.order_work_precision(group, norm),
+                        f"{scene_name}-orders", "Relative energy error against the cumulative "
+                        "wall time of each sequence, coloured by order (adaptive solid, uniform "
+                        "dashed); the line marks 1e-3.")
+        sections.append({"scene": scene_name, "norm": norm, "figure": item,
+                         "table": first_to_target(group, norm)})
+    return sections
