@@ -13,6 +13,7 @@ import pandas as pd
 from bench.hard import LOSS_TOLERANCE, PRESSURE_TOLERANCE, hard_display
 from bench.matrix.rates import RATE_LEVELS, rates_table
 from bench.report import figures
+from bench.report.orders import order_section
 from bench.report.sections import Figures, scene_section
 from bench.report.tables import (
     accuracy_table,
@@ -22,7 +23,6 @@ from bench.report.tables import (
     rate_verdicts,
     timing_table,
 )
-from bench.report.orders import order_section
 from bench.sequence.rows import COLUMNS, INTERRUPTED, KEYS, with_labels
 
 TEMPLATES = Path(__file__).with_name("templates")
