@@ -295,33 +295,3 @@ def hard_stability(hard: pd.DataFrame, pressure_bar: float):
     fig.tight_layout()
     return fig
 
-
-ORDER_COLOURS = ["tab:blue", "tab:orange", "tab:green", "tab:red"]
-
-
-def order_work_precision(table: pd.DataFrame, norm: float | None = None):
-    """Energy error (relative to ``norm`` when given) against the cumulative wall time of its
-    sequence, one line per sequence, coloured by polynomial order; uniform dashed, adaptive
-    solid. None unless the table has several orders and errors."""
-    if "order" not in table or table["order"].nunique() < 2 or \
-            not table["energy_error"].gt(0).any():
-        return None
-    fig = Figure(figsize=(8, 4.5))
-    ax = fig.subplots()
-    orders, labelled = sorted(table["order"].unique()), set()
-    for key, group in table.groupby(["formulation", "estimator", "strategy", "order"]):
-        group = group[group["status"] == STATUS_OK].sort_values("level")
-        ax.loglog(phase_time(group).cumsum(), group["energy_error"] / (norm or 1.0),
-                  linewidth=0.8, marker=marker(key[2]), markersize=2,
-                  color=ORDER_COLOURS[orders.index(key[3]) % len(ORDER_COLOURS)],
-                  linestyle="-" if key[2] == "adaptive" else "--",
-                  label=None if key[3] in labelled else f"P{key[3]}")
-        labelled.add(key[3])
-    if norm:
-        ax.axhline(1e-3, color="k", linewidth=0.6)
-    ax.set_xlabel("cumulative wall time of the sequence [s]")
-    ax.set_ylabel("||u - u_h|| / ||u||" if norm else "||u - u_h||")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    return fig

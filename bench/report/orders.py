@@ -5,9 +5,11 @@ from __future__ import annotations
 
 import numpy as np
 import pandas as pd
+from matplotlib.figure import Figure
 from skfem import Basis, ElementTriP1
 
 from bench.measure.discretisation_error import energy_density
+from bench.report.figures import marker
 from bench.sequence.rows import phase_time
 from formulations import STATUS_OK
 from scenes import get_scene
@@ -28,6 +30,37 @@ def exact_energy_norm(scene_name: str) -> float | None:
     basis = Basis(scene.mesh.refined(NORM_REFINEMENTS), ElementTriP1(), intorder=10)
     grad = scene.exact.gradient(np.asarray(basis.global_coordinates()))
     return float(np.sqrt((energy_density(grad, *scene.material.lame) * basis.dx).sum()))
+
+
+ORDER_COLOURS = ["tab:blue", "tab:orange", "tab:green", "tab:red"]
+
+
+def order_work_precision(table: pd.DataFrame, norm: float | None = None):
+    """Energy error (relative to ``norm`` when given) against the cumulative wall time of its
+    sequence, one line per sequence, coloured by polynomial order; uniform dashed, adaptive
+    solid. None unless the table has several orders and errors."""
+    if "order" not in table or table["order"].nunique() < 2 or \
+            not table["energy_error"].gt(0).any():
+        return None
+    fig = Figure(figsize=(8, 4.5))
+    ax = fig.subplots()
+    orders, labelled = sorted(table["order"].unique()), set()
+    for key, group in table.groupby(["formulation", "estimator", "strategy", "order"]):
+        group = group[group["status"] == STATUS_OK].sort_values("level")
+        ax.loglog(phase_time(group).cumsum(), group["energy_error"] / (norm or 1.0),
+                  linewidth=0.8, marker=marker(key[2]), markersize=2,
+                  color=ORDER_COLOURS[orders.index(key[3]) % len(ORDER_COLOURS)],
+                  linestyle="-" if key[2] == "adaptive" else "--",
+                  label=None if key[3] in labelled else f"P{key[3]}")
+        labelled.add(key[3])
+    if norm:
+        ax.axhline(1e-3, color="k", linewidth=0.6)
+    ax.set_xlabel("cumulative wall time of the sequence [s]")
+    ax.set_ylabel("||u - u_h|| / ||u||" if norm else "||u - u_h||")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    return fig
 
 
 def first_to_target(rows: pd.DataFrame, norm: float) -> pd.DataFrame:
@@ -55,8 +88,6 @@ def first_to_target(rows: pd.DataFrame, norm: float) -> pd.DataFrame:
 
 def order_section(rows: pd.DataFrame, figs) -> list[dict]:
     """One entry per exact scene with several orders: its work-precision figure and table."""
-    from bench.report import figures
-
     if "order" not in rows or rows["order"].nunique() < 2:
         return []
     sections = []
@@ -64,7 +95,7 @@ def order_section(rows: pd.DataFrame, figs) -> list[dict]:
         norm = exact_energy_norm(scene_name)
         if norm is None or group["order"].nunique() < 2:
             continue
-        item = figs.add(figures.order_work_precision(group, norm),
+        item = figs.add(order_work_precision(group, norm),
                         f"{scene_name}-orders", "Relative energy error against the cumulative "
                         "wall time of each sequence, coloured by order (adaptive solid, uniform "
                         "dashed); the line marks 1e-3.")

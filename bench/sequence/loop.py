@@ -152,10 +152,9 @@ def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
         est = None if failed else estimate(scene, sol)
         t_estimate = float("nan") if failed else time.perf_counter() - start
         numbers = dict(level_columns(disc, sol, mesh, options), level=level,
-                       t_assemble=t_assemble, t_refine=t_refine, t_estimate=t_estimate)
-        if failed:
-            numbers.update(solver_columns(sol.diagnostics))
-        else:
+                       t_assemble=t_assemble, t_refine=t_refine, t_estimate=t_estimate,
+                       **(solver_columns(sol.diagnostics) if failed else {}))
+        if not failed:
             numbers.update(diagnostic_columns(disc, sol, config.diagnostics,
                                               config.solver_options.get("backend")))
             numbers.update(eta=est.eta, eta_0=est.eta_0, eta_geometric=est.eta_geometric,
