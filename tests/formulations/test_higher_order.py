@@ -10,6 +10,7 @@ from bench.measure.difference import solution_difference
 from conftest import square_scene
 from formulations import get_formulation, solve
 from formulations.contact import contact_trace, gauss_legendre
+from formulations.diagnostics import inf_sup_constant
 from formulations.elasticity import assemble_elasticity, count_free_dofs, vector_element
 from formulations.evaluation import normal_trace_matrix
 from formulations.load import body_load
@@ -166,3 +167,19 @@ def test_dof_counts_match_the_assembled_spaces():
         for mesh in (scene.mesh, scene.mesh.refined(1)):
             assert count_free_dofs(scene, mesh, order) == assemble_elasticity(
                 scene, mesh, order).ndofs
+
+
+@pytest.mark.parametrize("order", ORDERS)
+def test_chosen_multiplier_space_is_inf_sup_stable_and_the_trace_mesh_is_not(order):
+    # docs/theory.md, section 9: degree p - 1 on segments with h/H <= 1/2 keeps beta_h at
+    # 0.38 (P2) / 0.30 (P3) under refinement; the same space on the trace mesh loses half of
+    # beta_h per level (measured 0.086, 0.042, 0.021 for P2)
+    scene = get_scene("paper")
+    chosen, trace_mesh = [], []
+    for refinements in (1, 2, 3):
+        mesh = scene.mesh.refined(refinements)
+        chosen.append(inf_sup_constant(get_formulation("mixed")(scene, mesh, order=order)))
+        trace_mesh.append(inf_sup_constant(get_formulation("mixed")(scene, mesh, order=order,
+                                                                    h_over_H=1.0)))
+    assert min(chosen) > 0.25 and chosen[-1] > 0.9 * chosen[1]
+    assert trace_mesh[-1] < 0.6 * trace_mesh[0] and trace_mesh[-1] < 0.1 * chosen[-1]
