@@ -58,18 +58,19 @@ def physical(mapping, cells, X: np.ndarray) -> np.ndarray:
 
 
 def refined_rule(body_force, basis: Basis):
-    """(cells, reference points (2, m), weights (m,)) of the adaptive rule on the rough
-    elements, and the rough elements (module docstring)."""
+    """The rough elements, and the adaptive rule on them as a list of (cells, corners): the
+    sub-triangles (corners in the reference coordinates of element ``cells[i]``) that keep the
+    element's rule (module docstring)."""
     mapping, rule = basis.mapping, basis.quadrature
     n = basis.mesh.t.shape[1]
     cells, corners = np.arange(n), np.broadcast_to(_REFERENCE, (n, 3, 2))
     scale = np.abs(body_force(np.asarray(basis.global_coordinates()))).max()
+    whole = integrals(body_force, mapping, cells, corners, rule)
     kept, rough = [], None
     for depth in range(MAX_DEPTH + 1):
         if cells.size == 0:
             break
         sub = children(corners)
-        whole = integrals(body_force, mapping, cells, corners, rule)
         parts = integrals(body_force, mapping, np.repeat(cells, 4), sub, rule)
         area = np.abs(mapping.detDF(np.zeros((2, 1)), tind=cells))[:, 0] / 2 / 4**depth
         split = (np.abs(whole - parts.reshape(2, -1, 4).sum(axis=-1)).max(axis=0)
@@ -81,6 +82,7 @@ def refined_rule(body_force, basis: Basis):
         kept.append((cells[~split], corners[~split]))
         cells, corners = np.repeat(cells[split], 4), sub.reshape(-1, 4, 3, 2)[split].reshape(
             -1, 3, 2)
+        whole = parts.reshape(2, -1, 4)[:, split].reshape(2, -1)  # the children's own integrals
     kept = kept[1:] if len(kept) > 1 else []  # depth 0 unsplit elements keep skfem's rule
     return rough, kept
 

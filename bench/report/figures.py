@@ -165,7 +165,8 @@ def meshes(artifacts: dict):
     for ax, (key, data) in zip(axes.ravel(), items, strict=False):
         ax.triplot(Triangulation(data["p"][0], data["p"][1], data["t"].T), linewidth=0.15,
                    color=colour(key[0]))
-        ax.set_title(f"{key[0]}/{key[1]}: {int(data['ndofs'])} DOFs", fontsize=9)
+        order = f"/P{key[3]}" if len(key) > 3 and key[3] != 1 else ""
+        ax.set_title(f"{key[0]}/{key[1]}{order}: {int(data['ndofs'])} DOFs", fontsize=9)
         ax.set_aspect("equal")
     fig.tight_layout()
     return fig

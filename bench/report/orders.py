@@ -54,7 +54,7 @@ def order_work_precision(table: pd.DataFrame, norm: float | None = None):
                   label=None if key[3] in labelled else f"P{key[3]}")
         labelled.add(key[3])
     if norm:
-        ax.axhline(1e-3, color="k", linewidth=0.6)
+        ax.axhline(TARGET, color="k", linewidth=0.6)
     ax.set_xlabel("cumulative wall time of the sequence [s]")
     ax.set_ylabel("||u - u_h|| / ||u||" if norm else "||u - u_h||")
     ax.grid(True, which="both", alpha=0.3)

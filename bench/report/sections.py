@@ -43,7 +43,8 @@ def _artifacts(results: Path | None, group: pd.DataFrame) -> dict:
     for _, row in group.drop_duplicates(KEYS).iterrows():
         data = load_artifact(artifact_path(results, row))
         if data is not None:
-            out[(row["formulation"], row["estimator"], row["strategy"])] = data
+            out[(row["formulation"], row["estimator"], row["strategy"],
+                 int(row.get("order", 1)))] = data
     return out
 
 
