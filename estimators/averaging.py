@@ -25,7 +25,7 @@ from estimators.base import Estimate, combine, register_estimator
 from estimators.contact_terms import contact_terms
 from formulations import DiscreteSolution
 from formulations.elasticity import ELEMENTS, stress_from_gradient
-from formulations.evaluation import gradients_at
+from formulations.evaluation import gradients_at_reference
 
 
 def element_areas(mesh) -> np.ndarray:
@@ -40,12 +40,10 @@ def averaged_stress(solution: DiscreteSolution, scalar: Basis) -> np.ndarray:
     the elements around it (for P1: of their constant stresses)."""
     elasticity = solution.elasticity
     mesh = elasticity.mesh
-    nodes = scalar.mapping.F(scalar.elem.doflocs.T)  # (2, n_elements, n_local)
-    n_local = nodes.shape[2]
-    cells = np.repeat(np.arange(mesh.t.shape[1]), n_local)
-    grad = gradients_at(elasticity.basis, solution.u, nodes.reshape(2, -1), cells)
-    stress = stress_from_gradient(grad, *elasticity.lame)  # (3, n_elements * n_local)
-    dofs = scalar.element_dofs.T.ravel()  # element-major, as ``nodes``
+    grad = gradients_at_reference(elasticity.basis, solution.u, scalar.elem.doflocs.T)
+    n_local = grad.shape[-1]
+    stress = stress_from_gradient(grad, *elasticity.lame).reshape(3, -1)  # element-major
+    dofs = scalar.element_dofs.T.ravel()  # element-major, as ``stress``
     weight = np.repeat(element_areas(mesh), n_local)
     total = np.bincount(dofs, weight, scalar.N)
     return np.array([np.bincount(dofs, weight * s, scalar.N) for s in stress]) / total

@@ -24,7 +24,7 @@ from estimators.contact_terms import contact_terms
 from formulations import DiscreteSolution
 from formulations.contact import gauss_legendre, outer_normals
 from formulations.elasticity import ELEMENTS, element_diameters, stress_from_gradient
-from formulations.evaluation import gradients_at
+from formulations.evaluation import gradients_at, gradients_at_reference
 
 EDGE_QUADRATURE_POINTS = 4  # Neumann and contact edges: q and lambda_h are not polynomials
 
@@ -47,11 +47,9 @@ def stress_divergence(solution: DiscreteSolution, basis: Basis) -> np.ndarray:
     elasticity = solution.elasticity
     mesh, order = elasticity.mesh, elasticity.order
     dg = Basis(mesh, ElementDG(ELEMENTS[order - 1]()), quadrature=basis.quadrature)
-    nodes = dg.mapping.F(dg.elem.doflocs.T)  # (2, n_elements, n_local)
-    cells = np.repeat(np.arange(mesh.t.shape[1]), nodes.shape[2])
-    grad = gradients_at(elasticity.basis, solution.u, nodes.reshape(2, -1), cells)
-    dofs = dg.element_dofs.T.ravel()  # element-major, as ``nodes``
-    sigma = _tensor(stress_from_gradient(grad, *elasticity.lame))  # (2, 2, n_el * n_local)
+    grad = gradients_at_reference(elasticity.basis, solution.u, dg.elem.doflocs.T)
+    dofs = dg.element_dofs.T.ravel()  # element-major, as ``grad``
+    sigma = _tensor(stress_from_gradient(grad, *elasticity.lame).reshape(3, -1))
     div = np.zeros((2, mesh.t.shape[1], basis.quadrature[0].shape[1]))
     for i in (0, 1):
         for j in (0, 1):

@@ -75,6 +75,13 @@ def normal_trace_matrix(basis: Basis, trace, t: np.ndarray) -> sparse.csr_matrix
     return evaluate_on_trace(basis, trace, t).matrix(np.repeat(trace.normal, t.size, axis=1))
 
 
+def gradients_at_reference(basis: Basis, u: np.ndarray, X: np.ndarray) -> np.ndarray:
+    """grad u_h at the same reference points X (2, nX) of every element, by scikit-fem's
+    vectorised interpolation; shape (2, 2, n_elements, nX), element-major."""
+    at = Basis(basis.mesh, basis.elem, quadrature=(X, np.ones(X.shape[1])))
+    return at.interpolate(u).grad
+
+
 def gradients_at(basis: Basis, u: np.ndarray, x: np.ndarray, cells: np.ndarray) -> np.ndarray:
     """grad u_h at many points (2, n) in elements ``cells``, in blocks of CHUNK points;
     shape (2, 2, n)."""
