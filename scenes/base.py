@@ -121,6 +121,8 @@ class Scene:
     exact: ExactSolution | None = None
     # a closed-form contact pressure for the computed contact force, where theory has one
     predict_contact: Callable[[float], ContactPrediction] | None = None
+    # the corners where the solution may be singular (scenes.corners), for rate predictions
+    corners: tuple = ()
 
     def __post_init__(self):
         _check(isinstance(self.material, Material), "material", self.material,

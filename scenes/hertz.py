@@ -20,6 +20,7 @@ import numpy as np
 from skfem import MeshTri
 
 from scenes.base import ContactPrediction, Material, Scene, SceneError, is_integer
+from scenes.corners import Corner
 from scenes.registry import register_scene
 
 _TOL = 1e-10
@@ -67,4 +68,6 @@ def hertz(young_modulus: float = 1000.0, poisson_ratio: float = 0.3, radius: flo
                     "initial_divisions": initial_divisions},
         tags=("exact", "hertz"),
         predict_contact=lambda force: hertz_contact(young_modulus, poisson_ratio, radius, force),
+        corners=(Corner((-W, 0.0), np.pi / 2, ("clamped", "free")),
+                 Corner((W, 0.0), np.pi / 2, ("clamped", "free"))),
     )

@@ -11,6 +11,7 @@ import numpy as np
 from skfem import MeshTri
 
 from scenes.base import Material, Scene, SceneError, is_integer
+from scenes.corners import Corner
 from scenes.registry import register_scene
 
 _TOL = 1e-10
@@ -43,4 +44,7 @@ def paper(young_modulus: float = 70000.0, poisson_ratio: float = 0.33, plane: st
         parameters={"young_modulus": float(young_modulus), "poisson_ratio": float(poisson_ratio),
                     "plane": plane, "initial_divisions": int(initial_divisions)},
         tags=("paper",),
+        # the clamped top edge meets the traction-free sides at right angles
+        corners=(Corner((-1.0, 1.0), np.pi / 2, ("clamped", "free")),
+                 Corner((1.0, 1.0), np.pi / 2, ("clamped", "free"))),
     )

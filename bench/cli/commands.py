@@ -98,7 +98,8 @@ def run_command(args) -> int:
         max_dofs=args.max_dofs,
         max_levels=args.max_levels, marking=args.marking, theta=args.theta,
         backend=args.backend, nested=not args.cold_start, reference_dofs=args.reference_dofs,
-        crosscheck_dofs=args.crosscheck_dofs, max_memory_gib=args.max_memory, out=args.out,
+        reference_crosscheck=args.reference_crosscheck, crosscheck_dofs=args.crosscheck_dofs,
+        max_memory_gib=args.max_memory, out=args.out,
         overwrite=args.overwrite, workers=args.workers, scheduler=args.scheduler,
         cache=args.cache,
         command=" ".join(["python -m bench", *args.argv]))

@@ -176,8 +176,11 @@ def _run_parser(sub) -> None:
                           "previous level's contact zone (nested iteration, the default)")
     run.add_argument("--reference-dofs", type=_positive_int("reference_dofs"), default=None,
                      help="measure errors of scenes without an exact solution against a "
-                          "cached adaptive overkill reference with about this many DOFs "
-                          "(default: only scenes with an exact solution get errors)")
+                          "cached adaptive P3 reference (mixed method) with at most this many "
+                          "DOFs (default: only scenes with an exact solution get errors)")
+    run.add_argument("--reference-crosscheck", action="store_true",
+                     help="also build the P2 reference of the same budget and record its "
+                          "agreement with the P3 one in truth.json (default: off)")
     _memory_option(run)
     _scale_out_options(run)
     run.add_argument("--crosscheck-dofs", type=_non_negative_int("crosscheck_dofs"), default=0,

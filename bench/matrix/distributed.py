@@ -35,8 +35,8 @@ def sequence_task(spec: SequenceSpec, out: str, run: dict, cache: str | None,
         rows.append(result.row)
 
     end = run_spec(spec, run, out, lambda scene: truth_for(scene, spec.reference_dofs,
-                                                           spec.max_dofs), record,
-                   max_memory_gib)
+                                                           spec.max_dofs, spec.order),
+                   record, max_memory_gib)
     writer.finish(end)
     return Outcome(spec.key, end, tuple(replace(r, sequence_end=end) for r in rows))
 

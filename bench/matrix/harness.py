@@ -36,6 +36,8 @@ def write_truth_summary(out, name: str, truth) -> None:
         summary[name] = {"kind": "none"}
     elif truth.kind == "reference":
         summary[name] = {"kind": "reference", **truth.reference.summary()}
+        if truth.crosscheck is not None:
+            summary[name]["crosscheck"] = truth.crosscheck.summary()
     else:
         summary[name] = {"kind": "exact", "source": truth.scene.exact.source}
     path.write_text(json.dumps(summary, indent=1, default=float))
@@ -75,7 +77,8 @@ def run_specs(specs: Sequence[SequenceSpec], store: ResultStore, run: dict,
 
         def truth_of(scene, name=name, spec=spec):
             if name not in truths:  # run() prepares them; run_matrix builds them here
-                truths[name] = truth_for(scene, spec.reference_dofs, spec.max_dofs)
+                truths[name] = truth_for(scene, spec.reference_dofs, spec.max_dofs,
+                                         spec.order)
                 write_truth_summary(store.out, name, truths[name])
             return truths[name]
         try:

@@ -60,6 +60,7 @@ class RunConfig:
     backend: str | None = None
     nested: bool = True
     reference_dofs: int | None = None
+    reference_crosscheck: bool = False  # also build the second recipe's reference, compare
     crosscheck_dofs: int = 0
     max_memory_gib: float | None = None  # None: what the machine has available, minus a margin
     out: str = "results"
@@ -128,24 +129,27 @@ class RunRefused(ValueError):
     that cannot judge the runs (the message says which)."""
 
 
-def prepare_truths(specs: list[SequenceSpec], out) -> dict:
+def prepare_truths(specs: list[SequenceSpec], out, crosscheck: bool = False) -> dict:
     """Every truth the specs need, built (or loaded) before any sequence runs, so that a bad
     scene parameter or formulation option, or a reference that cannot judge the runs, is
     refused first (RunRefused)."""
     try:
-        return _truths(specs, out)
+        return _truths(specs, out, crosscheck)
     except ValueError as error:  # SceneError, TruthError, unknown parameters
         raise RunRefused(str(error)) from None
 
 
-def _truths(specs: list[SequenceSpec], out) -> dict:
-    truths = {}
+def _truths(specs: list[SequenceSpec], out, crosscheck: bool) -> dict:
+    judged = {}  # per truth: the largest budget and order it judges, and a spec to build it
     for spec in specs:
         check_formulation_options(spec)
-        name = truth_name(spec)
-        if name not in truths:
-            truths[name] = truth_for(build_scene(spec), spec.reference_dofs, spec.max_dofs)
-            write_truth_summary(out, name, truths[name])
+        dofs, order, first = judged.get(truth_name(spec), (0, 0, spec))
+        judged[truth_name(spec)] = (max(dofs, spec.max_dofs), max(order, spec.order), first)
+    truths = {}
+    for name, (dofs, order, spec) in judged.items():
+        truths[name] = truth_for(build_scene(spec), spec.reference_dofs, dofs, order,
+                                 crosscheck)
+        write_truth_summary(out, name, truths[name])
     return truths
 
 
@@ -163,7 +167,7 @@ def run(config: RunConfig, on_level: Callable[[LevelResult], None] | None = None
     todo = [s for s in specs if s.key not in finished]
     reused = tuple(s.key for s in specs if s.key in finished)
     identity = new_run_identity()
-    truths = prepare_truths(todo, store.out)
+    truths = prepare_truths(todo, store.out, config.reference_crosscheck)
     (store.out / "run.json").write_text(json.dumps(
         {"command": config.command, "configuration": config.record(),
          "run_id": identity["run_id"], "reused": list(reused)}, indent=1, default=str))

@@ -1,81 +1,72 @@
-"""The energy-norm error of u_h (any order) against a P1 field on another (finer, possibly
-non-nested) mesh.
+"""The energy norm of the difference of two fields on different, possibly non-nested meshes
+(docs/theory.md, section 6).
 
-The integral runs over the reference mesh with the centroid rule for P1 u_h (a rule of degree
-2(p - 1) for P_p): u_h's gradient is found at each point by point location in u_h's mesh.
-When the reference mesh refines u_h's
-mesh (uniform or nested adaptive sequences) this is exact; otherwise a reference element that
-straddles an edge of u_h's mesh is integrated with u_h's gradient from the side of its centroid,
-an error confined to a layer of reference elements along u_h's edges
-(tests/bench/measure/test_discretisation_error.py measures both).
+The integral runs over the elements of the first field's mesh ("cells"), each cell split into
+its four red children while it is larger than the element of the second mesh that contains its
+centroid. So the cells resolve the finer of the two meshes everywhere, and on every cell the
+first field is one polynomial exactly. The second field is taken from the element containing
+the cell's centroid, its polynomial extended over the rest of the cell: exact when the first
+mesh refines the second (nested levels), otherwise off by the second field's gradient jumps
+across its own edges, which are of the size of *its* error. Hence: the judged solution first,
+the sharper reference second. A rule of degree 2(p - 1) for the higher of the two orders is then
+exact on every cell contained in one element of each mesh.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
-from matplotlib.tri import Triangulation
 from skfem.quadrature import get_quadrature
 from skfem.refdom import RefTri
 
-from bench.measure.discretisation_error import element_gradients, energy_density
-from formulations import DiscreteSolution
-from formulations.evaluation import gradients_at
+from bench.measure.discretisation_error import energy_density
+from bench.measure.fields import CHUNK, GradientField
+
+MAX_SPLITS = 40  # each split quarters a cell: 4^-40 of an element is far below any mesh
 
 
-def locate(mesh, x: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """Index of the element of ``mesh`` containing each point (matplotlib's trapezoid-map
-    finder: O(log n) per point, unlike a brute-force search)."""
-    triangulation = Triangulation(mesh.p[0], mesh.p[1], mesh.t.T)
-    element = triangulation.get_trifinder()(x, y)
-    if (element < 0).any():
-        bad = np.flatnonzero(element < 0)[0]
-        raise ValueError(f"point ({x[bad]}, {y[bad]}) lies outside the mesh")
-    return element
+def _children(corners: np.ndarray) -> np.ndarray:
+    """The four red children (2, 3, 4n) of triangles ``corners`` (2, 3, n), child-major."""
+    a, b, c = corners[:, 0], corners[:, 1], corners[:, 2]
+    ab, bc, ca = (a + b) / 2, (b + c) / 2, (c + a) / 2
+    kids = [(a, ab, ca), (ab, b, bc), (ca, bc, c), (bc, ca, ab)]
+    return np.concatenate([np.stack(kid, axis=1) for kid in kids], axis=2)
 
 
-@dataclass(frozen=True, eq=False)
-class P1Field:
-    """A P1 displacement on its own mesh, reduced to what error integration needs: the constant
-    gradient, centroid and area of every element (computed once, reused for every u_h)."""
-
-    gradient: np.ndarray  # (2, 2, n_elements)
-    centroid: np.ndarray  # (2, n_elements)
-    area: np.ndarray
-    corners: np.ndarray  # (2, 3, n_elements): the vertices of every element
-
-    @classmethod
-    def from_nodal(cls, mesh, u_nodal: np.ndarray) -> P1Field:
-        p = mesh.p[:, mesh.t]  # (2, 3, nT)
-        a, b = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
-        det = a[0] * b[1] - a[1] * b[0]
-        # gradients of the barycentric coordinates l1, l2 (l0 = 1 - l1 - l2)
-        g1, g2 = np.array([b[1], -b[0]]) / det, np.array([-a[1], a[0]]) / det
-        u = u_nodal[:, mesh.t]  # (2 components, 3 vertices, nT)
-        du1, du2 = u[:, 1] - u[:, 0], u[:, 2] - u[:, 0]
-        gradient = du1[:, None, :] * g1[None] + du2[:, None, :] * g2[None]
-        return cls(gradient, p.mean(axis=1), 0.5 * np.abs(det), p)
+def _cell_energy(first: GradientField, second: GradientField, lame, corners, parent, located,
+                 rule) -> float:
+    """sum over cells of the rule applied to sigma(e) : eps(e), e = u_first - u_second."""
+    X, W = rule
+    a, b = corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]
+    area = 0.5 * np.abs(a[0] * b[1] - a[1] * b[0])
+    total = 0.0
+    for q in range(W.size):
+        x = corners[:, 0] + a * X[0, q] + b * X[1, q]
+        difference = first.at(x, parent) - second.at(x, located)
+        total += 2.0 * W[q] * float((energy_density(difference, *lame) * area).sum())
+    return total
 
 
-def energy_error_on(field: P1Field, lame, solution: DiscreteSolution) -> float:
-    """||u - u_h|| for a P1 ``field`` on another (finer) mesh, integrated over that mesh with
-    u_h's gradient located at each quadrature point (module docstring): the centroid for P1
-    u_h, a rule of degree 2(p - 1) for P_p. Where the fine mesh refines u_h's mesh the rule is
-    exact: the integrand is a polynomial of that degree on every fine element."""
-    order = solution.elasticity.order
-    if order == 1:
-        element = locate(solution.elasticity.mesh, field.centroid[0], field.centroid[1])
-        grad_h = element_gradients(solution)[:, :, element]
-        energy = float((energy_density(field.gradient - grad_h, *lame) * field.area).sum())
-        return float(np.sqrt(max(energy, 0.0)))
-    X, W = get_quadrature(RefTri, 2 * (order - 1))  # sum W = 1/2, the reference area
-    c = field.corners
-    x = (c[:, 0, :, None] + (c[:, 1] - c[:, 0])[:, :, None] * X[0]
-         + (c[:, 2] - c[:, 0])[:, :, None] * X[1]).reshape(2, -1)  # element-major
-    mesh = solution.elasticity.mesh
-    grad_h = gradients_at(solution.elasticity.basis, solution.u, x, locate(mesh, *x))
-    difference = np.repeat(field.gradient, W.size, axis=2) - grad_h
-    weight = np.repeat(field.area, W.size) * np.tile(2.0 * W, field.area.size)
-    energy = float((energy_density(difference, *lame) * weight).sum())
-    return float(np.sqrt(max(energy, 0.0)))
+def energy_difference(first: GradientField, second: GradientField, lame) -> float:
+    """||u_first - u_second|| = a(e, e)^(1/2), integrated on cells of the first mesh refined to
+    the second where that one is finer (module docstring)."""
+    rule = get_quadrature(RefTri, 2 * max(first.degree, second.degree))
+    mesh = first.locator.mesh
+    corners = mesh.p[:, mesh.t]
+    parent = np.arange(mesh.t.shape[1])
+    total = 0.0
+    for depth in range(MAX_SPLITS + 1):
+        located = second.locator.find(corners.mean(axis=1))
+        a, b = corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]
+        area = 0.5 * np.abs(a[0] * b[1] - a[1] * b[0])
+        split = area > second.area[located]
+        if depth == MAX_SPLITS:
+            split[:] = False
+        keep = np.flatnonzero(~split)
+        for start in range(0, keep.size, CHUNK):
+            block = keep[start:start + CHUNK]
+            total += _cell_energy(first, second, lame, corners[:, :, block], parent[block],
+                                  located[block], rule)
+        if not split.any():
+            break
+        corners, parent = _children(corners[:, :, split]), np.tile(parent[split], 4)
+    return float(np.sqrt(max(total, 0.0)))

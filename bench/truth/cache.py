@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 from skfem import MeshTri
 
-from bench.truth.references import Reference, build_reference, reference_key
+from bench.truth.references import PRIMARY, Reference, build_reference, reference_key
 
 
 class CorruptCache(Exception):
@@ -36,11 +36,13 @@ def _checksum_path(path: Path) -> Path:
 def save_reference(ref: Reference, path: Path) -> None:
     """Write the reference and then its checksum, each atomically."""
     path.parent.mkdir(parents=True, exist_ok=True)
-    meta = {"lame": list(ref.lame), "ndofs": ref.ndofs, "energy": ref.energy,
-            "contact_force": ref.contact_force, "zone": list(ref.zone),
-            "estimated_error": ref.estimated_error}
+    meta = {"recipe": ref.recipe, "order": ref.order, "lame": list(ref.lame),
+            "ndofs": ref.ndofs, "energy": ref.energy, "norm": ref.norm,
+            "contact_force": ref.contact_force,
+            "zone": list(ref.zone), "estimated_error": ref.estimated_error, "rate": ref.rate,
+            "build_seconds": ref.build_seconds}
     tmp = path.with_suffix(".tmp.npz")
-    np.savez_compressed(tmp, p=ref.mesh.p, t=ref.mesh.t, u=ref.u_nodal,
+    np.savez_compressed(tmp, p=ref.mesh.p, t=ref.mesh.t, u=ref.u,
                         pressure_s=ref.pressure_s, pressure_values=ref.pressure_values,
                         meta=json.dumps(meta))
     checksum = _checksum_path(path).with_suffix(".sha256.tmp")
@@ -60,18 +62,22 @@ def load_reference(path: Path, key: str) -> Reference:
     try:
         with np.load(path) as data:
             meta = json.loads(str(data["meta"]))
-            return Reference(key=key, mesh=MeshTri(data["p"], data["t"]), u_nodal=data["u"],
+            return Reference(key=key, recipe=meta["recipe"], order=meta["order"],
+                             mesh=MeshTri(data["p"], data["t"]), u=data["u"],
                              lame=tuple(meta["lame"]), pressure_s=data["pressure_s"],
                              pressure_values=data["pressure_values"], ndofs=meta["ndofs"],
-                             energy=meta["energy"], contact_force=meta["contact_force"],
-                             zone=tuple(meta["zone"]), estimated_error=meta["estimated_error"])
+                             energy=meta["energy"], norm=meta["norm"],
+                             contact_force=meta["contact_force"],
+                             zone=tuple(meta["zone"]), estimated_error=meta["estimated_error"],
+                             rate=meta["rate"], build_seconds=meta["build_seconds"])
     except Exception as error:  # zip, pickle, JSON and key errors alike: do not trust it
         raise CorruptCache(f"{type(error).__name__}: {error}") from None
 
 
-def load_or_build(scene, max_dofs: int) -> Reference:
-    """The cached reference for (scene, max_dofs), built and stored if missing or corrupt."""
-    key = reference_key(scene, max_dofs)
+def load_or_build(scene, max_dofs: int, recipe: str = PRIMARY) -> Reference:
+    """The cached reference for (scene, max_dofs, recipe), built and stored if missing or
+    corrupt."""
+    key = reference_key(scene, max_dofs, recipe)
     path = cache_folder() / f"{key}.npz"
     if path.exists():
         try:
@@ -81,6 +87,6 @@ def load_or_build(scene, max_dofs: int) -> Reference:
                   "rebuilding it", file=sys.stderr)
             path.unlink(missing_ok=True)
             _checksum_path(path).unlink(missing_ok=True)
-    ref = build_reference(scene, max_dofs)
+    ref = build_reference(scene, max_dofs, recipe)
     save_reference(ref, path)
     return ref

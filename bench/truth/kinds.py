@@ -10,12 +10,14 @@ import numpy as np
 
 from bench.measure.discretisation_error import Errors, exact_errors
 from bench.truth.cache import load_or_build
-from bench.truth.references import TruthError
+from bench.truth.crosscheck import CrossCheck, cross_check
+from bench.truth.references import CROSSCHECK, TruthError
 
-TOO_COARSE = 0.1  # a reference whose own error exceeds 10 % of the measured error is too coarse
-# A reference needs at least this many times the DOFs of the finest level it judges: at the
-# adaptive rate N^(-1/2) its own error is then at most 1/sqrt(10) = 0.32 of that level's, the
-# least for the two to be told apart; a smaller one is refused before any run.
+TOO_COARSE = 0.05  # a reference whose own error exceeds 5 % of the measured error is too coarse
+# A reference of an order no higher than the runs it judges needs at least this many times the
+# DOFs of their finest level: at the adaptive rate N^(-p/2) its own error is then at most
+# 10^(-1/2) of that level's, the least for the two to be told apart; a smaller one is refused
+# before any run. A reference of higher order converges faster and is judged row by row.
 REFERENCE_FACTOR = 10
 
 
@@ -39,6 +41,7 @@ class ExactTruth(_Truth):
 @dataclass(frozen=True, eq=False)
 class ReferenceTruth(_Truth):
     reference: object
+    crosscheck: CrossCheck | None = None
     kind: str = "reference"
 
     @property
@@ -55,26 +58,33 @@ class ReferenceTruth(_Truth):
             no_contact and solution.active_constraints > 0)
 
 
-def check_reference(reference, scene, judged_max_dofs: int | None) -> None:
-    """Refuse a reference that cannot judge runs up to ``judged_max_dofs`` DOFs."""
+def check_reference(reference, scene, judged_max_dofs: int | None, judged_order: int = 1,
+                    ) -> None:
+    """Refuse a reference that cannot judge runs up to ``judged_max_dofs`` DOFs of order up
+    to ``judged_order``."""
     where = f"the {scene.name!r} reference ({reference.ndofs} DOFs)"
     if not (np.isfinite(reference.estimated_error) and reference.estimated_error > 0):
         raise TruthError(f"{where} estimates its own error as {reference.estimated_error:g}: "
                          "it has not shown it is sharper than anything; raise --reference-dofs")
-    if judged_max_dofs is not None and reference.ndofs < REFERENCE_FACTOR * judged_max_dofs:
+    if (judged_max_dofs is not None and reference.order <= judged_order
+            and reference.ndofs < REFERENCE_FACTOR * judged_max_dofs):
         raise TruthError(f"{where} is not {REFERENCE_FACTOR}x finer than the runs it would "
                          f"judge (--max-dofs={judged_max_dofs}); raise --reference-dofs to at "
                          f"least {REFERENCE_FACTOR * judged_max_dofs * 2} or lower --max-dofs")
 
 
-def truth_for(scene, reference_dofs: int | None, judged_max_dofs: int | None = None):
+def truth_for(scene, reference_dofs: int | None, judged_max_dofs: int | None = None,
+              judged_order: int = 1, crosscheck: bool = False):
     """Exact if the scene has an exact solution; else the cached reference with
     ``reference_dofs`` DOFs (None: no error measurement), refused (TruthError) if it cannot
-    judge runs up to ``judged_max_dofs`` DOFs."""
+    judge runs up to ``judged_max_dofs`` DOFs of order ``judged_order``; with ``crosscheck``
+    also the second recipe's reference, compared with the first."""
     if scene.exact is not None:
         return ExactTruth(scene)
     if reference_dofs is None:
         return None
     reference = load_or_build(scene, reference_dofs)
-    check_reference(reference, scene, judged_max_dofs)
-    return ReferenceTruth(reference)
+    check_reference(reference, scene, judged_max_dofs, judged_order)
+    check = (cross_check(reference, load_or_build(scene, reference_dofs, CROSSCHECK))
+             if crosscheck else None)
+    return ReferenceTruth(reference, check)

@@ -1,14 +1,17 @@
-"""Overkill references for scenes without an exact solution, cached on disk.
+"""Overkill references for scenes without an exact solution, cached on disk
+(docs/theory.md, section 6.3).
 
-A reference is the last level of an adaptive sequence (mixed method, active-set solver,
-residual estimator, Doerfler 0.5) run to ``max_dofs``. Its own energy-norm error is estimated
-from its last two levels: if the error decays like N^(-1/2) (the adaptive rate, measured) and
-the levels are nearly orthogonal in the energy norm, e_L = ||u_L - u_(L-1)|| / sqrt(N_L/N_(L-1)
-- 1). It is a model, not a bound; ``reference_too_coarse`` flags rows whose error is within 10x.
+A reference is the last level of an adaptive sequence of a ``Recipe``: by default the mixed
+method in P3 (``PRIMARY``), which on the singular paper scene converges like N^(-3/2) against
+N^(-1/2) for P1, so that a few hundred thousand DOFs are far sharper than any P1 run it judges.
+Its own energy-norm error is estimated from the differences between its last levels
+(``bench.truth.error_bar``); ``reference_too_coarse`` flags rows whose error is not at least
+1/TOO_COARSE times larger. A second recipe (``CROSSCHECK``, P2) checks the first
+(``bench.truth.crosscheck``).
 
 The cache (``bench.truth.cache``) is keyed by a hash of everything that determines the
-reference: scene name and parameters, formulation, solver, estimator, marking, DOF budget and
-``ASSEMBLY_VERSION`` (bump it when the assembly or a formulation changes).
+reference: scene name and parameters, recipe, DOF budget and ``ASSEMBLY_VERSION`` (bump it when
+the assembly or a formulation changes).
 """
 
 from __future__ import annotations
@@ -16,91 +19,147 @@ from __future__ import annotations
 import functools
 import hashlib
 import json
-from dataclasses import dataclass
+import time
+from dataclasses import asdict, dataclass
 
 import numpy as np
 from skfem import MeshTri
 
 from bench.measure.contact import contact_zone
 from bench.measure.discretisation_error import Errors, errors_from
-from bench.measure.nonnested import P1Field, energy_error_on
+from bench.measure.fields import GradientField
+from bench.measure.nonnested import energy_difference
 from bench.sequence.loop import LoopConfig, run_sequence
+from bench.truth.error_bar import error_bar
 from formulations import STATUS_OK, DiscreteSolution
 
-ASSEMBLY_VERSION = 2  # 2: greedy multiplier segments, contact grading closure
-RECIPE = {"formulation": "mixed", "solver": "active-set", "estimator": "residual",
-          "strategy": "adaptive", "marking": "doerfler", "theta": 0.5}
+ASSEMBLY_VERSION = 3  # 3: P_p references, error bar with a fitted rate
+
+
+@dataclass(frozen=True)
+class Recipe:
+    """How a reference is built: an adaptive sequence of one formulation at one order."""
+
+    name: str
+    formulation: str
+    order: int
+    solver: str = "active-set"
+    estimator: str = "residual"
+    marking: str = "doerfler"
+    theta: float = 0.5
+    budget_factor: float = 1.0  # the DOF budget is this times the reference's
+
+
+# the P2 cross-check gets twice the budget: its energy must agree with P3's to 1e-7, and its
+# energy error, ||e||^2 / ||u||^2, is 1.1e-7 on hertz at the same budget (3.3e-4 relative)
+RECIPES = {r.name: r for r in (Recipe("mixed-p3", "mixed", 3),
+                               Recipe("mixed-p2", "mixed", 2, budget_factor=2.0))}
+PRIMARY, CROSSCHECK = "mixed-p3", "mixed-p2"
 
 
 @dataclass(frozen=True, eq=False)
 class Reference:
     key: str
+    recipe: str
+    order: int
     mesh: MeshTri
-    u_nodal: np.ndarray
+    u: np.ndarray  # the DOF vector of vector P_order on ``mesh`` (scikit-fem's numbering)
     lame: tuple[float, float]
     pressure_s: np.ndarray  # contact coordinates and reference pressure there (dense samples)
     pressure_values: np.ndarray
     ndofs: int
     energy: float
+    norm: float  # ||u_ref|| = a(u_ref, u_ref)^(1/2), the scale of relative errors
     contact_force: float
     zone: tuple[float, float]
     estimated_error: float
+    rate: float  # the fitted decay rate of the error bar (N^-rate)
+    build_seconds: float
 
     def pressure(self, s: np.ndarray) -> np.ndarray:
         return np.interp(s, self.pressure_s, self.pressure_values)
 
+    @property
+    def peak_pressure(self) -> float:
+        return float(self.pressure_values.max()) if self.pressure_values.size else 0.0
+
     @functools.cached_property
-    def field(self) -> P1Field:
-        return P1Field.from_nodal(self.mesh, self.u_nodal)
+    def field(self) -> GradientField:
+        return GradientField.from_dofs(self.mesh, self.order, self.u)
 
     def errors(self, solution: DiscreteSolution) -> Errors:
-        return errors_from(energy_error_on(self.field, self.lame, solution), solution,
+        judged = GradientField.from_solution(solution.elasticity.basis, solution.u)
+        return errors_from(energy_difference(judged, self.field, self.lame), solution,
                            self.pressure, self.zone)
 
     def summary(self) -> dict:
-        return {"ndofs": self.ndofs, "energy": self.energy, "contact_force": self.contact_force,
+        return {"recipe": self.recipe, "order": self.order, "ndofs": self.ndofs,
+                "energy": self.energy, "energy_norm": self.norm,
+                "relative_estimated_error": self.estimated_error / self.norm,
+                "contact_force": self.contact_force,
                 "contact_zone_start": self.zone[0], "contact_zone_end": self.zone[1],
-                "estimated_error": self.estimated_error, "key": self.key}
+                "peak_pressure": self.peak_pressure, "estimated_error": self.estimated_error,
+                "error_rate": self.rate, "build_seconds": self.build_seconds, "key": self.key}
 
 
-def reference_key(scene, max_dofs: int) -> str:
-    recipe = {"scene": scene.name, "parameters": scene.parameters, "max_dofs": max_dofs,
-              "assembly_version": ASSEMBLY_VERSION, **RECIPE}
-    text = json.dumps(recipe, sort_keys=True, default=str)
-    return f"{scene.name}-{max_dofs}-{hashlib.sha256(text.encode()).hexdigest()[:16]}"
+def reference_key(scene, max_dofs: int, recipe: str = PRIMARY) -> str:
+    spec = {"scene": scene.name, "parameters": scene.parameters, "max_dofs": max_dofs,
+            "assembly_version": ASSEMBLY_VERSION, **asdict(RECIPES[recipe])}
+    text = json.dumps(spec, sort_keys=True, default=str)
+    return f"{scene.name}-{recipe}-{max_dofs}-{hashlib.sha256(text.encode()).hexdigest()[:16]}"
 
 
 def _sampled_pressure(solution: DiscreteSolution):
     t = np.linspace(0.0, 1.0, 9)
-    return solution.trace.coordinates_at(t).ravel(), solution.pressure(t).ravel()
+    s, values = solution.trace.coordinates_at(t).ravel(), solution.pressure(t).ravel()
+    order = np.argsort(s, kind="stable")
+    return s[order], values[order]
 
 
 class TruthError(ValueError):
     """A reference that cannot be built or cannot be trusted for the runs it would judge."""
 
 
-def build_reference(scene, max_dofs: int) -> Reference:
-    config = LoopConfig(strategy="adaptive", max_dofs=max_dofs, marking=RECIPE["marking"],
-                        theta=RECIPE["theta"], diagnostics=False)
-    previous, last = None, None
-    for result in run_sequence(scene, RECIPE["formulation"], RECIPE["solver"],
-                               RECIPE["estimator"], config):
+def _levels(scene, max_dofs: int, recipe: Recipe):
+    """The recipe's adaptive sequence: yields (ndofs, solution, field, difference to the level
+    before or None); TruthError if a level fails."""
+    config = LoopConfig(strategy="adaptive", order=recipe.order,
+                        max_dofs=int(max_dofs * recipe.budget_factor),
+                        marking=recipe.marking, theta=recipe.theta, diagnostics=False)
+    previous = None
+    for result in run_sequence(scene, recipe.formulation, recipe.solver, recipe.estimator,
+                               config):
         if result.row.status != STATUS_OK:
             raise TruthError(f"reference for scene {scene.name!r}: level {result.row.level} "
                              f"failed: {result.row.reason}")
-        previous, last = last, result
-    if previous is None:
+        sol = result.solution
+        field = GradientField.from_solution(sol.elasticity.basis, sol.u)
+        # nested levels: the finer field first makes the integral exact
+        difference = (None if previous is None
+                       else energy_difference(field, previous, sol.elasticity.lame))
+        previous = field
+        yield result.row.ndofs, sol, field, difference
+
+
+def build_reference(scene, max_dofs: int, recipe: str = PRIMARY) -> Reference:
+    start = time.perf_counter()
+    ndofs, differences, sol = [], [], None
+    for n, level_solution, _field, difference in _levels(scene, max_dofs, RECIPES[recipe]):
+        ndofs.append(n)
+        sol = level_solution
+        if difference is not None:
+            differences.append(difference)
+    if not differences:
         raise TruthError(f"reference_dofs={max_dofs} leaves the {scene.name!r} reference one "
-                         f"level ({last.row.ndofs} DOFs): its own error cannot be estimated; "
-                         "give a budget of at least ten times the runs' --max-dofs")
-    sol = last.solution
-    u_nodal = sol.elasticity.nodal(sol.u)
-    difference = energy_error_on(P1Field.from_nodal(sol.elasticity.mesh, u_nodal),
-                                 sol.elasticity.lame, previous.solution)
-    ratio = last.row.ndofs / previous.row.ndofs
+                         f"level ({ndofs[-1]} DOFs): its own error cannot be estimated; "
+                         "give a larger budget")
+    bar = error_bar(ndofs, differences)
     s, values = _sampled_pressure(sol)
-    return Reference(key=reference_key(scene, max_dofs), mesh=sol.elasticity.mesh,
-                     u_nodal=u_nodal, lame=sol.elasticity.lame, pressure_s=s,
-                     pressure_values=values, ndofs=last.row.ndofs, energy=sol.energy,
-                     contact_force=sol.contact_force(), zone=contact_zone(sol),
-                     estimated_error=float(difference / np.sqrt(max(ratio - 1.0, 1e-12))))
+    return Reference(key=reference_key(scene, max_dofs, recipe), recipe=recipe,
+                     order=RECIPES[recipe].order, mesh=sol.elasticity.mesh, u=sol.u,
+                     lame=sol.elasticity.lame, pressure_s=s, pressure_values=values,
+                     ndofs=ndofs[-1], energy=sol.energy,
+                     norm=float(np.sqrt(sol.u @ (sol.elasticity.K @ sol.u))),
+                     contact_force=sol.contact_force(),
+                     zone=contact_zone(sol), estimated_error=bar.estimated_error,
+                     rate=bar.rate, build_seconds=time.perf_counter() - start)

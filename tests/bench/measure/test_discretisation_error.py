@@ -2,12 +2,14 @@
 
 import numpy as np
 import pytest
-from skfem import Basis, ElementTriP1, ElementVector
+from skfem import Basis
 
 from bench.measure.discretisation_error import energy_density, exact_errors
-from bench.measure.nonnested import P1Field, energy_error_on
+from bench.measure.fields import GradientField, Locator
+from bench.measure.nonnested import energy_difference
 from bench.truth import cache
 from formulations import get_formulation, solve
+from formulations.elasticity import vector_element
 from scenes import get_scene
 
 
@@ -34,20 +36,21 @@ def test_transfer_is_exact_on_nested_meshes():
     scene = get_scene("paper")
     coarse, fine = scene.mesh.refined(2), scene.mesh.refined(4)
     sol, ref = solved(scene, coarse), solved(scene, fine)
-    ref_nodal = ref.elasticity.nodal(ref.u)
-    via_location = energy_error_on(P1Field.from_nodal(fine, ref_nodal), ref.elasticity.lame, sol)
+    fine_field = GradientField.from_solution(ref.elasticity.basis, ref.u)
+    coarse_field = GradientField.from_solution(sol.elasticity.basis, sol.u)
+    lame = ref.elasticity.lame
     basis = ref.elasticity.basis
     interpolated = np.zeros(basis.N)
     interpolated[basis.nodal_dofs] = _interpolate(sol, fine.p)
     e = ref.u - interpolated
-    assert via_location == pytest.approx(np.sqrt(e @ ref.elasticity.K @ e), rel=1e-10)
+    expected = np.sqrt(e @ ref.elasticity.K @ e)
+    assert energy_difference(fine_field, coarse_field, lame) == pytest.approx(expected, rel=1e-10)
+    assert energy_difference(coarse_field, fine_field, lame) == pytest.approx(expected, rel=1e-10)
 
 
 def _interpolate(sol, points):
-    from bench.measure.nonnested import locate
-
     mesh = sol.elasticity.mesh
-    element = locate(mesh, points[0], points[1])
+    element = Locator.from_mesh(mesh).find(points)
     nodal = sol.elasticity.nodal(sol.u)  # (2, nv)
     p = mesh.p[:, mesh.t[:, element]]  # (2, 3, n)
     # barycentric coordinates of each point in its element
@@ -71,11 +74,9 @@ def test_reference_error_agrees_with_exact_error_on_non_nested_meshes(tmp_path, 
     measured = ref.errors(sol).energy_error
     assert measured == pytest.approx(exact, abs=2 * ref.estimated_error + 0.02 * exact)
     # the reference's estimated own error is of the size of its true error
-    basis = Basis(ref.mesh, ElementVector(ElementTriP1()), intorder=6)
-    u = np.zeros(basis.N)
-    u[basis.nodal_dofs] = ref.u_nodal
+    basis = Basis(ref.mesh, vector_element(ref.order), intorder=10)
     diff = scene.exact.gradient(np.asarray(basis.global_coordinates())) - \
-        basis.interpolate(u).grad
+        basis.interpolate(ref.u).grad
     true_error = np.sqrt((energy_density(diff, *ref.lame) * basis.dx).sum())
     assert 0.5 < ref.estimated_error / true_error < 2.0, (ref.estimated_error, true_error)
 
@@ -87,7 +88,7 @@ def test_reference_is_cached_and_keyed_by_what_determines_it(tmp_path, monkeypat
     files = list(tmp_path.glob("*.npz"))
     assert len(files) == 1 and first.key in files[0].name
     again = cache.load_or_build(scene, 3000)
-    assert again.ndofs == first.ndofs and np.array_equal(again.u_nodal, first.u_nodal)
+    assert again.ndofs == first.ndofs and np.array_equal(again.u, first.u)
     assert again.energy == first.energy and again.zone == first.zone
     other = cache.reference_key(get_scene("paper", young_modulus=1.0), 3000)
     assert other != first.key and cache.reference_key(scene, 6000) != first.key

@@ -1,0 +1,162 @@
+"""Gradients of finite element fields as polynomials per element, and point location, for
+errors between solutions on different meshes (docs/theory.md, section 6).
+
+A ``GradientField`` stores, for every element, the coefficients of grad u_h in the monomials of
+the element's reference coordinates (degree p - 1 for P_p): evaluating it at any point of the
+element, or just outside it, is a gather and a dot product, with no scikit-fem basis to build
+per point. A ``Locator`` finds the element containing each point: the element of the nearest
+centroid (a k-d tree), then a walk across the edge of the most negative barycentric coordinate,
+all points at once.
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+
+import numpy as np
+from matplotlib.tri import Triangulation
+from scipy.spatial import cKDTree
+from skfem import Basis, MeshTri
+
+from formulations.elasticity import vector_element
+from formulations.evaluation import gradients_at_reference
+
+CHUNK = 250_000  # points per block when evaluating (bounds the temporary arrays)
+MAX_WALK = 64  # walk steps before the remaining points go to matplotlib's trapezoid finder
+INSIDE = 1e-12  # barycentric tolerance for "inside"
+
+
+def _neighbours(mesh: MeshTri) -> np.ndarray:
+    """neighbours[k, e]: the element across the edge of e opposite its vertex k, -1 on the
+    boundary."""
+    f2t, t2f = mesh.f2t, mesh.t2f  # facet -> its (one or two) elements; element -> facets
+    out = np.full((3, mesh.t.shape[1]), -1)
+    elements = np.arange(mesh.t.shape[1])
+    for j in range(3):
+        facet = t2f[j]
+        other = np.where(f2t[0, facet] == elements, f2t[1, facet], f2t[0, facet])
+        vertices = mesh.facets[:, facet]
+        # the vertex of e not on facet j is the one this neighbour lies opposite to
+        for k in range(3):
+            opposite = (mesh.t[k] != vertices[0]) & (mesh.t[k] != vertices[1])
+            out[k, opposite] = other[opposite]
+    return out
+
+
+@dataclass(frozen=True, eq=False)
+class Locator:
+    """Point location in one triangle mesh (module docstring)."""
+
+    mesh: MeshTri
+    origin: np.ndarray  # (2, nE): vertex 0 of every element
+    inverse: np.ndarray  # (2, 2, nE): the inverse of the affine map's matrix
+    area: np.ndarray
+
+    @classmethod
+    def from_mesh(cls, mesh: MeshTri) -> Locator:
+        p = mesh.p[:, mesh.t]  # (2, 3, nE)
+        a, b = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
+        det = a[0] * b[1] - a[1] * b[0]
+        inverse = np.array([[b[1], -b[0]], [-a[1], a[0]]]) / det
+        return cls(mesh, p[:, 0], inverse, 0.5 * np.abs(det))
+
+    @functools.cached_property
+    def neighbours(self) -> np.ndarray:
+        return _neighbours(self.mesh)
+
+    @functools.cached_property
+    def tree(self) -> cKDTree:
+        return cKDTree(self.mesh.p[:, self.mesh.t].mean(axis=1).T)
+
+    def reference_coordinates(self, x: np.ndarray, cells: np.ndarray) -> np.ndarray:
+        """The coordinates (2, n) of points x (2, n) in the reference triangle of ``cells``
+        (outside it for a point outside its cell)."""
+        d = x - self.origin[:, cells]
+        inv = self.inverse[:, :, cells]
+        return np.array([inv[0, 0] * d[0] + inv[0, 1] * d[1], inv[1, 0] * d[0] + inv[1, 1] * d[1]])
+
+    def find(self, x: np.ndarray) -> np.ndarray:
+        """The element containing each point of x (2, n); ValueError for a point outside."""
+        cells = self.tree.query(x.T)[1]
+        todo = np.arange(x.shape[1])
+        for _ in range(MAX_WALK):
+            xi = self.reference_coordinates(x[:, todo], cells[todo])
+            bary = np.array([1.0 - xi[0] - xi[1], xi[0], xi[1]])
+            worst = bary.argmin(axis=0)
+            outside = bary[worst, np.arange(todo.size)] < -INSIDE
+            step = self.neighbours[worst[outside], cells[todo[outside]]]
+            todo = todo[outside]
+            if todo.size == 0:
+                return cells
+            stuck = step < 0  # across the boundary: left to the exact finder below
+            cells[todo[~stuck]] = step[~stuck]
+            if stuck.all():
+                break
+        return self._finish(x, cells, todo)
+
+    def _finish(self, x, cells, todo) -> np.ndarray:
+        triangulation = Triangulation(self.mesh.p[0], self.mesh.p[1], self.mesh.t.T)
+        found = triangulation.get_trifinder()(x[0, todo], x[1, todo])
+        if (found < 0).any():
+            bad = todo[np.flatnonzero(found < 0)[0]]
+            raise ValueError(f"point ({x[0, bad]}, {x[1, bad]}) lies outside the mesh")
+        cells[todo] = found
+        return cells
+
+
+def monomials(degree: int) -> list[tuple[int, int]]:
+    """Exponents (i, j) of xi^i eta^j with i + j <= degree."""
+    return [(i, total - i) for total in range(degree + 1) for i in range(total, -1, -1)]
+
+
+def _lattice(degree: int) -> np.ndarray:
+    """Points (2, n) of the reference triangle on which the monomials of ``degree`` are
+    unisolvent: the centroid for degree 0, the degree-d lattice otherwise."""
+    if degree == 0:
+        return np.array([[1.0 / 3.0], [1.0 / 3.0]])
+    return np.array([[i / degree, j / degree] for i, j in monomials(degree)]).T
+
+
+def _powers(xi: np.ndarray, degree: int) -> np.ndarray:
+    return np.array([xi[0] ** i * xi[1] ** j for i, j in monomials(degree)])
+
+
+@dataclass(frozen=True, eq=False)
+class GradientField:
+    """grad u_h of a P_p field: per element, the coefficients of a polynomial of degree p - 1
+    in the reference coordinates (module docstring)."""
+
+    locator: Locator
+    degree: int
+    coefficients: np.ndarray  # (2, 2, n_monomials, nE)
+
+    @classmethod
+    def from_solution(cls, basis: Basis, u: np.ndarray, locator: Locator | None = None,
+                      ) -> GradientField:
+        """The field of the DOF vector ``u`` of a vector P_p ``basis``."""
+        degree = basis.elem.maxdeg - 1
+        nodes = _lattice(degree)
+        values = gradients_at_reference(basis, u, nodes)  # (2, 2, nE, n_nodes)
+        solve = np.linalg.inv(_powers(nodes, degree).T)  # Vandermonde: coefficients <- values
+        coefficients = np.einsum("mk,ijek->ijme", solve, values)
+        return cls(locator or Locator.from_mesh(basis.mesh), degree, coefficients)
+
+    @classmethod
+    def from_dofs(cls, mesh: MeshTri, order: int, u: np.ndarray) -> GradientField:
+        return cls.from_solution(Basis(mesh, vector_element(order), intorder=1), u)
+
+    @property
+    def area(self) -> np.ndarray:
+        return self.locator.area
+
+    def at(self, x: np.ndarray, cells: np.ndarray) -> np.ndarray:
+        """grad u_h (2, 2, n) at points x (2, n) from the polynomials of ``cells`` (extended
+        beyond the element for a point outside it)."""
+        out = np.empty((2, 2, x.shape[1]))
+        for start in range(0, x.shape[1], CHUNK):
+            block = slice(start, start + CHUNK)
+            xi = self.locator.reference_coordinates(x[:, block], cells[block])
+            out[:, :, block] = np.einsum("ijmn,mn->ijn", self.coefficients[:, :, :, cells[block]],
+                                         _powers(xi, self.degree))
+        return out
