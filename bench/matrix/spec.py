@@ -16,7 +16,7 @@ from formulations import get_formulation
 from scenes import get_scene
 from scenes.registry import SCENES
 
-SPEC_VERSION = 2  # bump when the rows of an unchanged spec would change
+SPEC_VERSION = 3  # bump when the rows of an unchanged spec would change (3: P3 references)
 
 
 @dataclass(frozen=True)

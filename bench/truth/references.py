@@ -120,7 +120,7 @@ class TruthError(ValueError):
     """A reference that cannot be built or cannot be trusted for the runs it would judge."""
 
 
-def _levels(scene, max_dofs: int, recipe: Recipe):
+def reference_levels(scene, max_dofs: int, recipe: Recipe):
     """The recipe's adaptive sequence: yields (ndofs, solution, field, difference to the level
     before or None); TruthError if a level fails."""
     config = LoopConfig(strategy="adaptive", order=recipe.order,
@@ -144,7 +144,7 @@ def _levels(scene, max_dofs: int, recipe: Recipe):
 def build_reference(scene, max_dofs: int, recipe: str = PRIMARY) -> Reference:
     start = time.perf_counter()
     ndofs, differences, sol = [], [], None
-    for n, level_solution, _field, difference in _levels(scene, max_dofs, RECIPES[recipe]):
+    for n, level_solution, _field, difference in reference_levels(scene, max_dofs, RECIPES[recipe]):
         ndofs.append(n)
         sol = level_solution
         if difference is not None:

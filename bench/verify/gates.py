@@ -19,6 +19,7 @@ from bench.matrix.rates import rates_table
 from bench.sequence.rows import KEYS
 from bench.verify.closed_form import closed_form_table
 from bench.verify.expected import EXPECTED, load_expected
+from bench.verify.truth_checks import error_bar_table, truth_table
 
 
 @dataclass(frozen=True)
@@ -51,19 +52,28 @@ def _matches(row: pd.Series, gate: dict) -> bool:
     return all(fnmatch.fnmatch(str(row[k]), str(gate.get(k, "*"))) for k in KEYS if k in row)
 
 
-def check_gates(expected: dict, rates: pd.DataFrame,
-                closed_form: pd.DataFrame) -> list[Verdict]:
+def gate_names(expected: dict, quick: bool = False) -> list[str]:
+    """The gates checked: all, or without those marked ``full`` (the reduced run)."""
+    return sorted({g["name"] for g in expected["gate"] if not (quick and g.get("full"))})
+
+
+def check_gates(expected: dict, tables: list[pd.DataFrame], quick: bool = False,
+                ) -> list[Verdict]:
+    """Every gate against the first of ``tables`` with a column of its quantity."""
     verdicts = []
     for gate in expected["gate"]:
+        if quick and gate.get("full"):
+            continue
         low, high = gate.get("min", -np.inf), gate.get("max", np.inf)
         source = gate["source"]
-        table = closed_form if gate["quantity"] in closed_form.columns else rates
+        table = next((t for t in tables if gate["quantity"] in t.columns), tables[0])
         selected = [row for _, row in table.iterrows() if _matches(row, gate)]
         if not selected:
             verdicts.append(Verdict(gate["name"], "(no rows)", np.nan, low, high, False, source))
         for row in selected:
             value = float(row[gate["quantity"]])
-            label = "/".join(str(row[k]) for k in KEYS if k in row and str(row[k]))
+            label = row["label"] if "label" in row else "/".join(
+                str(row[k]) for k in KEYS if k in row and str(row[k]))
             verdicts.append(Verdict(gate["name"], label, value, low, high,
                                     bool(low <= value <= high), source))
     return verdicts
@@ -83,16 +93,21 @@ def hard_verdicts(expected: dict, hard: pd.DataFrame) -> list[Verdict]:
 
 
 def verify(out: str | Path = "results-verify", expected_path: str | Path = EXPECTED,
-           on_level=None, hard: bool = True) -> tuple[list[Verdict], pd.DataFrame, pd.DataFrame]:
-    """Every gate; with ``hard`` also the hard cases' verdicts (written to out/hard.csv).
-    Returns the verdicts, the rates table and the closed-form comparison."""
+           on_level=None, hard: bool = True, quick: bool = False,
+           ) -> tuple[list[Verdict], pd.DataFrame, pd.DataFrame]:
+    """Every gate; with ``hard`` also the hard cases' verdicts (written to out/hard.csv);
+    ``quick``: the reduced truth checks of ``[truth.quick]`` and no ``full`` gates. Returns
+    the verdicts, the rates table and the closed-form comparison."""
     expected = load_expected(expected_path)
     rows = run_gate_matrices(expected, out, on_level)
     rates = rates_table(rows)
     closed_form = closed_form_table(expected["closed_form"])
-    rates.to_csv(Path(out) / "rates.csv", index=False)
-    closed_form.to_csv(Path(out) / "closed-form.csv", index=False)
-    verdicts = check_gates(expected, rates, closed_form)
+    truth = truth_table(expected["truth"], quick)
+    bars = error_bar_table(expected["truth"], quick)
+    for name, table in (("rates", rates), ("closed-form", closed_form), ("truth", truth),
+                        ("error-bar", bars)):
+        table.to_csv(Path(out) / f"{name}.csv", index=False)
+    verdicts = check_gates(expected, [rates, closed_form, truth, bars], quick)
     if hard:
         table = run_hard()
         write_hard(table, out)
