@@ -11,6 +11,7 @@ import pandas as pd
 from bench.cli.guards import InputError, check_output_folders
 from bench.cli.parser import build_parser
 from bench.cli.progress import Progress
+from bench.cli.study import study_command
 from bench.hard import (
     check_expected,
     hard_case_descriptions,
@@ -182,7 +183,7 @@ def scaling_command(args) -> int:
 
 COMMANDS = {"run": run_command, "compare": compare_command, "report": report_command,
             "verify": verify_command, "hard": hard_command, "scaling": scaling_command,
-            "list": list_command}
+            "list": list_command, "study": study_command}
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -8,7 +8,8 @@ from pathlib import Path
 
 # the folder options of each command that will be written to
 OUTPUT_OPTIONS = {"run": ("out",), "compare": ("out", "reports"), "report": ("out",),
-                  "verify": ("out",), "hard": ("out",), "scaling": ("out",)}
+                  "verify": ("out",), "hard": ("out",), "scaling": ("out",),
+                  "study": ("out", "report")}
 
 
 class InputError(ValueError):

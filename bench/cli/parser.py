@@ -280,6 +280,9 @@ def build_parser() -> argparse.ArgumentParser:
     _compare_parser(sub)
     _verify_parser(sub)
     _hard_parser(sub)
+    from bench.cli.study import add_study_parser  # the study's own module (it uses these types)
+
+    add_study_parser(sub)
     sub.add_parser("list", help="list registered scenes, formulations, solvers, estimators "
                    "and hard cases",
                    description="List everything registered, with one line of description.")

@@ -1,0 +1,61 @@
+"""``python -m bench study``: its options and its command (docs/theory.md, section 10)."""
+
+from __future__ import annotations
+
+import dataclasses
+
+from bench.cli import parser as options
+from bench.study import QUICK, StudyConfig, run_study
+from scenes import scene_names
+
+DEFAULTS = StudyConfig()
+
+
+def add_study_parser(sub) -> None:
+    study = sub.add_parser(
+        "study", help="the rate study: uniform sequences to 2e6 DOFs, adaptive to 1e6, every "
+        "formulation x estimator, against sharp references; writes its own report",
+        description="Run (or reuse) every sequence of the rate study into OUT, then write "
+        "REPORT/README.md with local and asymptotic slopes, the predictions from the scenes' "
+        "singular exponents and the effectivity on every level. A rerun reuses every finished "
+        "sequence.")
+    study.add_argument("--scene", type=options._names("scene", scene_names()),
+                       default=list(DEFAULTS.scenes),
+                       help=f"scene(s) (default: {','.join(DEFAULTS.scenes)})")
+    study.add_argument("--order", type=options._orders, default=list(DEFAULTS.orders),
+                       help="polynomial order(s) (default: 1)")
+    study.add_argument("--uniform-max-dofs", type=options._positive_int("uniform_max_dofs"),
+                       default=DEFAULTS.uniform_max_dofs,
+                       help=f"DOF budget of the uniform sequences "
+                            f"(default: {DEFAULTS.uniform_max_dofs})")
+    study.add_argument("--adaptive-max-dofs", type=options._positive_int("adaptive_max_dofs"),
+                       default=DEFAULTS.adaptive_max_dofs,
+                       help=f"DOF budget of the adaptive sequences "
+                            f"(default: {DEFAULTS.adaptive_max_dofs})")
+    study.add_argument("--reference-dofs", type=options._positive_int("reference_dofs"),
+                       default=DEFAULTS.reference_dofs,
+                       help=f"P3 reference budget (default: {DEFAULTS.reference_dofs})")
+    study.add_argument("--workers", type=options._non_negative_int("workers"),
+                       default=DEFAULTS.workers,
+                       help=f"adaptive sequences run in parallel on a local Dask cluster of "
+                            f"this many processes; uniform ones one at a time "
+                            f"(default: {DEFAULTS.workers})")
+    study.add_argument("--quick", action="store_true",
+                       help="the reduced study of the default tests: paper, uniform to 9000 "
+                            "and adaptive to 5000 DOFs, in this process")
+    study.add_argument("--out", default=DEFAULTS.out,
+                       help=f"results folder (default: {DEFAULTS.out})")
+    study.add_argument("--report", default=DEFAULTS.report,
+                       help=f"report folder (default: {DEFAULTS.report})")
+
+
+def study_command(args) -> int:
+    base = QUICK if args.quick else StudyConfig(
+        scenes=tuple(args.scene), orders=tuple(args.order),
+        uniform_max_dofs=args.uniform_max_dofs, adaptive_max_dofs=args.adaptive_max_dofs,
+        reference_dofs=args.reference_dofs, workers=args.workers)
+    config = dataclasses.replace(base, out=args.out, report=args.report,
+                                 command=" ".join(["python -m bench", *args.argv]))
+    table, report = run_study(config)
+    print(f"{len(table)} levels; wrote {report}")
+    return 0

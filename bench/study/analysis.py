@@ -1,0 +1,117 @@
+"""The rate study's numbers (docs/theory.md, section 10): local slopes between consecutive
+levels, fitted asymptotic slopes with their standard errors, the predictions from the scenes'
+singular exponents, and where the seed paper's "nearly O(h^1/2)" holds.
+
+Slopes are of log(y) against log(N): -1/4 is O(h^1/2), -1/2 is O(h).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from bench.sequence.rows import KEYS, with_labels
+from formulations import STATUS_OK
+from scenes import get_scene
+from scenes.corners import predicted_rate, singularities
+
+FIT_LEVELS = 4  # the asymptotic slope: least squares over the last levels
+QUANTITIES = {"error": "energy_error", "eta": "eta", "pressure": "pressure_error"}
+NEARLY = 0.05  # "nearly O(h^1/2)": a local error slope within this of -1/4
+EFFECTIVITY_FROM = 1000  # effectivity statistics from this many DOFs (coarser: no contact yet)
+SHOWN = ["scene", "formulation", "estimator", "strategy", "order"]  # the columns of a sequence
+
+
+def _ok(table: pd.DataFrame) -> pd.DataFrame:
+    return with_labels(table[(table["status"] == STATUS_OK) & (table["level"] >= 0)])
+
+
+def local_slopes(table: pd.DataFrame) -> pd.DataFrame:
+    """One row per pair of consecutive levels of every sequence: the slopes between them."""
+    rows = []
+    for key, group in _ok(table).groupby(KEYS, sort=True):
+        group = group.sort_values("ndofs")
+        for (_, a), (_, b) in zip(group.iloc[:-1].iterrows(), group.iloc[1:].iterrows(),
+                                  strict=True):
+            row = {**dict(zip(KEYS, key, strict=True)), "ndofs_from": int(a["ndofs"]),
+                   "ndofs_to": int(b["ndofs"])}
+            step = np.log(b["ndofs"]) - np.log(a["ndofs"])
+            for name, column in QUANTITIES.items():
+                ok = a[column] > 0 and b[column] > 0
+                row[f"{name}_slope"] = (np.log(b[column] / a[column]) / step if ok
+                                        else float("nan"))
+            rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def fitted_slope(ndofs, values, levels: int = FIT_LEVELS) -> tuple[float, float]:
+    """The least-squares slope over the last ``levels`` positive values and its standard error
+    (NaN with fewer than 3 points: a line through two points has no spread)."""
+    ndofs, values = np.asarray(ndofs, float), np.asarray(values, float)
+    keep = values > 0
+    x, y = np.log(ndofs[keep])[-levels:], np.log(values[keep])[-levels:]
+    if x.size < 2:
+        return float("nan"), float("nan")
+    if x.size < 3:
+        return float(np.polyfit(x, y, 1)[0]), float("nan")
+    coefficients, residuals = np.polyfit(x, y, 1, full=True)[:2]
+    spread = float(residuals[0]) / (x.size - 2) if residuals.size else 0.0
+    return float(coefficients[0]), float(np.sqrt(spread / ((x - x.mean()) ** 2).sum()))
+
+
+def predictions(scenes, orders=(1,)) -> pd.DataFrame:
+    """Per scene and order: its smallest singular exponent, where, and the predicted slopes."""
+    rows = []
+    for name in scenes:
+        found = singularities(get_scene(name))
+        for order in orders:
+            rows.append({"scene": name, "order": order, "exponent": found[0].exponent,
+                         "where": found[0].where,
+                         "predicted_uniform": predicted_rate([s.exponent for s in found],
+                                                             order),
+                         "predicted_adaptive": -order / 2.0})
+    return pd.DataFrame(rows)
+
+
+def asymptotic_table(table: pd.DataFrame, levels: int = FIT_LEVELS) -> pd.DataFrame:
+    """Per sequence: the fitted slopes (and standard errors) of error, eta and pressure error
+    over the last levels, the prediction beside them, and the effectivity on every level."""
+    ok = _ok(table)
+    scenes, orders = sorted(ok["scene"].unique()), sorted(ok["order"].unique())
+    predicted = predictions(scenes, orders).set_index(["scene", "order"])
+    rows = []
+    for key, group in ok.groupby(KEYS, sort=True):
+        group = group.sort_values("ndofs")
+        row = {**dict(zip(KEYS, key, strict=True)), "levels": len(group),
+               "ndofs_first": int(group["ndofs"].iloc[0]),
+               "ndofs_last": int(group["ndofs"].iloc[-1])}
+        for name, column in QUANTITIES.items():
+            row[f"{name}_slope"], row[f"{name}_slope_se"] = fitted_slope(
+                group["ndofs"], group[column], levels)
+        expected = predicted.loc[(row["scene"], row["order"])]
+        row["predicted"] = float(expected[f"predicted_{row['strategy']}"])
+        effectivity = group.loc[group["ndofs"] >= EFFECTIVITY_FROM, "effectivity_index"]
+        row.update(effectivity_min=float(effectivity.min()),
+                   effectivity_max=float(effectivity.max()),
+                   too_coarse_rows=int(group["reference_too_coarse"].astype(bool).sum()))
+        rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def nearly_half_range(slopes: pd.DataFrame, target: float = -0.25) -> pd.DataFrame:
+    """Per uniform sequence: the DOF range over which the local error slopes are within NEARLY
+    of ``target`` (-1/4: "nearly O(h^1/2)"), the range of the local slopes and the last one."""
+    rows = []
+    uniform = slopes[slopes["strategy"] == "uniform"]
+    for key, group in uniform.groupby(SHOWN, sort=True):
+        inside = (group["error_slope"] - target).abs() <= NEARLY
+        rows.append({**dict(zip(SHOWN, key, strict=True)),
+                     "holds_from": int(group.loc[inside, "ndofs_from"].min()) if inside.any()
+                     else None,
+                     "holds_to": int(group.loc[inside, "ndofs_to"].max()) if inside.any()
+                     else None,
+                     "local_slope_min": float(group["error_slope"].min()),
+                     "local_slope_max": float(group["error_slope"].max()),
+                     "last_local_slope": float(group["error_slope"].iloc[-1]),
+                     "last_pair": f"{group['ndofs_from'].iloc[-1]}-{group['ndofs_to'].iloc[-1]}"})
+    return pd.DataFrame(rows)

@@ -1,0 +1,158 @@
+"""The rate study's report: ``README.md`` with its tables and ``figures/*.png`` (convergence
+against the predictions, local slopes, effectivity on every level)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from matplotlib.figure import Figure
+
+from bench.report.figures import colour, line_style
+from bench.sequence.rows import KEYS
+from bench.study.analysis import (
+    EFFECTIVITY_FROM,
+    NEARLY,
+    SHOWN,
+    asymptotic_table,
+    local_slopes,
+    nearly_half_range,
+    predictions,
+)
+from formulations import STATUS_OK
+
+MARKERS = {"uniform": "s", "adaptive": "o"}
+
+
+def _sequences(table: pd.DataFrame, scene: str):
+    ok = table[(table["scene"] == scene) & (table["status"] == STATUS_OK)]
+    for key, group in ok.groupby(["formulation", "estimator", "strategy", "order"], sort=True):
+        yield key, group.sort_values("ndofs")
+
+
+def convergence_figure(table: pd.DataFrame, scene: str, column: str, label: str,
+                       predicted: pd.DataFrame) -> Figure:
+    """``column`` against N for every sequence of ``scene``, with the predicted slopes drawn
+    through the finest uniform and adaptive points."""
+    figure = Figure(figsize=(7, 5))
+    axes = figure.add_subplot()
+    for (formulation, estimator, strategy, order), group in _sequences(table, scene):
+        axes.loglog(group["ndofs"], group[column], color=colour(formulation),
+                    linestyle=line_style(estimator), marker=MARKERS.get(strategy, "x"),
+                    markersize=3, label=f"{formulation}/{estimator}/{strategy}/P{order}")
+    for strategy in ("uniform", "adaptive"):
+        rows = table[(table["scene"] == scene) & (table["strategy"] == strategy)
+                     & (table[column] > 0)]
+        if rows.empty:
+            continue
+        slope = float(predicted[f"predicted_{strategy}"].iloc[0])
+        last = rows.sort_values("ndofs").iloc[-1]
+        n = np.array([last["ndofs"] / 30, last["ndofs"]])
+        axes.loglog(n, last[column] * 1.5 * (n / n[-1]) ** slope, color="k",
+                    linestyle="-" if strategy == "uniform" else "--", linewidth=2,
+                    label=f"predicted {strategy}: N^{slope:.3f}")
+    axes.set_xlabel("DOFs N")
+    axes.set_ylabel(label)
+    axes.set_title(f"{scene}: {label}")
+    axes.legend(fontsize=5, ncol=2)
+    axes.grid(True, which="both", alpha=0.3)
+    return figure
+
+
+def local_slope_figure(slopes: pd.DataFrame, scene: str, predicted: pd.DataFrame) -> Figure:
+    """The local error slope between consecutive levels against N, with the predictions."""
+    figure = Figure(figsize=(7, 4))
+    axes = figure.add_subplot()
+    mine = slopes[slopes["scene"] == scene]
+    for key, group in mine.groupby(["formulation", "estimator", "strategy", "order"]):
+        formulation, estimator, strategy, order = key
+        middle = np.sqrt(group["ndofs_from"] * group["ndofs_to"])
+        axes.semilogx(middle, group["error_slope"], color=colour(formulation),
+                      linestyle=line_style(estimator), marker=MARKERS.get(strategy, "x"),
+                      markersize=3, label=f"{formulation}/{estimator}/{strategy}/P{order}")
+    for strategy, style in (("uniform", "-"), ("adaptive", "--")):
+        axes.axhline(float(predicted[f"predicted_{strategy}"].iloc[0]), color="k",
+                     linestyle=style, linewidth=1.5, label=f"predicted {strategy}")
+    axes.axhline(-0.25, color="grey", linestyle=":", label="paper: nearly O(h^1/2)")
+    axes.set_ylim(-1.2, 0.2)
+    axes.set_xlabel("DOFs N (geometric mean of the two levels)")
+    axes.set_ylabel("local slope of the error")
+    axes.set_title(f"{scene}: local error slopes")
+    axes.legend(fontsize=5, ncol=2)
+    axes.grid(True, which="both", alpha=0.3)
+    return figure
+
+
+def effectivity_figure(table: pd.DataFrame, scene: str) -> Figure:
+    """eta / ||u - u_h|| on every level of every sequence of ``scene``."""
+    figure = Figure(figsize=(7, 4))
+    axes = figure.add_subplot()
+    for (formulation, estimator, strategy, order), group in _sequences(table, scene):
+        axes.semilogx(group["ndofs"], group["effectivity_index"], color=colour(formulation),
+                      linestyle=line_style(estimator), marker=MARKERS.get(strategy, "x"),
+                      markersize=3, label=f"{formulation}/{estimator}/{strategy}/P{order}")
+    axes.set_yscale("log")
+    axes.set_xlabel("DOFs N")
+    axes.set_ylabel("effectivity eta / ||u - u_h||")
+    axes.set_title(f"{scene}: effectivity on every level")
+    axes.legend(fontsize=5, ncol=2)
+    axes.grid(True, which="both", alpha=0.3)
+    return figure
+
+
+def _markdown(frame: pd.DataFrame) -> str:
+    return frame.to_markdown(index=False, floatfmt=".4g") if len(frame) else "(no rows)"
+
+
+def write_study_report(table: pd.DataFrame, out: str | Path, wall_seconds: float | None = None,
+                       ) -> Path:
+    """README.md, tables as CSV and figures for the study's rows ``table``."""
+    out = Path(out)
+    (out / "figures").mkdir(parents=True, exist_ok=True)
+    slopes, asymptotic = local_slopes(table), asymptotic_table(table)
+    scenes = sorted(table["scene"].unique())
+    predicted = predictions(scenes, sorted(table["order"].unique()))
+    nearly = nearly_half_range(slopes)
+    for name, frame in (("local-slopes", slopes), ("asymptotic", asymptotic),
+                        ("predictions", predicted), ("nearly-half", nearly)):
+        frame.to_csv(out / f"{name}.csv", index=False)
+    figures = []
+    for scene in scenes:
+        mine = predicted[predicted["scene"] == scene]
+        for kind, figure in (
+                ("error", convergence_figure(table, scene, "energy_error", "energy error", mine)),
+                ("eta", convergence_figure(table, scene, "eta", "eta", mine)),
+                ("slopes", local_slope_figure(slopes, scene, mine)),
+                ("effectivity", effectivity_figure(table, scene))):
+            path = out / "figures" / f"{scene}-{kind}.png"
+            figure.savefig(path, dpi=110, bbox_inches="tight")
+            figures.append(path.name)
+    text = _report_text(table, asymptotic, predicted, nearly, figures, wall_seconds)
+    (out / "README.md").write_text(text)
+    return out / "README.md"
+
+
+def _report_text(table, asymptotic, predicted, nearly, figures, wall_seconds) -> str:
+    columns = SHOWN + ["levels", "ndofs_last", "error_slope", "error_slope_se", "eta_slope",
+                      "eta_slope_se", "pressure_slope", "pressure_slope_se", "predicted",
+                      "effectivity_min", "effectivity_max", "too_coarse_rows"]
+    lines = ["# Rate study", "",
+             f"{len(table)} levels of {table.groupby(KEYS).ngroups} sequences; "
+             f"{int(table['reference_too_coarse'].astype(bool).sum())} rows flagged "
+             "`reference_too_coarse`."
+             + (f" Wall time {wall_seconds / 60:.1f} min." if wall_seconds else ""), "",
+             "## Predictions", "",
+             "Smallest singular exponent lambda of each scene (u ~ r^lambda; corners from "
+             "their eigenvalue equation, contact-zone ends 3/2) and the slopes it predicts: "
+             "uniform -min(lambda, p)/2, adaptive -p/2.", "", _markdown(predicted), "",
+             "## Asymptotic slopes", "",
+             "Least-squares slopes over the last levels with their standard errors; "
+             f"effectivity over every level from {EFFECTIVITY_FROM} DOFs.", "",
+             _markdown(asymptotic.reindex(columns=columns)), "",
+             "## The seed paper's \"nearly O(h^1/2)\" under uniform refinement", "",
+             f"Range of DOFs over which local error slopes are within {NEARLY} of -1/4, the "
+             "range of all local slopes and the last one.",
+             "", _markdown(nearly), "", "## Figures", ""]
+    lines += [f"![{name}](figures/{name})" for name in figures]
+    return "\n".join(lines) + "\n"

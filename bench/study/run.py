@@ -1,0 +1,58 @@
+"""The rate study (docs/theory.md, section 10): uniform sequences to about 2e6 DOFs and
+adaptive ones to 1e6 for every formulation x estimator on the study's scenes, errors against
+exact solutions or the P3 references, then the study's report. Resumable: the rows go to an
+ordinary result store, and a rerun reuses every finished sequence."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, replace
+
+import pandas as pd
+
+from bench.matrix import RunConfig, run
+from bench.study.report import write_study_report
+from estimators import estimator_names
+from formulations import formulation_names
+
+
+@dataclass(frozen=True)
+class StudyConfig:
+    scenes: tuple[str, ...] = ("paper", "free-boundary", "hertz")
+    orders: tuple[int, ...] = (1,)
+    uniform_max_dofs: int = 2_100_000
+    adaptive_max_dofs: int = 1_000_000
+    reference_dofs: int = 200_000
+    workers: int = 2  # adaptive sequences in parallel; uniform ones run one at a time
+    out: str = "study"
+    report: str = "reports/study"
+    command: str = "python -m bench study"
+
+    def run_configs(self) -> list[RunConfig]:
+        """Adaptive first (in parallel, about 5 GiB each at 1e6 DOFs), then uniform in this
+        process (a 2.1e6-DOF level needs about 11 GiB, half of a 24 GiB machine)."""
+        common = dict(scenes=self.scenes, formulations=tuple(formulation_names()),
+                      solvers=("active-set",), estimators=tuple(estimator_names()),
+                      orders=self.orders, reference_dofs=self.reference_dofs, out=self.out,
+                      command=self.command)
+        return [RunConfig(strategies=("adaptive",), max_dofs=self.adaptive_max_dofs,
+                          workers=self.workers, **common),
+                RunConfig(strategies=("uniform",), max_dofs=self.uniform_max_dofs, **common)]
+
+
+# the default tests' version: the paper scene to a few thousand DOFs
+QUICK = StudyConfig(scenes=("paper",), uniform_max_dofs=9000, adaptive_max_dofs=5000,
+                    workers=0)
+
+
+def run_study(config: StudyConfig, on_level=None) -> tuple[pd.DataFrame, object]:
+    """Run (or reuse) every sequence of the study, then write its report; returns the rows
+    and the report's path."""
+    start = time.perf_counter()
+    tables = []
+    for run_config in config.run_configs():
+        if not run_config.workers:
+            run_config = replace(run_config, workers=0)
+        tables.append(run(run_config, on_level=on_level).table)
+    table = pd.concat(tables, ignore_index=True)
+    return table, write_study_report(table, config.report, time.perf_counter() - start)
