@@ -234,7 +234,8 @@ def _compare_parser(sub) -> None:
     compare.add_argument("--max-dofs", type=_positive_int("max_dofs"), default=20000,
                          help="DOF budget per sequence (default: 20000)")
     compare.add_argument("--reference-dofs", type=_positive_int("reference_dofs"),
-                         default=500000, help="overkill reference size (default: 500000)")
+                         default=200000,
+                         help="DOF budget of the P3 overkill references (default: 200000)")
     _memory_option(compare)
     _scale_out_options(compare)
     compare.add_argument("--crosscheck-dofs", type=_non_negative_int("crosscheck_dofs"),

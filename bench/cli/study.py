@@ -5,7 +5,9 @@ from __future__ import annotations
 import dataclasses
 
 from bench.cli import parser as options
+from bench.cli.guards import InputError
 from bench.study import QUICK, StudyConfig, run_study
+from bench.study.run import report_study
 from scenes import scene_names
 
 DEFAULTS = StudyConfig()
@@ -43,6 +45,9 @@ def add_study_parser(sub) -> None:
     study.add_argument("--quick", action="store_true",
                        help="the reduced study of the default tests: paper, uniform to 9000 "
                             "and adaptive to 5000 DOFs, in this process")
+    study.add_argument("--report-only", action="store_true",
+                       help="write the report of the sequences finished so far in OUT, "
+                            "without running anything")
     study.add_argument("--out", default=DEFAULTS.out,
                        help=f"results folder (default: {DEFAULTS.out})")
     study.add_argument("--report", default=DEFAULTS.report,
@@ -56,6 +61,12 @@ def study_command(args) -> int:
         reference_dofs=args.reference_dofs, workers=args.workers)
     config = dataclasses.replace(base, out=args.out, report=args.report,
                                  command=" ".join(["python -m bench", *args.argv]))
-    table, report = run_study(config)
+    if args.report_only:
+        try:
+            table, report = report_study(config)
+        except ValueError as error:
+            raise InputError(str(error)) from None
+    else:
+        table, report = run_study(config)
     print(f"{len(table)} levels; wrote {report}")
     return 0

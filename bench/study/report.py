@@ -106,7 +106,7 @@ def _markdown(frame: pd.DataFrame) -> str:
 
 
 def write_study_report(table: pd.DataFrame, out: str | Path, wall_seconds: float | None = None,
-                       ) -> Path:
+                       planned: int | None = None) -> Path:
     """README.md, tables as CSV and figures for the study's rows ``table``."""
     out = Path(out)
     (out / "figures").mkdir(parents=True, exist_ok=True)
@@ -128,17 +128,18 @@ def write_study_report(table: pd.DataFrame, out: str | Path, wall_seconds: float
             path = out / "figures" / f"{scene}-{kind}.png"
             figure.savefig(path, dpi=110, bbox_inches="tight")
             figures.append(path.name)
-    text = _report_text(table, asymptotic, predicted, nearly, figures, wall_seconds)
+    text = _report_text(table, asymptotic, predicted, nearly, figures, wall_seconds, planned)
     (out / "README.md").write_text(text)
     return out / "README.md"
 
 
-def _report_text(table, asymptotic, predicted, nearly, figures, wall_seconds) -> str:
+def _report_text(table, asymptotic, predicted, nearly, figures, wall_seconds, planned) -> str:
     columns = SHOWN + ["levels", "ndofs_last", "error_slope", "error_slope_se", "eta_slope",
                       "eta_slope_se", "pressure_slope", "pressure_slope_se", "predicted",
                       "effectivity_min", "effectivity_max", "too_coarse_rows"]
     lines = ["# Rate study", "",
-             f"{len(table)} levels of {table.groupby(KEYS).ngroups} sequences; "
+             f"{len(table)} levels of {table.groupby(KEYS).ngroups} sequences"
+             + (f" (of {planned} planned)" if planned else "") + "; "
              f"{int(table['reference_too_coarse'].astype(bool).sum())} rows flagged "
              "`reference_too_coarse`."
              + (f" Wall time {wall_seconds / 60:.1f} min." if wall_seconds else ""), "",

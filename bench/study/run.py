@@ -11,6 +11,8 @@ from dataclasses import dataclass, replace
 import pandas as pd
 
 from bench.matrix import RunConfig, run
+from bench.matrix.store import ResultStore
+from bench.sequence.rows import FINISHED
 from bench.study.report import write_study_report
 from estimators import estimator_names
 from formulations import formulation_names
@@ -55,4 +57,22 @@ def run_study(config: StudyConfig, on_level=None) -> tuple[pd.DataFrame, object]
             run_config = replace(run_config, workers=0)
         tables.append(run(run_config, on_level=on_level).table)
     table = pd.concat(tables, ignore_index=True)
-    return table, write_study_report(table, config.report, time.perf_counter() - start)
+    return table, write_study_report(table, config.report, time.perf_counter() - start,
+                                     planned=table.groupby("sequence_key").ngroups)
+
+
+def finished_table(config: StudyConfig) -> tuple[pd.DataFrame, int]:
+    """The rows of the study's sequences finished so far in ``config.out`` (another process may
+    still be running the rest), and how many sequences the study plans."""
+    keys = {spec.key for run_config in config.run_configs() for spec in run_config.specs()}
+    table = ResultStore(config.out).table()
+    done = table["sequence_key"].isin(keys) & table["sequence_end"].isin(FINISHED)
+    return table[done].reset_index(drop=True), len(keys)
+
+
+def report_study(config: StudyConfig):
+    """The report of what is finished, without running anything."""
+    table, planned = finished_table(config)
+    if table.empty:
+        raise ValueError(f"out={config.out!r} holds no finished sequence of this study")
+    return table, write_study_report(table, config.report, planned=planned)
