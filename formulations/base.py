@@ -63,6 +63,7 @@ class SolverDiagnostics:
     safeguard: str = ""  # what answered instead of the plain iteration ("" if nothing did)
     condition_estimate: float = float("nan")  # of the last linear system, solver's scaling
     condensed: np.ndarray | None = None  # B K^-1 B' when the solver formed it (cholmod)
+    phases: tuple[tuple[str, float], ...] = ()  # (phase, seconds) of the solve, in order
 
 
 @dataclass(frozen=True, eq=False)

@@ -63,10 +63,13 @@ def study_command(args) -> int:
                                  command=" ".join(["python -m bench", *args.argv]))
     if args.report_only:
         try:
-            table, report = report_study(config)
+            table, report, verdicts = report_study(config)
         except ValueError as error:
             raise InputError(str(error)) from None
     else:
-        table, report = run_study(config)
-    print(f"{len(table)} levels; wrote {report}")
-    return 0
+        table, report, verdicts = run_study(config)
+    failed = [v for v in verdicts if not v.passed]
+    print(f"{len(table)} levels; wrote {report}"
+          + (f"; {len(verdicts) - len(failed)} of {len(verdicts)} study gates pass"
+             if verdicts else ""))
+    return 1 if failed else 0

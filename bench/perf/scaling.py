@@ -72,6 +72,7 @@ def measure(size: str, backend: str | None = None, reference: bool = True,
     fast = solve(disc, "active-set", backend=backend)
     row.update(t_fast_solve=fast.solve_time, fast_iterations=fast.iterations,
                fast_status=fast.status, fast_max_residual=max(vars(fast.residuals).values()))
+    row.update({phase_column(name): seconds for name, seconds in fast.diagnostics.phases})
     start = time.perf_counter()
     get_estimator("residual")(scene, fast)
     row["t_estimate"] = time.perf_counter() - start
@@ -89,6 +90,22 @@ def measure(size: str, backend: str | None = None, reference: bool = True,
                    max_lambda_difference=pressure)
     row["peak_gib"] = _peak_gib()
     return row
+
+
+def phase_column(phase: str) -> str:
+    """The scaling column of a phase of the fast solve ("schur block" -> t_fast_schur_block)."""
+    return "t_fast_" + phase.replace(" ", "_").replace("-", "_")
+
+
+def phase_table(frame: pd.DataFrame) -> str:
+    """Where the fast contact solve's time goes (cholmod's condensed route), per size."""
+    columns = [c for c in frame.columns if c.startswith("t_fast_") and c != "t_fast_solve"]
+    if not columns:
+        return ""
+    table = frame[["order", "ndofs", "t_linear_solve", "t_fast_solve", *columns]].copy()
+    table.columns = ["order", "N (DOFs)", "linear solve [s]", "fast solve [s]",
+                     *[c.removeprefix("t_fast_").replace("_", " ") + " [s]" for c in columns]]
+    return table.to_markdown(index=False, floatfmt=".2f")
 
 
 def _measure_star(args):
@@ -160,7 +177,9 @@ def write_scaling(frame: pd.DataFrame, out: str | Path, readme: str | Path | Non
     out.mkdir(parents=True, exist_ok=True)
     frame.to_csv(out / "scaling.csv", index=False)
     text = markdown_table(frame)
-    (out / "scaling.md").write_text(text + "\n")
+    phases = phase_table(frame)
+    (out / "scaling.md").write_text(text + "\n" + (
+        f"\nPhases of the fast contact solve:\n\n{phases}\n" if phases else ""))
     if readme is not None:
         readme = Path(readme)
         content = readme.read_text()

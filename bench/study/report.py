@@ -20,6 +20,7 @@ from bench.study.analysis import (
     nearly_half_range,
     predictions,
 )
+from bench.verify.gates import check_gates, verdict_table
 from formulations import STATUS_OK
 
 MARKERS = {"uniform": "s", "adaptive": "o"}
@@ -106,14 +107,17 @@ def _markdown(frame: pd.DataFrame) -> str:
 
 
 def write_study_report(table: pd.DataFrame, out: str | Path, wall_seconds: float | None = None,
-                       planned: int | None = None) -> Path:
-    """README.md, tables as CSV and figures for the study's rows ``table``."""
+                       planned: int | None = None, gates: list[dict] | None = None,
+                       ) -> tuple[Path, list]:
+    """README.md, tables as CSV and figures for the study's rows ``table``; with ``gates``
+    (the ``[[study_gate]]`` entries of expected.toml) also their verdicts, returned too."""
     out = Path(out)
     (out / "figures").mkdir(parents=True, exist_ok=True)
     slopes, asymptotic = local_slopes(table), asymptotic_table(table)
     scenes = sorted(table["scene"].unique())
     predicted = predictions(scenes, sorted(table["order"].unique()))
     nearly = nearly_half_range(slopes)
+    verdicts = check_gates({"gate": gates}, [asymptotic]) if gates else []
     for name, frame in (("local-slopes", slopes), ("asymptotic", asymptotic),
                         ("predictions", predicted), ("nearly-half", nearly)):
         frame.to_csv(out / f"{name}.csv", index=False)
@@ -129,8 +133,11 @@ def write_study_report(table: pd.DataFrame, out: str | Path, wall_seconds: float
             figure.savefig(path, dpi=110, bbox_inches="tight")
             figures.append(path.name)
     text = _report_text(table, asymptotic, predicted, nearly, figures, wall_seconds, planned)
+    if verdicts:
+        text += ("\n## Gates\n\nThe `[[study_gate]]` entries of bench/verify/expected.toml.\n\n"
+                 + verdict_table(verdicts) + "\n")
     (out / "README.md").write_text(text)
-    return out / "README.md"
+    return out / "README.md", verdicts
 
 
 def _report_text(table, asymptotic, predicted, nearly, figures, wall_seconds, planned) -> str:

@@ -14,6 +14,7 @@ from bench.matrix import RunConfig, run
 from bench.matrix.store import ResultStore
 from bench.sequence.rows import FINISHED
 from bench.study.report import write_study_report
+from bench.verify import load_expected
 from estimators import estimator_names
 from formulations import formulation_names
 
@@ -57,9 +58,19 @@ QUICK = StudyConfig(scenes=("paper",), uniform_max_dofs=9000, adaptive_max_dofs=
                     workers=0)
 
 
-def run_study(config: StudyConfig, on_level=None) -> tuple[pd.DataFrame, object]:
-    """Run (or reuse) every sequence of the study, then write its report; returns the rows
-    and the report's path."""
+def study_gates(config: StudyConfig) -> list[dict] | None:
+    """The ``[[study_gate]]`` entries for the full study's budgets, None for a reduced one
+    (its slopes are pre-asymptotic)."""
+    full = StudyConfig()
+    if (config.uniform_max_dofs, config.adaptive_max_dofs) < (full.uniform_max_dofs,
+                                                               full.adaptive_max_dofs):
+        return None
+    return load_expected().get("study_gate", [])
+
+
+def run_study(config: StudyConfig, on_level=None) -> tuple[pd.DataFrame, object, list]:
+    """Run (or reuse) every sequence of the study, then write its report; returns the rows,
+    the report's path and the verdicts of the study's gates."""
     start = time.perf_counter()
     tables = []
     for run_config in config.run_configs():
@@ -67,8 +78,10 @@ def run_study(config: StudyConfig, on_level=None) -> tuple[pd.DataFrame, object]
             run_config = replace(run_config, workers=0)
         tables.append(run(run_config, on_level=on_level).table)
     table = pd.concat(tables, ignore_index=True)
-    return table, write_study_report(table, config.report, time.perf_counter() - start,
-                                     planned=table.groupby("sequence_key").ngroups)
+    report, verdicts = write_study_report(
+        table, config.report, time.perf_counter() - start,
+        planned=table.groupby("sequence_key").ngroups, gates=study_gates(config))
+    return table, report, verdicts
 
 
 def finished_table(config: StudyConfig) -> tuple[pd.DataFrame, int]:
@@ -80,9 +93,11 @@ def finished_table(config: StudyConfig) -> tuple[pd.DataFrame, int]:
     return table[done].reset_index(drop=True), len(keys)
 
 
-def report_study(config: StudyConfig):
+def report_study(config: StudyConfig) -> tuple[pd.DataFrame, object, list]:
     """The report of what is finished, without running anything."""
     table, planned = finished_table(config)
     if table.empty:
         raise ValueError(f"out={config.out!r} holds no finished sequence of this study")
-    return table, write_study_report(table, config.report, planned=planned)
+    report, verdicts = write_study_report(table, config.report, planned=planned,
+                                          gates=study_gates(config))
+    return table, report, verdicts

@@ -81,9 +81,12 @@ def solve_active_set(qp: ContactQP, warm_start: np.ndarray | None = None,
                           iterations=iterations, solve_time=time.perf_counter() - start,
                           solver="active-set", backend="splu", diagnostics=diagnostics)
     factor = factorise_condensed(qp.K, np.unique(qp.B.indices), backend)
+    clock = time.perf_counter()
     u0 = factor.solve(qp.F)
     S = factor.condensed(qp.B)
     r = qp.B @ u0 - qp.G
+    phases = [*factor.phases, ("condense", time.perf_counter() - clock)]
+    clock = time.perf_counter()
     active = (np.asarray(warm_start) > 0) if warm_start is not None else (r > 0)
     result = pdas(S, r, active, max_iter)
     diagnostics = SolverDiagnostics(active_set_changes=tuple(result.changes),
@@ -99,11 +102,17 @@ def solve_active_set(qp: ContactQP, warm_start: np.ndarray | None = None,
         if result.status != STATUS_OK:
             return _fallback(qp, f"{reason}, then {result.reason}", diagnostics, start)
         reason += "; answered by least-index pivoting (safeguard)"
+    phases.append(("iterate", time.perf_counter() - clock))
+    clock = time.perf_counter()
     scaled = S / np.outer(qp.row_scale, qp.row_scale)  # the solver's units, as for splu
-    # S = B K^-1 B' is kept: formulations.diagnostics reuses it for the inf-sup constant
-    diagnostics = replace(diagnostics, condition_estimate=condition_1(scaled, result.active),
-                          condensed=S)
+    condition = condition_1(scaled, result.active)
+    phases.append(("condition", time.perf_counter() - clock))
+    clock = time.perf_counter()
     u = factor.solve(qp.F - qp.B.T @ result.lam)
+    phases.append(("back-substitute", time.perf_counter() - clock))
+    # S = B K^-1 B' is kept: formulations.diagnostics reuses it for the inf-sup constant
+    diagnostics = replace(diagnostics, condition_estimate=condition, condensed=S,
+                          phases=tuple(phases))
     return QPSolution(u=u, multipliers=result.lam, status=STATUS_OK, reason=reason,
                       iterations=iterations, solve_time=time.perf_counter() - start,
                       solver="active-set", backend=factor.backend, diagnostics=diagnostics)

@@ -22,6 +22,7 @@ size, so it is the default whenever it imports; ``splu`` is the pure-scipy fallb
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -69,6 +70,7 @@ class CondensedFactor:
     contact: np.ndarray
     solve: Callable[[np.ndarray], np.ndarray]
     schur_cholesky: np.ndarray
+    phases: tuple[tuple[str, float], ...] = ()  # (phase, seconds) of the factorisation
 
     def condensed(self, B: sparse.spmatrix) -> np.ndarray:
         """B K^-1 B' for a B whose columns vanish outside ``contact`` (dense, m x m)."""
@@ -102,16 +104,23 @@ def factorise_condensed(K: sparse.spmatrix, contact: np.ndarray,
 
 def _cholmod_condensed(K, interior, contact) -> CondensedFactor:
     n, nc = K.shape[0], contact.size
+    clock = time.perf_counter()
     order = cholmod.analyze(K[interior][:, interior], ordering_method="amd").P()
     perm = np.concatenate([interior[order], contact])
-    factor = cholmod.cholesky(K[perm][:, perm].tocsc(), ordering_method="natural")
+    permuted = K[perm][:, perm].tocsc()
+    phases = [("order", time.perf_counter() - clock)]
+    clock = time.perf_counter()
+    factor = cholmod.cholesky(permuted, ordering_method="natural")
+    phases.append(("factorise", time.perf_counter() - clock))
     if not np.array_equal(factor.P(), np.arange(n)):  # the trailing block must stay C
         raise RuntimeError("CHOLMOD reordered a factorisation asked for in natural order")
+    clock = time.perf_counter()
     L_CC = factor.L()[n - nc:, n - nc:].toarray()
+    phases.append(("schur block", time.perf_counter() - clock))
     inverse = np.empty(n, dtype=np.int64)
     inverse[perm] = np.arange(n)
 
     def solve(b):
         return factor(np.asarray(b)[perm])[inverse]
 
-    return CondensedFactor("cholmod", contact, solve, np.tril(L_CC))
+    return CondensedFactor("cholmod", contact, solve, np.tril(L_CC), tuple(phases))

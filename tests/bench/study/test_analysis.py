@@ -58,12 +58,13 @@ def test_nearly_half_range_finds_where_the_local_slope_is_minus_a_quarter():
 
 def test_the_reduced_study_reports_every_sequence(tmp_path):
     config = dataclasses.replace(QUICK, out=str(tmp_path / "s"), report=str(tmp_path / "r"))
-    table, report = run_study(config)
+    table, report, verdicts = run_study(config)
+    assert verdicts == []  # the study's gates judge the full budgets only
     text = report.read_text()
     assert "## Predictions" in text and "0.7461" in text  # the paper scene's corner exponent
     assert not table["reference_too_coarse"].astype(bool).any()
     asymptotic = pd.read_csv(tmp_path / "r" / "asymptotic.csv")
     assert len(asymptotic) == table.groupby(["formulation", "estimator", "strategy"]).ngroups
     assert (tmp_path / "r" / "figures" / "paper-slopes.png").exists()
-    again, _ = run_study(config)  # resumable: every sequence reused, the same rows
+    again, _, _ = run_study(config)  # resumable: every sequence reused, the same rows
     assert len(again) == len(table)
