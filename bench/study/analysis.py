@@ -90,12 +90,35 @@ def asymptotic_table(table: pd.DataFrame, levels: int = FIT_LEVELS) -> pd.DataFr
                 group["ndofs"], group[column], levels)
         expected = predicted.loc[(row["scene"], row["order"])]
         row["predicted"] = float(expected[f"predicted_{row['strategy']}"])
+        if row["strategy"] == "uniform":
+            row["singular_share"], row["crossover_ndofs"], _ = two_term_fit(
+                group["ndofs"], group["energy_error"], float(expected["exponent"]),
+                int(row["order"]))
         effectivity = group.loc[group["ndofs"] >= EFFECTIVITY_FROM, "effectivity_index"]
         row.update(effectivity_min=float(effectivity.min()),
                    effectivity_max=float(effectivity.max()),
                    too_coarse_rows=int(group["reference_too_coarse"].astype(bool).sum()))
         rows.append(row)
     return pd.DataFrame(rows)
+
+
+def two_term_fit(ndofs, errors, exponent: float, order: int = 1,
+                 levels: int = FIT_LEVELS) -> tuple[float, float, float]:
+    """Fit e^2 = A N^-p + B N^-lambda (the smooth part and the singular part of the squared
+    error under uniform refinement, lambda < p) to the last ``levels`` errors by linear least
+    squares. Returns the singular part's share B N^-lambda / e^2 at the last level, the N at
+    which both parts are equal, (A / B)^(1 / (p - lambda)), and the local slope the model
+    predicts there. NaN when the fit has no positive B or too few levels."""
+    n, e = np.asarray(ndofs, float)[-levels:], np.asarray(errors, float)[-levels:]
+    if n.size < 3 or not exponent < order:
+        return float("nan"), float("nan"), float("nan")
+    basis = np.column_stack([n ** -float(order), n ** -exponent]) / e[:, None] ** 2
+    (A, B), *_ = np.linalg.lstsq(basis, np.ones(n.size), rcond=None)  # relative residuals
+    if not (A > 0 and B > 0):
+        return float("nan"), float("nan"), float("nan")
+    share = B * n[-1] ** -exponent / (A * n[-1] ** -float(order) + B * n[-1] ** -exponent)
+    crossover = (A / B) ** (1.0 / (order - exponent))
+    return float(share), float(crossover), float(-(order + exponent) / 4.0)
 
 
 def nearly_half_range(slopes: pd.DataFrame, target: float = -0.25) -> pd.DataFrame:

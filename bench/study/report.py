@@ -102,6 +102,22 @@ def effectivity_figure(table: pd.DataFrame, scene: str) -> Figure:
     return figure
 
 
+def _claim_lines(asymptotic: pd.DataFrame) -> list[str]:
+    """One line per scene and strategy: the range of the fitted error and eta slopes."""
+    lines = []
+    for (scene, strategy), rows in asymptotic.groupby(["scene", "strategy"], sort=True):
+        line = (f"- {scene}, {strategy}: error slope {rows['error_slope'].min():.3f} .. "
+                f"{rows['error_slope'].max():.3f}, eta slope {rows['eta_slope'].min():.3f} .. "
+                f"{rows['eta_slope'].max():.3f} to {rows['ndofs_last'].max()} DOFs "
+                f"(predicted asymptotically: {rows['predicted'].iloc[0]:.3f})")
+        if strategy == "uniform" and rows["crossover_ndofs"].notna().any():
+            line += (f"; singular share of e^2 at the last level "
+                     f"{rows['singular_share'].min():.2f} .. {rows['singular_share'].max():.2f}"
+                     f", equal shares near N = {rows['crossover_ndofs'].median():.2g}")
+        lines.append(line)
+    return lines
+
+
 def _markdown(frame: pd.DataFrame) -> str:
     return frame.to_markdown(index=False, floatfmt=".4g") if len(frame) else "(no rows)"
 
@@ -143,7 +159,8 @@ def write_study_report(table: pd.DataFrame, out: str | Path, wall_seconds: float
 def _report_text(table, asymptotic, predicted, nearly, figures, wall_seconds, planned) -> str:
     columns = SHOWN + ["levels", "ndofs_last", "error_slope", "error_slope_se", "eta_slope",
                       "eta_slope_se", "pressure_slope", "pressure_slope_se", "predicted",
-                      "effectivity_min", "effectivity_max", "too_coarse_rows"]
+                      "singular_share", "crossover_ndofs", "effectivity_min", "effectivity_max",
+                      "too_coarse_rows"]
     lines = ["# Rate study", "",
              f"{len(table)} levels of {table.groupby(KEYS).ngroups} sequences"
              + (f" (of {planned} planned)" if planned else "") + "; "
@@ -156,7 +173,10 @@ def _report_text(table, asymptotic, predicted, nearly, figures, wall_seconds, pl
              "uniform -min(lambda, p)/2, adaptive -p/2.", "", _markdown(predicted), "",
              "## Asymptotic slopes", "",
              "Least-squares slopes over the last levels with their standard errors; "
-             f"effectivity over every level from {EFFECTIVITY_FROM} DOFs.", "",
+             f"effectivity over every level from {EFFECTIVITY_FROM} DOFs. For uniform "
+             "sequences, the two-term model e^2 = A N^-p + B N^-lambda fitted to the last "
+             "levels gives the singular part's share of e^2 at the last level and the N at "
+             "which it would equal the smooth part.", "", *_claim_lines(asymptotic), "",
              _markdown(asymptotic.reindex(columns=columns)), "",
              "## The seed paper's \"nearly O(h^1/2)\" under uniform refinement", "",
              f"Range of DOFs over which local error slopes are within {NEARLY} of -1/4, the "

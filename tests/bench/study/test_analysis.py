@@ -8,7 +8,7 @@ import pandas as pd
 import pytest
 
 from bench.study import QUICK, run_study
-from bench.study.analysis import fitted_slope, local_slopes, nearly_half_range
+from bench.study.analysis import fitted_slope, local_slopes, nearly_half_range, two_term_fit
 
 
 def synthetic(rates, strategy="uniform", n0=100.0, levels=6):
@@ -68,3 +68,16 @@ def test_the_reduced_study_reports_every_sequence(tmp_path):
     assert (tmp_path / "r" / "figures" / "paper-slopes.png").exists()
     again, _, _ = run_study(config)  # resumable: every sequence reused, the same rows
     assert len(again) == len(table)
+
+
+def test_two_term_fit_recovers_the_singular_share_and_crossover():
+    # e^2 = A/N + B N^-lambda exactly: the share at the last level and the N of equal parts
+    # are known in closed form
+    A, B, lam = 4.0, 0.02, 0.75
+    n = 100.0 * 4.0 ** np.arange(8)
+    errors = np.sqrt(A / n + B * n ** -lam)
+    share, crossover, slope_there = two_term_fit(n, errors, lam)
+    assert share == pytest.approx(B * n[-1] ** -lam / errors[-1] ** 2, rel=1e-8)
+    assert crossover == pytest.approx((A / B) ** (1 / (1 - lam)), rel=1e-8)
+    assert slope_there == pytest.approx(-(1 + lam) / 4)
+    assert np.isnan(two_term_fit(n, n ** -0.5, 1.2)[0])  # lambda >= p: no singular part
