@@ -167,7 +167,8 @@ def run(config: RunConfig, on_level: Callable[[LevelResult], None] | None = None
     todo = [s for s in specs if s.key not in finished]
     reused = tuple(s.key for s in specs if s.key in finished)
     identity = new_run_identity()
-    truths = prepare_truths(todo, store.out, config.reference_crosscheck)
+    # every spec, reused ones too: truth.json then describes the whole table
+    truths = prepare_truths(specs, store.out, config.reference_crosscheck)
     (store.out / "run.json").write_text(json.dumps(
         {"command": config.command, "configuration": config.record(),
          "run_id": identity["run_id"], "reused": list(reused)}, indent=1, default=str))

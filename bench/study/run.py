@@ -27,6 +27,7 @@ class StudyConfig:
     adaptive_max_dofs: int = 1_000_000
     reference_dofs: int = 200_000
     workers: int = 2  # adaptive sequences in parallel; uniform ones run one at a time
+    crosscheck: bool = True  # build the P2 references too; truth.json records the agreement
     out: str = "study"
     report: str = "reports/study"
     command: str = "python -m bench study"
@@ -41,7 +42,8 @@ class StudyConfig:
         process (a 2.1e6-DOF level needs about 11 GiB, half of a 24 GiB machine)."""
         common = dict(scenes=self.scenes, solvers=("active-set",),
                       estimators=tuple(estimator_names()), orders=self.orders,
-                      reference_dofs=self.reference_dofs, out=self.out, command=self.command)
+                      reference_dofs=self.reference_dofs, reference_crosscheck=self.crosscheck,
+                      out=self.out, command=self.command)
         caps = dict(self.adaptive_caps)
         budgets = {f: min(caps.get(f, self.adaptive_max_dofs), self.adaptive_max_dofs)
                    for f in formulation_names()}
@@ -55,7 +57,7 @@ class StudyConfig:
 
 # the default tests' version: the paper scene to a few thousand DOFs
 QUICK = StudyConfig(scenes=("paper",), uniform_max_dofs=9000, adaptive_max_dofs=5000,
-                    workers=0)
+                    workers=0, crosscheck=False)
 
 
 def study_gates(config: StudyConfig) -> list[dict] | None:
