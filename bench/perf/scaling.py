@@ -103,6 +103,7 @@ def phase_table(frame: pd.DataFrame) -> str:
     if not columns:
         return ""
     table = frame[["order", "ndofs", "t_linear_solve", "t_fast_solve", *columns]].copy()
+    table[["order", "ndofs"]] = table[["order", "ndofs"]].astype(int).astype(str)
     table.columns = ["order", "N (DOFs)", "linear solve [s]", "fast solve [s]",
                      *[c.removeprefix("t_fast_").replace("_", " ") + " [s]" for c in columns]]
     return table.to_markdown(index=False, floatfmt=".2f")
