@@ -10,7 +10,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from bench.report.figures import colour, line_style
-from bench.sequence.rows import KEYS
+from bench.sequence.rows import KEYS, phase_time
 from bench.study.analysis import (
     EFFECTIVITY_FROM,
     NEARLY,
@@ -165,8 +165,10 @@ def _report_text(table, asymptotic, predicted, nearly, figures, wall_seconds, pl
              f"{len(table)} levels of {table.groupby(KEYS).ngroups} sequences"
              + (f" (of {planned} planned)" if planned else "") + "; "
              f"{int(table['reference_too_coarse'].astype(bool).sum())} rows flagged "
-             "`reference_too_coarse`."
-             + (f" Wall time {wall_seconds / 60:.1f} min." if wall_seconds else ""), "",
+             "`reference_too_coarse`. The levels' own phase times add up to "
+             f"{phase_time(table).sum() / 60:.1f} min"
+             + (f"; this invocation took {wall_seconds / 60:.1f} min (finished sequences of "
+                "earlier runs are reused, not recomputed)." if wall_seconds else "."), "",
              "## Predictions", "",
              "Smallest singular exponent lambda of each scene (u ~ r^lambda; corners from "
              "their eigenvalue equation, contact-zone ends 3/2) and the slopes it predicts: "
