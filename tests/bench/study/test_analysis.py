@@ -7,7 +7,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from bench.study import QUICK, run_study
+from bench.study import QUICK, StudyConfig, run_study
 from bench.study.analysis import fitted_slope, local_slopes, nearly_half_range, two_term_fit
 
 
@@ -81,3 +81,13 @@ def test_two_term_fit_recovers_the_singular_share_and_crossover():
     assert crossover == pytest.approx((A / B) ** (1 / (1 - lam)), rel=1e-8)
     assert slope_there == pytest.approx(-(1 + lam) / 4)
     assert np.isnan(two_term_fit(n, n ** -0.5, 1.2)[0])  # lambda >= p: no singular part
+
+
+@pytest.mark.slow
+def test_the_full_study_passes_its_gates(tmp_path):
+    # about an hour on 2 cores (README, "The rate study"); every [[study_gate]] must pass
+    config = dataclasses.replace(StudyConfig(), out=str(tmp_path / "s"),
+                                 report=str(tmp_path / "r"))
+    _, _, verdicts = run_study(config)
+    failed = [f"{v.gate} {v.combination}: {v.value:.4g}" for v in verdicts if not v.passed]
+    assert verdicts and not failed, "; ".join(failed)
