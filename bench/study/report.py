@@ -32,16 +32,32 @@ def _sequences(table: pd.DataFrame, scene: str):
         yield key, group.sort_values("ndofs")
 
 
+def _draw(axes, key, x, y) -> None:
+    """One sequence's line: colour by formulation, style by estimator, marker by strategy."""
+    formulation, estimator, strategy, order = key
+    axes.plot(x, y, color=colour(formulation), linestyle=line_style(estimator),
+              marker=MARKERS.get(strategy, "x"), markersize=3,
+              label=f"{formulation}/{estimator}/{strategy}/P{order}")
+
+
+def _finish(axes, xlabel: str, ylabel: str, title: str) -> None:
+    axes.set_xlabel(xlabel)
+    axes.set_ylabel(ylabel)
+    axes.set_title(title)
+    axes.legend(fontsize=5, ncol=2)
+    axes.grid(True, which="both", alpha=0.3)
+
+
 def convergence_figure(table: pd.DataFrame, scene: str, column: str, label: str,
                        predicted: pd.DataFrame) -> Figure:
     """``column`` against N for every sequence of ``scene``, with the predicted slopes drawn
     through the finest uniform and adaptive points."""
     figure = Figure(figsize=(7, 5))
     axes = figure.add_subplot()
-    for (formulation, estimator, strategy, order), group in _sequences(table, scene):
-        axes.loglog(group["ndofs"], group[column], color=colour(formulation),
-                    linestyle=line_style(estimator), marker=MARKERS.get(strategy, "x"),
-                    markersize=3, label=f"{formulation}/{estimator}/{strategy}/P{order}")
+    axes.set_xscale("log")
+    axes.set_yscale("log")
+    for key, group in _sequences(table, scene):
+        _draw(axes, key, group["ndofs"], group[column])
     for strategy in ("uniform", "adaptive"):
         rows = table[(table["scene"] == scene) & (table["strategy"] == strategy)
                      & (table[column] > 0)]
@@ -53,11 +69,7 @@ def convergence_figure(table: pd.DataFrame, scene: str, column: str, label: str,
         axes.loglog(n, last[column] * 1.5 * (n / n[-1]) ** slope, color="k",
                     linestyle="-" if strategy == "uniform" else "--", linewidth=2,
                     label=f"predicted {strategy}: N^{slope:.3f}")
-    axes.set_xlabel("DOFs N")
-    axes.set_ylabel(label)
-    axes.set_title(f"{scene}: {label}")
-    axes.legend(fontsize=5, ncol=2)
-    axes.grid(True, which="both", alpha=0.3)
+    _finish(axes, "DOFs N", label, f"{scene}: {label}")
     return figure
 
 
@@ -65,23 +77,17 @@ def local_slope_figure(slopes: pd.DataFrame, scene: str, predicted: pd.DataFrame
     """The local error slope between consecutive levels against N, with the predictions."""
     figure = Figure(figsize=(7, 4))
     axes = figure.add_subplot()
+    axes.set_xscale("log")
     mine = slopes[slopes["scene"] == scene]
     for key, group in mine.groupby(["formulation", "estimator", "strategy", "order"]):
-        formulation, estimator, strategy, order = key
-        middle = np.sqrt(group["ndofs_from"] * group["ndofs_to"])
-        axes.semilogx(middle, group["error_slope"], color=colour(formulation),
-                      linestyle=line_style(estimator), marker=MARKERS.get(strategy, "x"),
-                      markersize=3, label=f"{formulation}/{estimator}/{strategy}/P{order}")
+        _draw(axes, key, np.sqrt(group["ndofs_from"] * group["ndofs_to"]), group["error_slope"])
     for strategy, style in (("uniform", "-"), ("adaptive", "--")):
         axes.axhline(float(predicted[f"predicted_{strategy}"].iloc[0]), color="k",
                      linestyle=style, linewidth=1.5, label=f"predicted {strategy}")
     axes.axhline(-0.25, color="grey", linestyle=":", label="paper: nearly O(h^1/2)")
     axes.set_ylim(-1.2, 0.2)
-    axes.set_xlabel("DOFs N (geometric mean of the two levels)")
-    axes.set_ylabel("local slope of the error")
-    axes.set_title(f"{scene}: local error slopes")
-    axes.legend(fontsize=5, ncol=2)
-    axes.grid(True, which="both", alpha=0.3)
+    _finish(axes, "DOFs N (geometric mean of the two levels)", "local slope of the error",
+            f"{scene}: local error slopes")
     return figure
 
 
@@ -89,16 +95,12 @@ def effectivity_figure(table: pd.DataFrame, scene: str) -> Figure:
     """eta / ||u - u_h|| on every level of every sequence of ``scene``."""
     figure = Figure(figsize=(7, 4))
     axes = figure.add_subplot()
-    for (formulation, estimator, strategy, order), group in _sequences(table, scene):
-        axes.semilogx(group["ndofs"], group["effectivity_index"], color=colour(formulation),
-                      linestyle=line_style(estimator), marker=MARKERS.get(strategy, "x"),
-                      markersize=3, label=f"{formulation}/{estimator}/{strategy}/P{order}")
+    axes.set_xscale("log")
     axes.set_yscale("log")
-    axes.set_xlabel("DOFs N")
-    axes.set_ylabel("effectivity eta / ||u - u_h||")
-    axes.set_title(f"{scene}: effectivity on every level")
-    axes.legend(fontsize=5, ncol=2)
-    axes.grid(True, which="both", alpha=0.3)
+    for key, group in _sequences(table, scene):
+        _draw(axes, key, group["ndofs"], group["effectivity_index"])
+    _finish(axes, "DOFs N", "effectivity eta / ||u - u_h||",
+            f"{scene}: effectivity on every level")
     return figure
 
 
