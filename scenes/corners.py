@@ -100,10 +100,15 @@ def _stress(lam: float, coefficient: np.ndarray, theta: np.ndarray) -> float:
     return float(max(np.abs(traction).max(), np.abs(2 * (dphi + np.conj(dphi))).max()))
 
 
+def _wedge_matrix(lam: float, angle: float, sides, kappa: float) -> np.ndarray:
+    """The 4 x 4 matrix of both sides' conditions (module docstring)."""
+    return np.vstack([_side_rows(lam, 0.0, sides[0], kappa),
+                      _side_rows(lam, angle, sides[1], kappa)])
+
+
 def smallest_singular_value(lam: float, angle: float, sides, kappa: float) -> float:
     """sigma_min of the wedge's 4 x 4 matrix with unit columns: zero at an exponent."""
-    matrix = np.vstack([_side_rows(lam, 0.0, sides[0], kappa),
-                        _side_rows(lam, angle, sides[1], kappa)])
+    matrix = _wedge_matrix(lam, angle, sides, kappa)
     norms = np.linalg.norm(matrix, axis=0)
     matrix = matrix / np.where(norms > 0, norms, 1.0)  # a zero column: a stress-free field
     return float(np.linalg.svd(matrix, compute_uv=False)[-1])
@@ -127,9 +132,7 @@ def corner_exponents(corner: Corner, kappa: float, upper: float = 3.0) -> list[f
 
 
 def _rigid(lam: float, corner: Corner, kappa: float) -> bool:
-    matrix = np.vstack([_side_rows(lam, 0.0, corner.sides[0], kappa),
-                        _side_rows(lam, corner.angle, corner.sides[1], kappa)])
-    null = np.linalg.svd(matrix)[2][-1]
+    null = np.linalg.svd(_wedge_matrix(lam, corner.angle, corner.sides, kappa))[2][-1]
     return _stress(lam, null, np.linspace(0.0, corner.angle, 33)) < 1e-8
 
 

@@ -132,15 +132,14 @@ class GradientField:
     coefficients: np.ndarray  # (2, 2, n_monomials, nE)
 
     @classmethod
-    def from_solution(cls, basis: Basis, u: np.ndarray, locator: Locator | None = None,
-                      ) -> GradientField:
+    def from_solution(cls, basis: Basis, u: np.ndarray) -> GradientField:
         """The field of the DOF vector ``u`` of a vector P_p ``basis``."""
         degree = basis.elem.maxdeg - 1
         nodes = _lattice(degree)
         values = gradients_at_reference(basis, u, nodes)  # (2, 2, nE, n_nodes)
         solve = np.linalg.inv(_powers(nodes, degree).T)  # Vandermonde: coefficients <- values
         coefficients = np.einsum("mk,ijek->ijme", solve, values)
-        return cls(locator or Locator.from_mesh(basis.mesh), degree, coefficients)
+        return cls(Locator.from_mesh(basis.mesh), degree, coefficients)
 
     @classmethod
     def from_dofs(cls, mesh: MeshTri, order: int, u: np.ndarray) -> GradientField:

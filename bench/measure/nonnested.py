@@ -32,12 +32,11 @@ def _children(corners: np.ndarray) -> np.ndarray:
     return np.concatenate([np.stack(kid, axis=1) for kid in kids], axis=2)
 
 
-def _cell_energy(first: GradientField, second: GradientField, lame, corners, parent, located,
-                 rule) -> float:
+def _cell_energy(first: GradientField, second: GradientField, lame, corners, area, parent,
+                 located, rule) -> float:
     """sum over cells of the rule applied to sigma(e) : eps(e), e = u_first - u_second."""
     X, W = rule
     a, b = corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]
-    area = 0.5 * np.abs(a[0] * b[1] - a[1] * b[0])
     total = 0.0
     for q in range(W.size):
         x = corners[:, 0] + a * X[0, q] + b * X[1, q]
@@ -64,8 +63,8 @@ def energy_difference(first: GradientField, second: GradientField, lame) -> floa
         keep = np.flatnonzero(~split)
         for start in range(0, keep.size, CHUNK):
             block = keep[start:start + CHUNK]
-            total += _cell_energy(first, second, lame, corners[:, :, block], parent[block],
-                                  located[block], rule)
+            total += _cell_energy(first, second, lame, corners[:, :, block], area[block],
+                                  parent[block], located[block], rule)
         if not split.any():
             break
         corners, parent = _children(corners[:, :, split]), np.tile(parent[split], 4)

@@ -121,8 +121,8 @@ class TruthError(ValueError):
 
 
 def reference_levels(scene, max_dofs: int, recipe: Recipe):
-    """The recipe's adaptive sequence: yields (ndofs, solution, field, difference to the level
-    before or None); TruthError if a level fails."""
+    """The recipe's adaptive sequence: yields (ndofs, solution, energy-norm difference to the
+    level before or None); TruthError if a level fails."""
     config = LoopConfig(strategy="adaptive", order=recipe.order,
                         max_dofs=int(max_dofs * recipe.budget_factor),
                         marking=recipe.marking, theta=recipe.theta, diagnostics=False)
@@ -138,13 +138,13 @@ def reference_levels(scene, max_dofs: int, recipe: Recipe):
         difference = (None if previous is None
                        else energy_difference(field, previous, sol.elasticity.lame))
         previous = field
-        yield result.row.ndofs, sol, field, difference
+        yield result.row.ndofs, sol, difference
 
 
 def build_reference(scene, max_dofs: int, recipe: str = PRIMARY) -> Reference:
     start = time.perf_counter()
     ndofs, differences, sol = [], [], None
-    for n, level_solution, _field, difference in reference_levels(scene, max_dofs, RECIPES[recipe]):
+    for n, level_solution, difference in reference_levels(scene, max_dofs, RECIPES[recipe]):
         ndofs.append(n)
         sol = level_solution
         if difference is not None:
