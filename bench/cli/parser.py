@@ -179,7 +179,7 @@ def _run_parser(sub) -> None:
                           "cached adaptive P3 reference (mixed method) with at most this many "
                           "DOFs (default: only scenes with an exact solution get errors)")
     run.add_argument("--reference-crosscheck", action="store_true",
-                     help="also build the P2 reference of the same budget and record its "
+                     help="also build the P2 reference (twice the budget) and record its "
                           "agreement with the P3 one in truth.json (default: off)")
     _memory_option(run)
     _scale_out_options(run)

@@ -6,7 +6,7 @@ ordinary result store, and a rerun reuses every finished sequence."""
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import pandas as pd
 
@@ -61,13 +61,15 @@ QUICK = StudyConfig(scenes=("paper",), uniform_max_dofs=9000, adaptive_max_dofs=
 
 
 def study_gates(config: StudyConfig) -> list[dict] | None:
-    """The ``[[study_gate]]`` entries for the full study's budgets, None for a reduced one
-    (its slopes are pre-asymptotic)."""
+    """The ``[[study_gate]]`` entries for the scenes and orders of a study with the full
+    budgets, None for a reduced one (its slopes are pre-asymptotic)."""
     full = StudyConfig()
-    if (config.uniform_max_dofs, config.adaptive_max_dofs) < (full.uniform_max_dofs,
-                                                               full.adaptive_max_dofs):
+    if (config.uniform_max_dofs < full.uniform_max_dofs
+            or config.adaptive_max_dofs < full.adaptive_max_dofs):
         return None
-    return load_expected().get("study_gate", [])
+    return [gate for gate in load_expected().get("study_gate", [])
+            if gate.get("scene", config.scenes[0]) in config.scenes
+            and gate.get("order", config.orders[0]) in config.orders]
 
 
 def run_study(config: StudyConfig, on_level=None) -> tuple[pd.DataFrame, object, list]:
@@ -76,8 +78,6 @@ def run_study(config: StudyConfig, on_level=None) -> tuple[pd.DataFrame, object,
     start = time.perf_counter()
     tables = []
     for run_config in config.run_configs():
-        if not run_config.workers:
-            run_config = replace(run_config, workers=0)
         tables.append(run(run_config, on_level=on_level).table)
     table = pd.concat(tables, ignore_index=True)
     report, verdicts = write_study_report(
