@@ -13,8 +13,8 @@ from the assembled arrays and the returned solution, never taken from a solver.
   is the smallest eigenvalue of the pencil (E B K^-1 B', M) with M the Gram matrix of the
   multiplier norm (``Discretisation.multiplier_gram``). Dimensionless; bounded below under
   refinement exactly when the pair is uniformly stable. B K^-1 B' is the active-set solver's
-  condensed system on its cholmod route (passed as ``condensed``); otherwise it costs one
-  factorisation of K and m solves.
+  condensed system on its condensed route (pardiso, cholmod; passed as ``condensed``);
+  otherwise it costs one factorisation of K and m solves.
 * ``pressure_oscillation``: TV(lambda_h) / (2 max lambda_h) along Gamma_C, with lambda_h taken
   as 0 beyond the ends of Gamma_C: 1 for any single-hump (or constant) pressure, larger for every
   extra wiggle; a checkerboard multiplier drives it up with the number of segments. 0 when

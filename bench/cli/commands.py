@@ -24,6 +24,7 @@ from bench.matrix import RunConfig, run
 from bench.matrix.run import RunRefused
 from bench.matrix.store import ResultsError, read_results
 from bench.perf.scaling import run_scaling, write_scaling
+from bench.perf.sequence import SEQUENCES, run_sequences, write_sequences
 from bench.report import write_report
 from bench.sequence.loop import LevelResult
 from bench.sequence.rows import KEYS, level_time
@@ -175,9 +176,22 @@ def scaling_command(args) -> int:
         check_backend(args.backend)
     except ValueError as error:
         raise InputError(f"--backend: {error}") from None
+    if args.sequence:
+        return sequence_command(args)
     frame = run_scaling(args.sizes, args.backend, args.reference_max_dofs, on_row=show,
                         orders=args.order)
     print(f"wrote {write_scaling(frame, args.out, args.readme)}")
+    return 0
+
+
+def sequence_command(args) -> int:
+    def show(row):
+        print(f"{row['strategy']} to {row['max_dofs']}: {row['levels']} levels, finest "
+              f"{row['final_ndofs']} DOFs, {row['t_sequence']:.1f} s = "
+              f"{row['sequence_over_linear']:.1f} linear solves at the finest level", flush=True)
+    budgets = zip([s for s, _ in SEQUENCES], args.sequence_max_dofs, strict=True)
+    frame = run_sequences(list(budgets), args.backend, on_row=show)
+    print(f"wrote {write_sequences(frame, args.out, args.readme)}")
     return 0
 
 

@@ -10,6 +10,7 @@ import sys
 from bench.hard import hard_case_names
 from bench.matrix.spec import parse_item
 from bench.perf.scaling import SIZES
+from bench.perf.sequence import SEQUENCES
 from bench.sequence.loop import STRATEGIES
 from bench.sequence.marking import MARKINGS
 from estimators import estimator_names
@@ -87,6 +88,17 @@ def _integer(name: str, minimum: int, allowed: str):
 
 def _positive_int(name: str):
     return _integer(name, 1, "a positive integer")
+
+
+def _sequence_budgets(text: str) -> list[int]:
+    """One positive DOF budget per sequence of ``SEQUENCES``, comma-separated."""
+    parse = _positive_int("sequence_max_dofs")
+    items = [item.strip() for item in text.split(",")]
+    if len(items) != len(SEQUENCES):
+        raise argparse.ArgumentTypeError(
+            f"sequence_max_dofs={text!r} is not {len(SEQUENCES)} comma-separated budgets "
+            f"(for {', '.join(s for s, _ in SEQUENCES)})")
+    return [parse(item) for item in items]
 
 
 def _non_negative_int(name: str):
@@ -169,8 +181,9 @@ def _run_parser(sub) -> None:
     run.add_argument("--theta", type=_theta, default=0.5,
                      help="marking parameter in (0, 1] (default: 0.5)")
     run.add_argument("--backend", choices=BACKENDS, default=None,
-                     help="sparse direct back-end of the active-set solver: cholmod (needs "
-                          "scikit-sparse) or splu (scipy) (default: cholmod when installed)")
+                     help="sparse direct back-end of the active-set solver: pardiso (MKL, "
+                          "installed with the package on x86_64), cholmod (needs scikit-sparse) "
+                          "or splu (scipy) (default: the first of these that is available)")
     run.add_argument("--cold-start", action="store_true",
                      help="solve every level from scratch instead of starting from the "
                           "previous level's contact zone (nested iteration, the default)")
@@ -212,7 +225,8 @@ def _scaling_parser(sub) -> None:
     scaling.add_argument("--sizes", type=_names("size", list(SIZES)), default=list(SIZES),
                          help=f"sizes, comma-separated: {', '.join(SIZES)} (default: all)")
     scaling.add_argument("--backend", choices=BACKENDS, default=None,
-                         help="sparse back-end (default: cholmod when installed)")
+                         help="sparse back-end (default: the first available of "
+                              + ", ".join(BACKENDS) + ")")
     scaling.add_argument("--order", type=_orders, default=[1],
                          help="polynomial order(s) of the displacements (default: 1)")
     scaling.add_argument("--reference-max-dofs", type=_positive_int("reference_max_dofs"),
@@ -222,6 +236,15 @@ def _scaling_parser(sub) -> None:
     scaling.add_argument("--readme", default=None,
                          help="also replace the table between the scaling markers of this "
                               "README (e.g. README.md)")
+    scaling.add_argument("--sequence", action="store_true",
+                         help="time whole sequences instead (an adaptive one and a uniform one, "
+                              "every level and phase) against one linear solve at the finest "
+                              "level; writes OUT/scaling-sequence.{md,csv}")
+    scaling.add_argument("--sequence-max-dofs", type=_sequence_budgets,
+                         default=[b for _, b in SEQUENCES],
+                         help="the DOF budgets of the adaptive and the uniform sequence, "
+                              "comma-separated (default: "
+                              + ",".join(str(b) for _, b in SEQUENCES) + ")")
 
 
 def _compare_parser(sub) -> None:

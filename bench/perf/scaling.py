@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from scipy import sparse
 
 # (initial_divisions, uniform refinements) of the paper scene for ~10^4, 10^5, 10^6 DOFs
 SIZES = {"1e4": (9, 3), "1e5": (14, 4), "1e6": (11, 6)}
@@ -60,6 +61,7 @@ def measure(size: str, backend: str | None = None, reference: bool = True,
     from formulations.solvers.backends import check_backend, factorise
 
     backend = check_backend(backend)
+    factorise(sparse.identity(2, format="csc"), backend)  # load the library before any clock
     scene, mesh = paper_problem(size, order)
     start = time.perf_counter()
     disc = get_formulation("mixed")(scene, mesh, order=order)
@@ -182,12 +184,16 @@ def write_scaling(frame: pd.DataFrame, out: str | Path, readme: str | Path | Non
     (out / "scaling.md").write_text(text + "\n" + (
         f"\nPhases of the fast contact solve:\n\n{phases}\n" if phases else ""))
     if readme is not None:
-        readme = Path(readme)
-        content = readme.read_text()
-        if README_START not in content or README_END not in content:
-            raise ValueError(f"readme={str(readme)!r} has no {README_START} ... {README_END} "
-                             "markers")
-        head, rest = content.split(README_START, 1)
-        tail = rest.split(README_END, 1)[1]
-        readme.write_text(f"{head}{README_START}\n{text}\n{README_END}{tail}")
+        replace_in_readme(readme, README_START, README_END, text)
     return out / "scaling.md"
+
+
+def replace_in_readme(readme: str | Path, start: str, end: str, text: str) -> None:
+    """Replace what lies between the markers ``start`` and ``end`` of ``readme`` by ``text``."""
+    readme = Path(readme)
+    content = readme.read_text()
+    if start not in content or end not in content:
+        raise ValueError(f"readme={str(readme)!r} has no {start} ... {end} markers")
+    head, rest = content.split(start, 1)
+    tail = rest.split(end, 1)[1]
+    readme.write_text(f"{head}{start}\n{text}\n{end}{tail}")

@@ -29,7 +29,8 @@ is judged by its own KKT residuals like any other.
 Diagnostics (``QPSolution.diagnostics``): the active-set changes of every iteration, the
 cycling flag, the safeguard, and ``condition_estimate``: the 1-norm condition number of the
 last system the iteration solved, in the solver's scaling (rows of B divided by row_scale):
-the active block of the condensed S (cholmod) or the saddle-point matrix (splu, estimated).
+the active block of the condensed S (pardiso, cholmod) or the saddle-point matrix (splu,
+estimated).
 """
 
 from __future__ import annotations
@@ -42,7 +43,7 @@ from scipy import sparse
 
 from formulations.base import STATUS_OK, ContactQP, QPSolution, SolverDiagnostics
 from formulations.solvers.augmented import initial_active_set, solve_augmented
-from formulations.solvers.backends import check_backend, factorise_condensed
+from formulations.solvers.backends import check_backend, condenses, factorise_condensed
 from formulations.solvers.lcp import CYCLING_EXAMPLE, condition_1, least_index_pivoting, pdas
 from formulations.solvers.reference import solve_reference
 from formulations.solvers.registry import register_solver
@@ -61,17 +62,17 @@ def _fallback(qp: ContactQP, why: str, diagnostics: SolverDiagnostics,
 
 
 @register_solver("active-set", "primal-dual active set (semismooth Newton): condensed "
-                               "B K^-1 B' from one factorisation (cholmod) or the augmented "
-                               "saddle-point system (splu); nested iteration")
+                               "B K^-1 B' from one factorisation (pardiso, cholmod) or the "
+                               "augmented saddle-point system (splu); nested iteration")
 def solve_active_set(qp: ContactQP, warm_start: np.ndarray | None = None,
                      max_iter: int = 100, backend: str | None = None) -> QPSolution:
-    """``backend``: 'cholmod' (condensed iteration) or 'splu' (augmented iteration, see
-    ``augmented``); default: the fastest available, see ``backends``."""
+    """``backend``: 'pardiso' or 'cholmod' (condensed iteration) or 'splu' (augmented
+    iteration, see ``augmented``); default: the fastest available, see ``backends``."""
     start = time.perf_counter()
     backend = check_backend(backend)
     if warm_start is not None and np.shape(warm_start) != (qp.m,):
         raise ValueError(f"warm_start has shape {np.shape(warm_start)}, not ({qp.m},)")
-    if backend == "splu":
+    if not condenses(backend):
         active = (np.asarray(warm_start) > 0) if warm_start is not None else \
             initial_active_set(qp)
         u, lam, iterations, status, reason, diagnostics = solve_augmented(qp, active, max_iter)
@@ -79,7 +80,7 @@ def solve_active_set(qp: ContactQP, warm_start: np.ndarray | None = None,
             return _fallback(qp, f"plain active set failed ({reason})", diagnostics, start)
         return QPSolution(u=u, multipliers=lam, status=status, reason=reason,
                           iterations=iterations, solve_time=time.perf_counter() - start,
-                          solver="active-set", backend="splu", diagnostics=diagnostics)
+                          solver="active-set", backend=backend, diagnostics=diagnostics)
     factor = factorise_condensed(qp.K, np.unique(qp.B.indices), backend)
     clock = time.perf_counter()
     u0 = factor.solve(qp.F)

@@ -16,10 +16,12 @@ def qp():
     return get_formulation("mixed")(scene, scene.mesh.refined(2)).qp
 
 
-@pytest.mark.skipif("cholmod" not in backends.available_backends(),
-                    reason="scikit-sparse not installed")
-def test_condensed_operator_and_solve_match_dense_linear_algebra(qp):
-    backend = "cholmod"
+CONDENSING = [b for b in backends.available_backends() if backends.condenses(b)]
+
+
+@pytest.mark.skipif(not CONDENSING, reason="no condensing back-end installed")
+@pytest.mark.parametrize("backend", CONDENSING)
+def test_condensed_operator_and_solve_match_dense_linear_algebra(qp, backend):
     factor = backends.factorise_condensed(qp.K, np.unique(qp.B.indices), backend)
     K, B = qp.K.toarray(), qp.B.toarray()
     S = B @ np.linalg.solve(K, B.T)
@@ -27,6 +29,15 @@ def test_condensed_operator_and_solve_match_dense_linear_algebra(qp):
     assert factor.condensed(qp.B) == pytest.approx(S, rel=1e-9, abs=1e-9 * np.abs(S).max())
     x = factor.solve(qp.F)
     assert x == pytest.approx(np.linalg.solve(K, qp.F), rel=1e-9, abs=1e-9 * np.abs(x).max())
+    X = factor.solve(np.column_stack([qp.F, 2 * qp.F]))  # several right-hand sides at once
+    assert X[:, 1] == pytest.approx(2 * x, rel=1e-12, abs=1e-12 * np.abs(x).max())
+
+
+@pytest.mark.parametrize("backend", CONDENSING)
+def test_a_matrix_that_is_not_positive_definite_is_refused(backend):
+    K = sparse.csc_matrix(np.array([[1.0, 2.0, 0.0], [2.0, 1.0, 0.0], [0.0, 0.0, 1.0]]))
+    with pytest.raises(Exception, match="(?i)positive definite|not positive|pivot"):
+        backends.factorise_condensed(K, np.array([2]), backend)
 
 
 @pytest.mark.parametrize("backend", backends.available_backends())
@@ -44,8 +55,8 @@ def test_splu_gives_no_condensed_factor():
 
 
 def test_unknown_backend_is_refused_with_the_choices():
-    with pytest.raises(backends.BackendError, match=r"backend='mumps' is not one of cholmod, "
-                                                     r"splu"):
+    with pytest.raises(backends.BackendError, match=r"backend='mumps' is not one of "
+                                                     r"pardiso, cholmod, splu"):
         backends.check_backend("mumps")
 
 

@@ -4,10 +4,10 @@ import pandas as pd
 import pytest
 
 from bench.perf.scaling import measure, phase_table, write_scaling
-from formulations.solvers.backends import available_backends
+from formulations.solvers.backends import condenses
 
-pytestmark = pytest.mark.skipif("cholmod" not in available_backends(),
-                                reason="the condensed route's phases need cholmod")
+pytestmark = pytest.mark.skipif(not condenses(None),
+                                reason="the phases belong to the condensed route")
 
 
 def test_phases_account_for_the_fast_solve(tmp_path):

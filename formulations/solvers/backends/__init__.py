@@ -1,0 +1,85 @@
+"""Sparse direct back-ends: one factorisation of K that also yields the Schur complement of K on
+the contact DOFs, the only part of K the contact iteration needs (docs/theory.md, section 8).
+
+With the DOFs split into interior I and contact C (those B touches, on one boundary line),
+
+    S_C = K_CC - K_CI K_II^-1 K_IC,    (K^-1)_CC = S_C^-1,
+
+so B K^-1 B' = B_C S_C^-1 B_C' is a small dense matrix. A back-end is one module here, registered
+with ``register_backend`` in order of preference (the default is the first available):
+
+* ``pardiso`` (``pardiso.py``; Intel MKL PARDISO through pypardiso's library, installed by
+  ``pip install .`` on x86_64): S_C straight from PARDISO's partial factorisation;
+* ``cholmod`` (``cholmod.py``; optional scikit-sparse, needs SuiteSparse's headers): S_C as the
+  trailing block of the Cholesky factor with C ordered last;
+* ``splu`` (``splu.py``; scipy's SuperLU, always there): no cheap S_C, so the active-set solver
+  factorises the augmented saddle-point system once per iteration (``augmented``).
+
+The measured comparison that fixed this order is in the README ("Sparse back-ends").
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy import sparse
+
+from formulations.solvers.backends import cholmod, pardiso, splu  # noqa: F401  (registers)
+from formulations.solvers.backends.base import (
+    REGISTRY,
+    Backend,
+    BackendError,
+    CondensedFactor,
+    FactorisationError,
+    Solve,
+    register_backend,
+)
+
+__all__ = ["BACKENDS", "Backend", "BackendError", "CondensedFactor", "FactorisationError",
+           "available_backends", "check_backend", "condenses", "default_backend", "factorise",
+           "factorise_condensed", "register_backend"]
+
+BACKENDS = tuple(sorted(REGISTRY, key=lambda name: REGISTRY[name].rank))
+
+
+def available_backends() -> tuple[str, ...]:
+    return tuple(name for name in BACKENDS if not REGISTRY[name].missing)
+
+
+def default_backend() -> str:
+    return available_backends()[0]
+
+
+def check_backend(backend: str | None) -> str:
+    """The back-end to use for ``backend`` (None means the default), or a clear error."""
+    if backend is None:
+        return default_backend()
+    if backend not in BACKENDS:
+        raise BackendError(f"backend={backend!r} is not one of {', '.join(BACKENDS)}")
+    if backend not in available_backends():
+        raise BackendError(f"backend={backend!r} is not available: {REGISTRY[backend].missing}")
+    return backend
+
+
+def condenses(backend: str | None) -> bool:
+    """Whether ``backend`` gives the Schur complement (the condensed active-set route)."""
+    return REGISTRY[check_backend(backend)].condense is not None
+
+
+def factorise(K: sparse.spmatrix, backend: str | None = None) -> Solve:
+    """A plain factorisation of K: the linear-solve floor every contact solve is measured
+    against (same back-end, same ordering options as ``factorise_condensed``)."""
+    return REGISTRY[check_backend(backend)].factorise(sparse.csc_matrix(K))
+
+
+def factorise_condensed(K: sparse.spmatrix, contact: np.ndarray,
+                        backend: str | None = None) -> CondensedFactor:
+    backend = check_backend(backend)
+    condense = REGISTRY[backend].condense
+    if condense is None:
+        raise BackendError(f"backend={backend!r} gives no cheap Schur complement; "
+                           f"{', '.join(b for b in available_backends() if condenses(b))} "
+                           "do (the augmented iteration is used instead)")
+    K = sparse.csc_matrix(K)
+    contact = np.unique(np.asarray(contact, dtype=np.int64))
+    interior = np.setdiff1d(np.arange(K.shape[0]), contact)
+    return condense(K, interior, contact)
