@@ -1,14 +1,20 @@
-"""The command line's arguments: ``build_parser`` and the validating option types (a bad value
-is refused naming the option, the value and what is allowed). Every list of names comes from
-a registry."""
+"""The command line's arguments: ``build_parser`` (the option types are in ``option_types``).
+Every list of names comes from a registry."""
 
 from __future__ import annotations
 
 import argparse
-import sys
 
+from bench.cli.option_types import (
+    gib,
+    name_list,
+    non_negative_int,
+    order_list,
+    positive_int,
+    sequence_budgets,
+    theta_value,
+)
 from bench.hard import hard_case_names
-from bench.matrix.spec import parse_item
 from bench.perf.scaling import SIZES
 from bench.perf.sequence import SEQUENCES
 from bench.sequence.loop import STRATEGIES
@@ -20,103 +26,8 @@ from formulations.solvers.backends import BACKENDS
 from scenes import scene_names
 
 
-def _names(kind: str, valid: list[str], plural: str | None = None, sweep: bool = False):
-    """A comma-separated list of names from ``valid`` (``kind``: what one name is); a name
-    given twice is kept once, with a note on standard error. With ``sweep`` an item may carry
-    parameters, ``name:key=v1|v2:other=w`` (``bench.matrix.spec.parse_item``)."""
-    def parse(text: str) -> list[str]:
-        names = [name.strip() for name in text.split(",") if name.strip()]
-        if sweep:
-            for item in names:
-                try:
-                    parse_item(item, kind)
-                except ValueError as error:
-                    raise argparse.ArgumentTypeError(str(error)) from None
-        unknown = [name for name in names if name.split(":")[0] not in valid]
-        if not names or unknown:
-            raise argparse.ArgumentTypeError(
-                f"unknown {kind} {', '.join(map(repr, unknown)) or repr(text)}; "
-                f"valid {plural or kind + 's'}: {', '.join(valid)}")
-        once = list(dict.fromkeys(names))
-        for name in {n for n in names if names.count(n) > 1}:
-            print(f"note: {kind} {name!r} given {names.count(name)} times; running it once",
-                  file=sys.stderr)
-        return once
-    return parse
-
-
-def _orders(text: str) -> list[int]:
-    """A comma-separated list of polynomial orders from ``ORDERS``."""
-    items = [item.strip() for item in text.split(",") if item.strip()]
-    values = [integer_value(item) for item in items]
-    if not items or any(v not in ORDERS for v in values):
-        raise argparse.ArgumentTypeError(
-            f"order={text!r} is not a comma-separated list of orders from "
-            f"{', '.join(map(str, ORDERS))}")
-    once = list(dict.fromkeys(values))
-    if len(once) < len(values):
-        print(f"note: order given more than once in {text!r}; running each once",
-              file=sys.stderr)
-    return once
-
-
-def integer_value(text: str) -> int | None:
-    """``text`` as an int, also when written as a float with an integer value ("1e3", "2.0");
-    None when it is not an integer."""
-    try:
-        return int(text)
-    except ValueError:
-        pass
-    try:
-        value = float(text)
-    except ValueError:
-        return None
-    return int(value) if value.is_integer() else None
-
-
-def _integer(name: str, minimum: int, allowed: str):
-    """An int option >= ``minimum``, refused as "name='text' is not <allowed>"."""
-    def parse(text: str) -> int:
-        value = integer_value(text)
-        if value is None:
-            value = minimum - 1
-        if value < minimum:
-            raise argparse.ArgumentTypeError(f"{name}={text!r} is not {allowed}")
-        return value
-    return parse
-
-
-def _positive_int(name: str):
-    return _integer(name, 1, "a positive integer")
-
-
-def _sequence_budgets(text: str) -> list[int]:
-    """One positive DOF budget per sequence of ``SEQUENCES``, comma-separated."""
-    parse = _positive_int("sequence_max_dofs")
-    items = [item.strip() for item in text.split(",")]
-    if len(items) != len(SEQUENCES):
-        raise argparse.ArgumentTypeError(
-            f"sequence_max_dofs={text!r} is not {len(SEQUENCES)} comma-separated budgets "
-            f"(for {', '.join(s for s, _ in SEQUENCES)})")
-    return [parse(item) for item in items]
-
-
-def _non_negative_int(name: str):
-    return _integer(name, 0, "an integer >= 0")
-
-
-def _gib(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        value = float("nan")
-    if not (value > 0 and value < float("inf")):
-        raise argparse.ArgumentTypeError(f"max_memory={text!r} is not a number of GiB > 0")
-    return value
-
-
 def _scale_out_options(parser) -> None:
-    parser.add_argument("--workers", type=_non_negative_int("workers"), default=0,
+    parser.add_argument("--workers", type=non_negative_int("workers"), default=0,
                         help="run the sequences on a local Dask cluster of this many processes "
                              "(one thread each) (default: 0, in this process)")
     parser.add_argument("--scheduler", default=None, metavar="ADDRESS",
@@ -129,20 +40,10 @@ def _scale_out_options(parser) -> None:
 
 
 def _memory_option(parser) -> None:
-    parser.add_argument("--max-memory", type=_gib, default=None, metavar="GIB",
+    parser.add_argument("--max-memory", type=gib, default=None, metavar="GIB",
                         help="refuse (status failed) a level whose predicted peak memory "
                              "exceeds this many GiB, before building it (default: the memory "
                              "the machine has available, minus 10 %% and at least 1 GiB)")
-
-
-def _theta(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        value = float("nan")
-    if not 0.0 < value <= 1.0:
-        raise argparse.ArgumentTypeError(f"theta={text!r} is not a number in (0, 1]")
-    return value
 
 
 def _run_parser(sub) -> None:
@@ -150,35 +51,35 @@ def _run_parser(sub) -> None:
                          "write results.parquet and results.csv",
                          description="Run every combination of the given comma-separated "
                          "lists and write one row per level to OUT/results.{parquet,csv}.")
-    run.add_argument("--scene", type=_names("scene", scene_names(), sweep=True),
+    run.add_argument("--scene", type=name_list("scene", scene_names(), sweep=True),
                      default=["paper"],
                      help=f"scene(s), comma-separated; one of: {', '.join(scene_names())} "
                           "(default: paper); sweep parameters with name:key=v1|v2, e.g. "
                           "paper:poisson_ratio=0.3|0.45")
-    run.add_argument("--formulation", type=_names("formulation", formulation_names(),
+    run.add_argument("--formulation", type=name_list("formulation", formulation_names(),
                                                   sweep=True),
                      default=["mixed"], help="formulation(s): "
                      f"{', '.join(formulation_names())} (default: mixed); options as for "
                      "--scene, e.g. mixed:h_over_H=0.5|0.25")
-    run.add_argument("--solver", type=_names("solver", solver_names()), default=["reference"],
+    run.add_argument("--solver", type=name_list("solver", solver_names()), default=["reference"],
                      help=f"solver(s): {', '.join(solver_names())} (default: reference)")
-    run.add_argument("--estimator", type=_names("estimator", estimator_names()),
+    run.add_argument("--estimator", type=name_list("estimator", estimator_names()),
                      default=["residual"],
                      help=f"estimator(s): {', '.join(estimator_names())} (default: residual)")
-    run.add_argument("--strategy", type=_names("strategy", list(STRATEGIES), "strategies"),
+    run.add_argument("--strategy", type=name_list("strategy", list(STRATEGIES), "strategies"),
                      default=["adaptive"],
                      help="refinement strategy(ies): uniform, adaptive (default: adaptive)")
-    run.add_argument("--order", type=_orders, default=[1],
+    run.add_argument("--order", type=order_list, default=[1],
                      help="polynomial order(s) p of the displacements, comma-separated, from "
                           f"{', '.join(map(str, ORDERS))}; every formulation and estimator "
                           "runs at each (default: 1)")
-    run.add_argument("--max-dofs", type=_positive_int("max_dofs"), default=20000,
+    run.add_argument("--max-dofs", type=positive_int("max_dofs"), default=20000,
                      help="DOF budget: stop before a level with more unknowns (default: 20000)")
-    run.add_argument("--max-levels", type=_positive_int("max_levels"), default=40,
+    run.add_argument("--max-levels", type=positive_int("max_levels"), default=40,
                      help="maximum number of levels (default: 40)")
     run.add_argument("--marking", choices=MARKINGS, default="doerfler",
                      help="adaptive marking: doerfler (bulk) or maximum (default: doerfler)")
-    run.add_argument("--theta", type=_theta, default=0.5,
+    run.add_argument("--theta", type=theta_value, default=0.5,
                      help="marking parameter in (0, 1] (default: 0.5)")
     run.add_argument("--backend", choices=BACKENDS, default=None,
                      help="sparse direct back-end of the active-set solver: pardiso (MKL, "
@@ -187,7 +88,7 @@ def _run_parser(sub) -> None:
     run.add_argument("--cold-start", action="store_true",
                      help="solve every level from scratch instead of starting from the "
                           "previous level's contact zone (nested iteration, the default)")
-    run.add_argument("--reference-dofs", type=_positive_int("reference_dofs"), default=None,
+    run.add_argument("--reference-dofs", type=positive_int("reference_dofs"), default=None,
                      help="measure errors of scenes without an exact solution against a "
                           "cached adaptive P3 reference (mixed method) with at most this many "
                           "DOFs (default: only scenes with an exact solution get errors)")
@@ -196,7 +97,7 @@ def _run_parser(sub) -> None:
                           "agreement with the P3 one in truth.json (default: off)")
     _memory_option(run)
     _scale_out_options(run)
-    run.add_argument("--crosscheck-dofs", type=_non_negative_int("crosscheck_dofs"), default=0,
+    run.add_argument("--crosscheck-dofs", type=non_negative_int("crosscheck_dofs"), default=0,
                      help="also solve levels with at most this many DOFs with the reference "
                           "solver and record the differences (default: 0, never)")
     run.add_argument("--out", default="results",
@@ -222,14 +123,14 @@ def _scaling_parser(sub) -> None:
         "the estimator against N, with peak memory",
         description="Measure every phase once per size, each size in a fresh process, and "
         "write OUT/scaling.{md,csv} (and the README's table with --readme).")
-    scaling.add_argument("--sizes", type=_names("size", list(SIZES)), default=list(SIZES),
+    scaling.add_argument("--sizes", type=name_list("size", list(SIZES)), default=list(SIZES),
                          help=f"sizes, comma-separated: {', '.join(SIZES)} (default: all)")
     scaling.add_argument("--backend", choices=BACKENDS, default=None,
                          help="sparse back-end (default: the first available of "
                               + ", ".join(BACKENDS) + ")")
-    scaling.add_argument("--order", type=_orders, default=[1],
+    scaling.add_argument("--order", type=order_list, default=[1],
                          help="polynomial order(s) of the displacements (default: 1)")
-    scaling.add_argument("--reference-max-dofs", type=_positive_int("reference_max_dofs"),
+    scaling.add_argument("--reference-max-dofs", type=positive_int("reference_max_dofs"),
                          default=200_000, help="run the reference solver only up to this "
                          "many DOFs (default: 200000)")
     scaling.add_argument("--out", default="reports", help="output folder (default: reports)")
@@ -240,7 +141,7 @@ def _scaling_parser(sub) -> None:
                          help="time whole sequences instead (an adaptive one and a uniform one, "
                               "every level and phase) against one linear solve at the finest "
                               "level; writes OUT/scaling-sequence.{md,csv}")
-    scaling.add_argument("--sequence-max-dofs", type=_sequence_budgets,
+    scaling.add_argument("--sequence-max-dofs", type=sequence_budgets,
                          default=[b for _, b in SEQUENCES],
                          help="the DOF budgets of the adaptive and the uniform sequence, "
                               "comma-separated (default: "
@@ -254,14 +155,14 @@ def _compare_parser(sub) -> None:
         "adaptive} with the active-set solver (cross-checked by the reference on small "
         "levels), errors against exact solutions or cached overkill references, then every "
         "hard case into the same folder, then render the report.")
-    compare.add_argument("--max-dofs", type=_positive_int("max_dofs"), default=20000,
+    compare.add_argument("--max-dofs", type=positive_int("max_dofs"), default=20000,
                          help="DOF budget per sequence (default: 20000)")
-    compare.add_argument("--reference-dofs", type=_positive_int("reference_dofs"),
+    compare.add_argument("--reference-dofs", type=positive_int("reference_dofs"),
                          default=200000,
                          help="DOF budget of the P3 overkill references (default: 200000)")
     _memory_option(compare)
     _scale_out_options(compare)
-    compare.add_argument("--crosscheck-dofs", type=_non_negative_int("crosscheck_dofs"),
+    compare.add_argument("--crosscheck-dofs", type=non_negative_int("crosscheck_dofs"),
                          default=3000, help="cross-check levels up to this size with the "
                          "reference solver (default: 3000)")
     compare.add_argument("--out", default="results", help="results folder (default: results)")
@@ -286,7 +187,7 @@ def _hard_parser(sub) -> None:
         description="Run every hard case (bench/hard) with every formulation and every "
         "solver, write OUT/hard.{csv,md}, and check each verdict against "
         "bench/verify/expected.toml. Exit status 1 if a verdict differs from the expected one.")
-    hard.add_argument("--case", type=_names("hard case", hard_case_names()), default=None,
+    hard.add_argument("--case", type=name_list("hard case", hard_case_names()), default=None,
                       help=f"case(s), comma-separated: {', '.join(hard_case_names())} "
                            "(default: all)")
     hard.add_argument("--out", default="results-hard",

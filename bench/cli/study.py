@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 
-from bench.cli import parser as options
+from bench.cli import option_types as options
 from bench.cli.guards import InputError
 from bench.study import QUICK, StudyConfig, run_study
 from bench.study.run import report_study
@@ -21,23 +21,23 @@ def add_study_parser(sub) -> None:
         "REPORT/README.md with local and asymptotic slopes, the predictions from the scenes' "
         "singular exponents and the effectivity on every level. A rerun reuses every finished "
         "sequence.")
-    study.add_argument("--scene", type=options._names("scene", scene_names()),
+    study.add_argument("--scene", type=options.name_list("scene", scene_names()),
                        default=list(DEFAULTS.scenes),
                        help=f"scene(s) (default: {','.join(DEFAULTS.scenes)})")
-    study.add_argument("--order", type=options._orders, default=list(DEFAULTS.orders),
+    study.add_argument("--order", type=options.order_list, default=list(DEFAULTS.orders),
                        help="polynomial order(s) (default: 1)")
-    study.add_argument("--uniform-max-dofs", type=options._positive_int("uniform_max_dofs"),
+    study.add_argument("--uniform-max-dofs", type=options.positive_int("uniform_max_dofs"),
                        default=DEFAULTS.uniform_max_dofs,
                        help=f"DOF budget of the uniform sequences "
                             f"(default: {DEFAULTS.uniform_max_dofs})")
-    study.add_argument("--adaptive-max-dofs", type=options._positive_int("adaptive_max_dofs"),
+    study.add_argument("--adaptive-max-dofs", type=options.positive_int("adaptive_max_dofs"),
                        default=DEFAULTS.adaptive_max_dofs,
                        help=f"DOF budget of the adaptive sequences "
                             f"(default: {DEFAULTS.adaptive_max_dofs})")
-    study.add_argument("--reference-dofs", type=options._positive_int("reference_dofs"),
+    study.add_argument("--reference-dofs", type=options.positive_int("reference_dofs"),
                        default=DEFAULTS.reference_dofs,
                        help=f"P3 reference budget (default: {DEFAULTS.reference_dofs})")
-    study.add_argument("--workers", type=options._non_negative_int("workers"),
+    study.add_argument("--workers", type=options.non_negative_int("workers"),
                        default=DEFAULTS.workers,
                        help=f"adaptive sequences run in parallel on a local Dask cluster of "
                             f"this many processes; uniform ones one at a time "

@@ -1,5 +1,5 @@
 """Sparse direct back-ends: one factorisation of K that also yields the Schur complement of K on
-the contact DOFs, the only part of K the contact iteration needs (docs/theory.md, section 8).
+the contact DOFs, the only part of K the contact iteration needs (docs/theory.md, section 11).
 
 With the DOFs split into interior I and contact C (those B touches, on one boundary line),
 

@@ -4,7 +4,7 @@
 PARDISO computes the Schur complement of K on the contact DOFs inside its factorisation: with
 the contact DOFs flagged in ``perm`` and iparm[35] = 2 it eliminates the interior, returns S_C
 as a dense matrix and keeps the partial factor, with which the same handle still solves with
-the whole K (docs/theory.md, section 8). Both factorisations use parallel nested dissection
+the whole K (docs/theory.md, section 11). Both factorisations use parallel nested dissection
 (iparm[1] = 3) and the two-level parallel factorisation (iparm[23] = 1), so the contact solve
 and the plain linear solve are compared like with like.
 """

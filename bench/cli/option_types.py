@@ -1,0 +1,116 @@
+"""Validating option types of the command line: a bad value is refused naming the option, the
+value and what is allowed."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from bench.matrix.spec import parse_item
+from bench.perf.sequence import SEQUENCES
+from formulations.elasticity import ORDERS
+
+
+def name_list(kind: str, valid: list[str], plural: str | None = None, sweep: bool = False):
+    """A comma-separated list of names from ``valid`` (``kind``: what one name is); a name
+    given twice is kept once, with a note on standard error. With ``sweep`` an item may carry
+    parameters, ``name:key=v1|v2:other=w`` (``bench.matrix.spec.parse_item``)."""
+    def parse(text: str) -> list[str]:
+        names = [name.strip() for name in text.split(",") if name.strip()]
+        if sweep:
+            for item in names:
+                try:
+                    parse_item(item, kind)
+                except ValueError as error:
+                    raise argparse.ArgumentTypeError(str(error)) from None
+        unknown = [name for name in names if name.split(":")[0] not in valid]
+        if not names or unknown:
+            raise argparse.ArgumentTypeError(
+                f"unknown {kind} {', '.join(map(repr, unknown)) or repr(text)}; "
+                f"valid {plural or kind + 's'}: {', '.join(valid)}")
+        once = list(dict.fromkeys(names))
+        for name in {n for n in names if names.count(n) > 1}:
+            print(f"note: {kind} {name!r} given {names.count(name)} times; running it once",
+                  file=sys.stderr)
+        return once
+    return parse
+
+
+def order_list(text: str) -> list[int]:
+    """A comma-separated list of polynomial orders from ``ORDERS``."""
+    items = [item.strip() for item in text.split(",") if item.strip()]
+    values = [integer_value(item) for item in items]
+    if not items or any(v not in ORDERS for v in values):
+        raise argparse.ArgumentTypeError(
+            f"order={text!r} is not a comma-separated list of orders from "
+            f"{', '.join(map(str, ORDERS))}")
+    once = list(dict.fromkeys(values))
+    if len(once) < len(values):
+        print(f"note: order given more than once in {text!r}; running each once",
+              file=sys.stderr)
+    return once
+
+
+def integer_value(text: str) -> int | None:
+    """``text`` as an int, also when written as a float with an integer value ("1e3", "2.0");
+    None when it is not an integer."""
+    try:
+        return int(text)
+    except ValueError:
+        pass
+    try:
+        value = float(text)
+    except ValueError:
+        return None
+    return int(value) if value.is_integer() else None
+
+
+def bounded_int(name: str, minimum: int, allowed: str):
+    """An int option >= ``minimum``, refused as "name='text' is not <allowed>"."""
+    def parse(text: str) -> int:
+        value = integer_value(text)
+        if value is None:
+            value = minimum - 1
+        if value < minimum:
+            raise argparse.ArgumentTypeError(f"{name}={text!r} is not {allowed}")
+        return value
+    return parse
+
+
+def positive_int(name: str):
+    return bounded_int(name, 1, "a positive integer")
+
+
+def sequence_budgets(text: str) -> list[int]:
+    """One positive DOF budget per sequence of ``SEQUENCES``, comma-separated."""
+    parse = positive_int("sequence_max_dofs")
+    items = [item.strip() for item in text.split(",")]
+    if len(items) != len(SEQUENCES):
+        raise argparse.ArgumentTypeError(
+            f"sequence_max_dofs={text!r} is not {len(SEQUENCES)} comma-separated budgets "
+            f"(for {', '.join(s for s, _ in SEQUENCES)})")
+    return [parse(item) for item in items]
+
+
+def non_negative_int(name: str):
+    return bounded_int(name, 0, "an integer >= 0")
+
+
+def gib(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not (value > 0 and value < float("inf")):
+        raise argparse.ArgumentTypeError(f"max_memory={text!r} is not a number of GiB > 0")
+    return value
+
+
+def theta_value(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not 0.0 < value <= 1.0:
+        raise argparse.ArgumentTypeError(f"theta={text!r} is not a number in (0, 1]")
+    return value
