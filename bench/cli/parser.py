@@ -22,7 +22,7 @@ from bench.sequence.marking import MARKINGS
 from estimators import estimator_names
 from formulations import formulation_names, solver_names
 from formulations.elasticity import ORDERS
-from formulations.solvers.backends import BACKENDS
+from formulations.solvers.backends import backend_names
 from scenes import scene_names
 
 
@@ -81,7 +81,7 @@ def _run_parser(sub) -> None:
                      help="adaptive marking: doerfler (bulk) or maximum (default: doerfler)")
     run.add_argument("--theta", type=theta_value, default=0.5,
                      help="marking parameter in (0, 1] (default: 0.5)")
-    run.add_argument("--backend", choices=BACKENDS, default=None,
+    run.add_argument("--backend", choices=backend_names(), default=None,
                      help="sparse direct back-end of the active-set solver: pardiso (MKL, "
                           "installed with the package on x86_64), cholmod (needs scikit-sparse) "
                           "or splu (scipy) (default: the first of these that is available)")
@@ -125,9 +125,9 @@ def _scaling_parser(sub) -> None:
         "write OUT/scaling.{md,csv} (and the README's table with --readme).")
     scaling.add_argument("--sizes", type=name_list("size", list(SIZES)), default=list(SIZES),
                          help=f"sizes, comma-separated: {', '.join(SIZES)} (default: all)")
-    scaling.add_argument("--backend", choices=BACKENDS, default=None,
+    scaling.add_argument("--backend", choices=backend_names(), default=None,
                          help="sparse back-end (default: the first available of "
-                              + ", ".join(BACKENDS) + ")")
+                              + ", ".join(backend_names()) + ")")
     scaling.add_argument("--order", type=order_list, default=[1],
                          help="polynomial order(s) of the displacements (default: 1)")
     scaling.add_argument("--reference-max-dofs", type=positive_int("reference_max_dofs"),

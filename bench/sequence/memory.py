@@ -56,8 +56,10 @@ def route(solver: str, backend: str) -> str:
 
 
 def predict_peak_gib(ndofs: int, solver: str, backend: str, order: int = 1) -> float:
-    """The predicted peak memory of a level with ``ndofs`` unknowns of order ``order`` (GiB)."""
-    line = MODEL[route(solver, backend)]
+    """The predicted peak memory of a level with ``ndofs`` unknowns of order ``order`` (GiB);
+    a back-end without a measured line gets the steepest one (a bound, not a fit)."""
+    steepest = max(MODEL.values(), key=lambda line: line.per_dof_gib)
+    line = MODEL.get(route(solver, backend), steepest)
     return line.base_gib + ORDER_FACTOR[order] * line.per_dof_gib * ndofs
 
 

@@ -95,3 +95,37 @@ def test_the_report_shows_both(results, tmp_path):
     assert all(name in readme for name in (NEW_FORMULATION, NEW_SCENE, NEW_ESTIMATOR))
     hard_section = readme.split("Hard cases", 1)[1]
     assert NEW_SCENE in hard_section and NEW_FORMULATION in hard_section
+
+
+def test_a_registered_backend_is_offered_and_solves(tmp_path):
+    """A back-end is one module and one ``register_backend``: a dense Cholesky one here."""
+    from scipy import linalg
+
+    from formulations.solvers.backends import (
+        Backend,
+        CondensedFactor,
+        register_backend,
+        unregister_backend,
+    )
+
+    def factorise(K):
+        factor = linalg.cho_factor(K.toarray(), lower=True)
+        return lambda b: linalg.cho_solve(factor, b)
+
+    def condense(K, interior, contact):
+        dense = K.toarray()
+        schur = dense[np.ix_(contact, contact)] - dense[np.ix_(contact, interior)] @ \
+            np.linalg.solve(dense[np.ix_(interior, interior)], dense[np.ix_(interior, contact)])
+        return CondensedFactor("dense", contact, factorise(K), linalg.cholesky(schur, lower=True))
+
+    register_backend(Backend("dense", rank=9, factorise=factorise, condense=condense))
+    try:
+        out = tmp_path / "r"
+        assert main(["run", "--scene", "paper", "--formulation", "mixed", "--solver",
+                     "active-set", "--estimator", "residual", "--strategy", "uniform",
+                     "--max-dofs", "600", "--backend", "dense", "--out", str(out)]) == 0
+        table = pd.read_parquet(out / "results.parquet")
+        assert (table["backend"] == "dense").all() and (table["status"] == "ok").all()
+        assert (table["stationarity"] < 1e-10).all()
+    finally:
+        unregister_backend("dense")

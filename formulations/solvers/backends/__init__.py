@@ -32,17 +32,25 @@ from formulations.solvers.backends.base import (
     FactorisationError,
     Solve,
     register_backend,
+    unregister_backend,
 )
 
 __all__ = ["BACKENDS", "Backend", "BackendError", "CondensedFactor", "FactorisationError",
-           "available_backends", "check_backend", "condenses", "default_backend", "factorise",
-           "factorise_condensed", "register_backend"]
+           "available_backends", "backend_names", "check_backend", "condenses",
+           "default_backend", "factorise", "factorise_condensed", "register_backend",
+           "unregister_backend"]
 
-BACKENDS = tuple(sorted(REGISTRY, key=lambda name: REGISTRY[name].rank))
+
+def backend_names() -> tuple[str, ...]:
+    """Every registered back-end, the preferred first."""
+    return tuple(sorted(REGISTRY, key=lambda name: REGISTRY[name].rank))
+
+
+BACKENDS = backend_names()  # the built-in ones
 
 
 def available_backends() -> tuple[str, ...]:
-    return tuple(name for name in BACKENDS if not REGISTRY[name].missing)
+    return tuple(name for name in backend_names() if not REGISTRY[name].missing)
 
 
 def default_backend() -> str:
@@ -53,8 +61,8 @@ def check_backend(backend: str | None) -> str:
     """The back-end to use for ``backend`` (None means the default), or a clear error."""
     if backend is None:
         return default_backend()
-    if backend not in BACKENDS:
-        raise BackendError(f"backend={backend!r} is not one of {', '.join(BACKENDS)}")
+    if backend not in REGISTRY:
+        raise BackendError(f"backend={backend!r} is not one of {', '.join(backend_names())}")
     if backend not in available_backends():
         raise BackendError(f"backend={backend!r} is not available: {REGISTRY[backend].missing}")
     return backend

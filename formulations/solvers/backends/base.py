@@ -58,3 +58,7 @@ def register_backend(backend: Backend) -> Backend:
         raise ValueError(f"back-end {backend.name!r} is registered twice")
     REGISTRY[backend.name] = backend
     return backend
+
+
+def unregister_backend(name: str) -> None:
+    del REGISTRY[name]
