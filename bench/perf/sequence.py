@@ -92,7 +92,7 @@ def sequence_table(frame: pd.DataFrame) -> str:
     solve."""
     table = pd.DataFrame({
         "sequence": frame["strategy"] + " to " + frame["max_dofs"].map(
-            lambda n: f"{n:.0e}".replace("e+0", "e").replace("e+", "e")),
+            lambda n: f"{n:.2g}".replace("e+0", "e").replace("e+", "e")),
         "levels": frame["levels"], "finest N": frame["final_ndofs"],
         "whole sequence [s]": frame["t_sequence"].map("{:.1f}".format),
         "linear solve at finest [s]": frame["t_linear_finest"].map("{:.2f}".format),

@@ -9,8 +9,9 @@ Coefficients are fitted to ``python -m bench scaling`` (peak resident memory of 
 assembly, factorisation, contact solve, estimator; paper scene, mixed method, uniform meshes)
 on the 2-core reference machine:
 
-* ``pardiso`` (active-set): 0.63 / 2.59 GiB at 100 800 / 992 640 DOFs, the line through them
-  (base 0.41 GiB, 2.20e-6 GiB per DOF, 2.4 kB);
+* ``pardiso`` (active-set): 0.23 / 0.52 / 2.58 GiB at 10 512 / 100 800 / 992 640 DOFs; the
+  line through the first and the last gives base 0.20 GiB and 2.39e-6 GiB per DOF (2.6 kB),
+  0.86 x the middle point (P2 at 992 640 DOFs: 3.25 GiB measured, 3.53 predicted);
 * ``cholmod`` (active-set): 0.218 / 0.650 / 4.893 GiB at 10 512 / 100 800 / 992 640 DOFs; the
   line through the last two gives base 0.17 GiB and 4.76e-6 GiB per DOF (5.1 kB), within 5 %
   of all three points;
@@ -46,7 +47,7 @@ class MemoryLine:
 
 
 CHOLMOD = MemoryLine(0.1713, 4.754e-6)
-MODEL = {"pardiso": MemoryLine(0.408, 2.198e-6), "cholmod": CHOLMOD,
+MODEL = {"pardiso": MemoryLine(0.2048, 2.393e-6), "cholmod": CHOLMOD,
          "splu": MemoryLine(0.1612, 7.851e-6), "reference": CHOLMOD}
 ORDER_FACTOR = {1: 1.0, 2: 1.4, 3: 1.7}  # per-DOF memory of P_p relative to P1 (docstring)
 
