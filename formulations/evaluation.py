@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy import sparse
-from skfem import Basis
+from skfem import Basis, ElementH1, ElementVector
 
 CHUNK = 200_000  # points per block when summing gradients (bounds the temporary arrays)
 
@@ -54,11 +54,31 @@ class PointEvaluation:
 def evaluate_at(basis: Basis, x: np.ndarray, cells: np.ndarray) -> PointEvaluation:
     """The basis functions of ``basis`` at points ``x`` (2, n) lying in elements ``cells``."""
     X = basis.mapping.invF(x[:, :, None], tind=cells)
+    if isinstance(basis.elem, ElementVector) and isinstance(basis.elem.elem, ElementH1):
+        values, gradients = _vector_h1_at(basis, X, cells)
+        return PointEvaluation(basis=basis, cells=cells, values=values, gradients=gradients)
     fields = [basis.elem.gbasis(basis.mapping, X, k, tind=cells)[0]
               for k in range(basis.Nbfun)]
     return PointEvaluation(basis=basis, cells=cells,
                            values=tuple(np.asarray(f)[..., 0] for f in fields),
                            gradients=tuple(f.grad[..., 0] for f in fields))
+
+
+def _vector_h1_at(basis: Basis, X: np.ndarray, cells: np.ndarray):
+    """What ``gbasis`` gives for vector Lagrange elements, with the inverse Jacobian computed
+    once instead of once per basis function (vector function k = 2 j + c is the scalar
+    function j in component c, scikit-fem's order)."""
+    inverse = basis.mapping.invDF(X, tind=cells)[..., 0]  # (2, 2, n)
+    values, gradients = [], []
+    for j in range(basis.Nbfun // 2):
+        phi, dphi = basis.elem.elem.lbasis(X, j)
+        grad = np.einsum("ijn,in->jn", inverse, dphi[..., 0])
+        for c in range(2):
+            value, gradient = np.zeros((2, cells.size)), np.zeros((2, 2, cells.size))
+            value[c], gradient[c] = phi[..., 0], grad
+            values.append(value)
+            gradients.append(gradient)
+    return tuple(values), tuple(gradients)
 
 
 def evaluate_on_trace(basis: Basis, trace, t: np.ndarray) -> PointEvaluation:
