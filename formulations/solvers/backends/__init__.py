@@ -5,8 +5,8 @@ With the DOFs split into interior I and contact C (those B touches, on one bound
 
     S_C = K_CC - K_CI K_II^-1 K_IC,    (K^-1)_CC = S_C^-1,
 
-so B K^-1 B' = B_C S_C^-1 B_C' is a small dense matrix. A back-end is one module here, registered
-with ``register_backend`` in order of preference (the default is the first available):
+so B K^-1 B' = B_C S_C^-1 B_C' is a small dense matrix. A back-end is one module here that calls
+``register_backend``; its ``rank`` orders the preference (the default is the first available):
 
 * ``pardiso`` (``pardiso.py``; Intel MKL PARDISO through pypardiso's library, installed by
   ``pip install .`` on x86_64): S_C straight from PARDISO's partial factorisation;
@@ -15,7 +15,8 @@ with ``register_backend`` in order of preference (the default is the first avail
 * ``splu`` (``splu.py``; scipy's SuperLU, always there): no cheap S_C, so the active-set solver
   factorises the augmented saddle-point system once per iteration (``augmented``).
 
-The measured comparison that fixed this order is in the README ("Sparse back-ends").
+The measured comparison that fixed this order is in the README ("Solvers, sparse back-ends and
+scaling").
 """
 
 from __future__ import annotations
