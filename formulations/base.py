@@ -62,7 +62,7 @@ class SolverDiagnostics:
     cycled: bool = False  # the plain active-set iteration repeated a set
     safeguard: str = ""  # what answered instead of the plain iteration ("" if nothing did)
     condition_estimate: float = float("nan")  # of the last linear system, solver's scaling
-    condensed: np.ndarray | None = None  # B K^-1 B' when the solver formed it (cholmod)
+    condensed: np.ndarray | None = None  # B K^-1 B' when the solver formed it (pardiso, cholmod)
     phases: tuple[tuple[str, float], ...] = ()  # (phase, seconds) of the solve, in order
 
 

@@ -74,7 +74,7 @@ def solve_both(case: str, scene: Scene, formulation: str, mesh, variant: str = "
                for sol in solutions]
     best = int(np.argmin([r["max_residual"] if np.isfinite(r["max_residual"]) else np.inf
                           for r in records]))
-    # B K^-1 B' from whichever solver formed it (the active-set solver on cholmod)
+    # B K^-1 B' from whichever solver formed it (the active-set solver on pardiso or cholmod)
     condensed = next((s.diagnostics.condensed for s in solutions
                       if s.diagnostics.condensed is not None), None)
     beta = inf_sup_constant(disc, condensed=condensed) if inf_sup else np.nan

@@ -48,8 +48,15 @@ def linear_rhs(qp) -> np.ndarray:
     return qp.F - qp.B.T @ np.ones(qp.m)
 
 
-def _peak_gib() -> float:
+def peak_gib() -> float:
+    """This process's peak resident memory so far (GiB)."""
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20  # KiB on Linux
+
+
+def in_fresh_process(function, *args):
+    """``function(*args)`` in a newly spawned process, so that its peak memory is its own."""
+    with multiprocessing.get_context("spawn").Pool(1) as pool:
+        return pool.apply(function, args)
 
 
 def measure(size: str, backend: str | None = None, reference: bool = True,
@@ -77,7 +84,7 @@ def measure(size: str, backend: str | None = None, reference: bool = True,
     start = time.perf_counter()
     get_estimator("residual")(scene, fast)
     row["t_estimate"] = time.perf_counter() - start
-    row["peak_gib_without_reference"] = _peak_gib()
+    row["peak_gib_without_reference"] = peak_gib()
     row.update(t_reference_solve=np.nan, reference_iterations=0, reference_status="not run",
                energy_norm_difference=np.nan, max_lambda_difference=np.nan)
     if reference:
@@ -89,7 +96,7 @@ def measure(size: str, backend: str | None = None, reference: bool = True,
                    reference_iterations=reference.iterations,
                    reference_status=reference.status, energy_norm_difference=energy,
                    max_lambda_difference=pressure)
-    row["peak_gib"] = _peak_gib()
+    row["peak_gib"] = peak_gib()
     return row
 
 
@@ -111,7 +118,7 @@ def phase_column(phase: str) -> str:
 
 
 def phase_table(frame: pd.DataFrame) -> str:
-    """Where the fast contact solve's time goes (cholmod's condensed route), per size."""
+    """Where the fast contact solve's time goes (the condensed route), per size."""
     columns = [c for c in frame.columns if c.startswith("t_fast_") and c != "t_fast_solve"]
     if not columns:
         return ""
@@ -122,10 +129,6 @@ def phase_table(frame: pd.DataFrame) -> str:
     return table.to_markdown(index=False, floatfmt=".2f")
 
 
-def _measure_star(args):
-    return measure(*args)
-
-
 def run_scaling(sizes, backend=None, reference_max_dofs=200_000, on_row=None,
                 orders=(1,)) -> pd.DataFrame:
     """``measure`` every size (and order) in its own spawned process; the reference only up to
@@ -133,13 +136,10 @@ def run_scaling(sizes, backend=None, reference_max_dofs=200_000, on_row=None,
     from formulations.elasticity import count_free_dofs
 
     rows = []
-    context = multiprocessing.get_context("spawn")
     for size, order in itertools.product(sizes, orders):
         scene, mesh = paper_problem(size, order)  # cheap: the DOF count decides the reference
         ndofs = count_free_dofs(scene, mesh, order)
-        with context.Pool(1) as pool:
-            row = pool.apply(_measure_star,
-                             ((size, backend, ndofs <= reference_max_dofs, order),))
+        row = in_fresh_process(measure, size, backend, ndofs <= reference_max_dofs, order)
         rows.append(row)
         if on_row is not None:
             on_row(row)

@@ -11,7 +11,6 @@ row; ``t_sequence`` is the wall time of the whole sequence, everything included.
 
 from __future__ import annotations
 
-import multiprocessing
 import tempfile
 import time
 from pathlib import Path
@@ -30,7 +29,7 @@ def measure_sequence(strategy: str, max_dofs: int, backend: str | None = None,
                      reference_dofs: int = REFERENCE_DOFS) -> dict:
     """Run one sequence and time it; run in a fresh process for a meaningful peak."""
     from bench.matrix.store import ResultStore
-    from bench.perf.scaling import _peak_gib
+    from bench.perf.scaling import peak_gib
     from bench.sequence.loop import LoopConfig, run_sequence
     from bench.truth import truth_for
     from formulations.solvers.backends import check_backend, factorise
@@ -66,21 +65,17 @@ def measure_sequence(strategy: str, max_dofs: int, backend: str | None = None,
         out[phase] = float(frame[phase].fillna(0.0).sum())
         out[phase + "_finest"] = float(np.nan_to_num(frame[phase].iloc[-1]))
     out.update(t_store=t_store, sequence_over_linear=t_sequence / t_linear,
-               peak_gib=_peak_gib())
+               peak_gib=peak_gib())
     return out
-
-
-def _measure_star(args):
-    return measure_sequence(*args)
 
 
 def run_sequences(sequences=SEQUENCES, backend=None, on_row=None) -> pd.DataFrame:
     """``measure_sequence`` for every (strategy, budget), each in its own spawned process."""
+    from bench.perf.scaling import in_fresh_process
+
     rows = []
-    context = multiprocessing.get_context("spawn")
     for strategy, max_dofs in sequences:
-        with context.Pool(1) as pool:
-            row = pool.apply(_measure_star, ((strategy, max_dofs, backend),))
+        row = in_fresh_process(measure_sequence, strategy, max_dofs, backend)
         rows.append(row)
         if on_row is not None:
             on_row(row)
