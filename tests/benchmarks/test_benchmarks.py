@@ -92,7 +92,9 @@ def test_stability_diagnostics(benchmark, problem, solution):
         return inf_sup_constant(disc), pressure_oscillation(solution)
 
     beta, oscillation = benchmark.pedantic(diagnose, rounds=ROUNDS[size], iterations=1)
-    assert beta > 0.5 and oscillation >= 1.0  # h/H = 1/2 on uniform meshes: beta ~ 0.53
+    # h/H = 1/2 on uniform meshes: beta ~ 0.53; the oscillation is >= 1 up to the round-off of
+    # its sum of differences (see tests/bench/sequence/test_loop.py): 1e-12 slack
+    assert beta > 0.5 and oscillation >= 1.0 - 1e-12
     _info(benchmark, disc, inf_sup=beta, pressure_oscillation=oscillation)
 
 

@@ -50,7 +50,7 @@ def test_positive_on_the_paper_scene_and_indicators_sum_to_eta_squared():
     scene = get_scene("paper")
     sol = solve(get_formulation("mixed")(scene, scene.mesh.refined(3)), "active-set")
     est = estimate(scene, sol)
-    assert est.eta_0 > 0 and (est.indicators >= 0).all()
+    assert est.eta_0 > 0 and (est.indicators >= 0).all()  # exact: sums of squares
     assert est.indicators.sum() == pytest.approx(est.eta**2, rel=1e-12)
 
 

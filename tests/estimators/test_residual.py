@@ -23,6 +23,7 @@ def test_no_contact_gives_exactly_zero_contact_terms(free_scene):
     u_n = sol.normal_displacement(np.array([0.0, 1.0]))
     assert 0 < np.abs(u_n).max() < 0.5  # the body moves, far from the obstacle at 1.0
     est = estimate(free_scene, sol)
+    # exact, no tolerance: lambda_h = 0 and (g - u_n)_- = 0 exactly when nothing touches
     assert est.eta_geometric == 0.0 and est.eta_complementarity == 0.0
     assert est.eta_0 > 0 and est.eta == pytest.approx(est.eta_0, rel=1e-15)
 
@@ -54,7 +55,7 @@ def test_indicators_sum_to_eta_squared_and_localise_at_contact():
     sol = solved(scene, scene.mesh.refined(3))
     est = estimate(scene, sol)
     assert est.indicators.sum() == pytest.approx(est.eta**2, rel=1e-12)
-    assert (est.indicators >= 0).all()
+    assert (est.indicators >= 0).all()  # exact: sums of squares
     assert est.eta**2 == pytest.approx(est.eta_0**2 + est.eta_geometric**2
                                        + est.eta_complementarity**2, rel=1e-14)
     # the largest indicator sits at the bottom (contact zone) or at the clamped corners

@@ -65,7 +65,8 @@ def test_segments_are_the_shortest_runs_with_h_over_H_at_most_half(lengths, expe
     seg = multiplier_segments(np.array(lengths, dtype=float))
     assert seg.tolist() == expected
     H = np.bincount(seg, np.array(lengths, dtype=float))
-    assert (np.array(lengths) / H[seg]).max() <= 0.5
+    # a ratio of sums of the given lengths: 1/2 up to a few ulps (the builder allows 1e-12)
+    assert (np.array(lengths) / H[seg]).max() <= 0.5 + 1e-12
 
 
 def test_exact_linear_solution_is_reproduced(compression_scene):
@@ -95,7 +96,8 @@ def test_reference_solution_satisfies_kkt_conditions():
     # and the same checks written out independently of formulations.kkt
     u, lam = sol.u[disc.elasticity.free], sol.multipliers
     qp = disc.qp
-    assert (lam >= 0).all()
+    # an interior point method's multipliers are >= 0 up to its tolerance 1e-9 (relative)
+    assert lam.min() >= -1e-9 * np.abs(lam).max()
     assert ((qp.B @ u - qp.G) / qp.row_scale).max() < 1e-9
     stationarity = qp.K @ u - qp.F + qp.B.T @ lam
     assert np.linalg.norm(stationarity) < 1e-6 * np.linalg.norm(qp.K @ u)

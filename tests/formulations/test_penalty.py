@@ -26,6 +26,7 @@ def max_penetration(sol):
 def test_pressure_is_non_negative_and_matches_the_active_set():
     sol = penalty_solution(1e-3)
     pressure = sol.pressure(np.linspace(0.0, 1.0, 7))
+    # exact, no tolerance: lambda_h is a positive part (np.maximum) divided by eps > 0
     assert pressure.min() >= 0.0 and pressure.max() > 0.0
     assert sol.active_constraints > 0
 

@@ -30,7 +30,9 @@ def test_no_nodal_penetration(solved):
 def test_reactions_are_non_negative_and_balance_the_pressure(solved):
     _, disc, sol = solved
     reactions = sol.details.reactions
-    assert reactions.min() >= 0.0 and reactions.max() > 0.0
+    # the reactions are the reference solver's multipliers, >= 0 up to its relative tolerance
+    # 1e-9 (Clarabel's 1e-10 on the scaled problem, 10x for the rescaling)
+    assert reactions.min() >= -1e-9 * reactions.max() and reactions.max() > 0.0
     # lumped recovery: int lambda_h = sum of the reactions up to the lumping of the ends of
     # the contact zone (one facet each); measured 0.3 % here
     assert sol.contact_force() == pytest.approx(reactions.sum(), rel=0.02)

@@ -17,7 +17,8 @@ def test_phases_account_for_the_fast_solve(tmp_path):
                            "t_fast_condense", "t_fast_iterate", "t_fast_condition",
                            "t_fast_back_substitute"}
     # the phases are disjoint parts of the solve: together no more than it, and most of it
-    assert 0.5 * row["t_fast_solve"] <= sum(phases.values()) <= row["t_fast_solve"]
+    # (1e-9 s of slack: a sum of seven differences of clock readings against one difference)
+    assert 0.5 * row["t_fast_solve"] <= sum(phases.values()) <= row["t_fast_solve"] + 1e-9
     frame = pd.DataFrame([row])
     frame["fast_over_linear"] = frame["t_fast_solve"] / frame["t_linear_solve"]
     frame["reference_over_fast"] = float("nan")

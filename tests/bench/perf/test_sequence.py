@@ -17,7 +17,8 @@ def test_a_sequence_is_timed_level_by_level_and_phase_by_phase(adaptive):
     assert adaptive["final_ndofs"] <= 3000
     phases = sum(adaptive[phase] for phase in LEVEL_PHASES) + adaptive["t_store"]
     # the phases are disjoint parts of the sequence: together no more than its wall time
-    assert 0 < phases <= adaptive["t_sequence"]
+    # (1e-9 s of slack: a sum of differences of clock readings against one difference)
+    assert 0 < phases <= adaptive["t_sequence"] + 1e-9
     assert adaptive["t_error"] > 0  # errors against the reference are part of every level
     assert adaptive["sequence_over_linear"] == pytest.approx(
         adaptive["t_sequence"] / adaptive["t_linear_finest"])

@@ -31,7 +31,8 @@ def test_paper_adaptive_run_is_ok_and_settles(adaptive_rows):
     rows = adaptive_rows
     assert all(r.status == "ok" for r in rows), [(r.level, r.reason) for r in rows]
     assert 2000 < rows[-1].ndofs <= 4000
-    assert all(r.max_h_over_H <= 0.5 for r in rows)
+    # h/H is a ratio of computed lengths: 1/2 holds to a few ulps (the builder allows 1e-12)
+    assert all(r.max_h_over_H <= 0.5 + 1e-12 for r in rows)
     energy = np.array([r.energy for r in rows])
     force = np.array([r.contact_force for r in rows])
     print("levels", [r.ndofs for r in rows], "energy", energy, "contact force", force)
@@ -121,9 +122,13 @@ def test_every_row_carries_the_stability_diagnostics(tmp_path):
             assert row.status == "ok" and not row.cycled and row.safeguard == ""
             changes = [int(c) for c in row.active_set_changes.split(",")]
             assert changes[-1] == 0 and len(changes) == row.iterations
-            assert row.condition_estimate >= 1.0
-            # one hump of pressure: TV / (2 max) = 1 (up to the P0 staircase's overshoot)
-            assert 1.0 <= row.pressure_oscillation < 1.05
+            # a condition number is >= 1; the estimate is a product of two computed norms,
+            # each exact to a few ulps, hence the 1e-12 relative slack
+            assert row.condition_estimate >= 1.0 - 1e-12
+            # one hump of pressure: TV / (2 max) = 1 (up to the P0 staircase's overshoot); TV
+            # is a sum of ~10^3 differences, each rounded to an ulp of the peak, so it can fall
+            # below 2 max by ~10^3 eps ~ 2e-13 (0.9999999999999999 was seen): 1e-12 slack
+            assert 1.0 - 1e-12 <= row.pressure_oscillation < 1.05
             assert np.isnan(row.inf_sup) == (formulation != "mixed")
     # the mixed method at h/H = 1/2 is inf-sup stable: beta_h bounded below, settling (the
     # hard case mixed-h/H measures the same against h/H = 1, where it decays like h)
