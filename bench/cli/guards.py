@@ -17,9 +17,12 @@ class InputError(ValueError):
 
 
 def check_output_folder(path: str | Path, option: str) -> Path:
-    """Create ``path`` if needed and prove it writable; else InputError naming the option."""
-    path = Path(path)
+    """Create ``path`` if needed and prove it writable; else InputError naming the option.
+    An empty value is refused: it would silently write into the current folder."""
     flag = f"--{option.replace('_', '-')}={str(path)!r}"
+    if not str(path).strip():
+        raise InputError(f"{flag} is empty; give a folder to write into")
+    path = Path(path)
     if path.exists() and not path.is_dir():
         raise InputError(f"{flag} is a file, not a folder; give a folder to write into")
     try:

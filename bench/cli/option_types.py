@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 import sys
 
+from bench.matrix.distributed import SchedulerError, scheduler_endpoint
 from bench.matrix.spec import parse_item
 from bench.perf.sequence import SEQUENCES
 from formulations.elasticity import ORDERS
@@ -114,3 +115,13 @@ def theta_value(text: str) -> float:
     if not 0.0 < value <= 1.0:
         raise argparse.ArgumentTypeError(f"theta={text!r} is not a number in (0, 1]")
     return value
+
+
+def scheduler_address(text: str) -> str:
+    """A Dask scheduler address, SCHEME://HOST:PORT (whether one answers there is checked
+    when the run starts, with a bounded wait)."""
+    try:
+        scheduler_endpoint(text)
+    except SchedulerError as error:
+        raise argparse.ArgumentTypeError(str(error)) from None
+    return text

@@ -11,10 +11,12 @@ from bench.cli.option_types import (
     non_negative_int,
     order_list,
     positive_int,
+    scheduler_address,
     sequence_budgets,
     theta_value,
 )
 from bench.hard import hard_case_names
+from bench.matrix.run import COMPARE_REFERENCE_DOFS
 from bench.perf.scaling import SIZES
 from bench.perf.sequence import SEQUENCES
 from bench.sequence.loop import STRATEGIES
@@ -30,10 +32,12 @@ def _scale_out_options(parser) -> None:
     parser.add_argument("--workers", type=non_negative_int("workers"), default=0,
                         help="run the sequences on a local Dask cluster of this many processes "
                              "(one thread each) (default: 0, in this process)")
-    parser.add_argument("--scheduler", default=None, metavar="ADDRESS",
+    parser.add_argument("--scheduler", type=scheduler_address, default=None,
+                        metavar="ADDRESS",
                         help="run the sequences on the existing Dask cluster at ADDRESS, e.g. "
                              "tcp://10.0.0.5:8786 (its workers need this package and --cache "
-                             "on shared storage)")
+                             "on shared storage); refused if no scheduler answers there within "
+                             "10 s")
     parser.add_argument("--cache", default=None, metavar="DIR",
                         help="folder of the cached overkill references (default: "
                              "$SIGNORINI_BENCH_CACHE or .cache/references)")
@@ -158,8 +162,9 @@ def _compare_parser(sub) -> None:
     compare.add_argument("--max-dofs", type=positive_int("max_dofs"), default=20000,
                          help="DOF budget per sequence (default: 20000)")
     compare.add_argument("--reference-dofs", type=positive_int("reference_dofs"),
-                         default=200000,
-                         help="DOF budget of the P3 overkill references (default: 200000)")
+                         default=COMPARE_REFERENCE_DOFS,
+                         help="DOF budget of the P3 overkill references (default: "
+                              f"{COMPARE_REFERENCE_DOFS})")
     _memory_option(compare)
     _scale_out_options(compare)
     compare.add_argument("--crosscheck-dofs", type=non_negative_int("crosscheck_dofs"),
@@ -167,6 +172,9 @@ def _compare_parser(sub) -> None:
                          "reference solver (default: 3000)")
     compare.add_argument("--out", default="results", help="results folder (default: results)")
     compare.add_argument("--reports", default="reports", help="report folder (default: reports)")
+    compare.add_argument("--readme", default=None,
+                         help="also replace the figures between the compare markers of this "
+                              "README (e.g. README.md): rows, sequences, hard verdicts, time")
 
 
 def _verify_parser(sub) -> None:

@@ -9,8 +9,10 @@ cache, which must be shared storage for a remote cluster (``--cache``)."""
 from __future__ import annotations
 
 import os
+import socket
 from dataclasses import replace
 from pathlib import Path
+from urllib.parse import urlsplit
 
 from bench.matrix.spec import SequenceSpec
 from bench.matrix.store import ResultStore, SequenceWriter
@@ -20,6 +22,41 @@ from bench.truth import truth_for
 
 SINGLE_THREAD = {name: "1" for name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS",
                                         "MKL_NUM_THREADS")}
+SCHEDULER_TIMEOUT = 10.0  # seconds to wait for a scheduler to answer before refusing the run
+SCHEDULER_SCHEMES = ("tcp", "tls")
+EXPECTED_ADDRESS = "SCHEME://HOST:PORT with SCHEME tcp or tls, e.g. tcp://10.0.0.5:8786"
+
+
+class SchedulerError(ValueError):
+    """A --scheduler address that is malformed or where no scheduler answers."""
+
+
+def scheduler_endpoint(address: str) -> tuple[str, int]:
+    """(host, port) of a Dask scheduler address; SchedulerError if it is not one."""
+    parts = urlsplit(address if "://" in address else f"tcp://{address}")
+    try:
+        port = parts.port
+    except ValueError:
+        port = None
+    if parts.scheme not in SCHEDULER_SCHEMES or not parts.hostname or port is None \
+            or parts.path not in ("", "/") or not 0 < port < 65536:
+        raise SchedulerError(f"scheduler={address!r} is not a Dask scheduler address; "
+                             f"expected {EXPECTED_ADDRESS}")
+    return parts.hostname, port
+
+
+def check_scheduler(address: str, timeout: float = SCHEDULER_TIMEOUT) -> None:
+    """Refuse (SchedulerError) an address where nothing accepts a connection within
+    ``timeout`` seconds, before any work starts."""
+    host, port = scheduler_endpoint(address)
+    try:
+        socket.create_connection((host, port), timeout=timeout).close()
+    except OSError as error:
+        reason = "timed out" if isinstance(error, TimeoutError) else (
+            error.strerror or type(error).__name__)
+        raise SchedulerError(f"scheduler={address!r}: no Dask scheduler answered ({reason}; "
+                             f"waited at most {timeout:g} s); expected the address of a "
+                             f"running scheduler, {EXPECTED_ADDRESS}") from None
 
 
 def sequence_task(spec: SequenceSpec, out: str, run: dict, cache: str | None,
@@ -46,7 +83,7 @@ def client_for(config):
     from dask.distributed import Client, LocalCluster
 
     if config.scheduler:
-        return Client(config.scheduler), None
+        return Client(config.scheduler, timeout=SCHEDULER_TIMEOUT), None
     cluster = LocalCluster(n_workers=config.workers, threads_per_worker=1, processes=True,
                            env=SINGLE_THREAD, dashboard_address=":0")
     client = Client(cluster)

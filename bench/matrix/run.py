@@ -10,11 +10,13 @@ from __future__ import annotations
 
 import json
 import os
+import sys
 from collections.abc import Callable
 from dataclasses import dataclass, fields
 
 import pandas as pd
 
+from bench.matrix.distributed import SchedulerError, check_scheduler, scheduler_endpoint
 from bench.matrix.harness import new_run_identity, run_specs, truth_name, write_truth_summary
 from bench.matrix.rates import write_rates
 from bench.matrix.spec import (
@@ -39,6 +41,7 @@ NAME_LISTS = {"scenes": scene_names, "formulations": formulation_names,
               "solvers": solver_names, "estimators": estimator_names,
               "strategies": lambda: list(STRATEGIES)}
 SWEPT = ("scenes", "formulations")  # lists whose items may carry name:key=v1|v2 sweeps
+COMPARE_REFERENCE_DOFS = 200000  # the default comparison's reference budget
 
 
 @dataclass(frozen=True)
@@ -96,6 +99,10 @@ class RunConfig:
                 raise ValueError(f"{name}={value!r} is not an integer >= 0")
         if self.backend is not None:
             check_backend(self.backend)
+        if not str(self.out).strip():
+            raise ValueError(f"out={self.out!r} is empty; give an output folder")
+        if self.scheduler is not None:
+            scheduler_endpoint(self.scheduler)
         self.specs()[0].loop_config(self.max_memory_gib)  # validates the loop's options
 
     def specs(self) -> list[SequenceSpec]:
@@ -141,8 +148,16 @@ def prepare_truths(specs: list[SequenceSpec], out, crosscheck: bool = False) -> 
 
 def _truths(specs: list[SequenceSpec], out, crosscheck: bool) -> dict:
     judged = {}  # per truth: the largest budget and order it judges, and a spec to build it
+    scenes, checked = {}, set()
     for spec in specs:
         check_formulation_options(spec)
+        scene_key = (spec.scene, spec.scene_parameters)
+        if scene_key not in scenes:
+            scenes[scene_key] = build_scene(spec)
+        option_key = (scene_key, spec.formulation, spec.formulation_options, spec.order)
+        if option_key not in checked:
+            check_formulation_options(spec, scenes[scene_key])
+            checked.add(option_key)
         dofs, order, first = judged.get(truth_name(spec), (0, 0, spec))
         judged[truth_name(spec)] = (max(dofs, spec.max_dofs), max(order, spec.order), first)
     truths = {}
@@ -150,6 +165,12 @@ def _truths(specs: list[SequenceSpec], out, crosscheck: bool) -> dict:
         truths[name] = truth_for(build_scene(spec), spec.reference_dofs, dofs, order,
                                  crosscheck)
         write_truth_summary(out, name, truths[name])
+        if truths[name] is None:
+            print(f"note: scene {spec.scene!r} has no exact solution and no reference budget "
+                  "was given, so its errors and effectivity indices are not measured (NaN); "
+                  "give --reference-dofs N (RunConfig.reference_dofs; compare uses "
+                  f"{COMPARE_REFERENCE_DOFS}) to measure them against a cached P3 reference",
+                  file=sys.stderr)
     return truths
 
 
@@ -167,6 +188,11 @@ def run(config: RunConfig, on_level: Callable[[LevelResult], None] | None = None
     todo = [s for s in specs if s.key not in finished]
     reused = tuple(s.key for s in specs if s.key in finished)
     identity = new_run_identity()
+    if config.scheduler:
+        try:
+            check_scheduler(config.scheduler)
+        except SchedulerError as error:
+            raise RunRefused(str(error)) from None
     # every spec, reused ones too: truth.json then describes the whole table
     truths = prepare_truths(specs, store.out, config.reference_crosscheck)
     (store.out / "run.json").write_text(json.dumps(

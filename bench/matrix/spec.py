@@ -115,10 +115,17 @@ def build_scene(spec: SequenceSpec):
     return get_scene(spec.scene, **dict(spec.scene_parameters))
 
 
-def check_formulation_options(spec: SequenceSpec) -> None:
-    """Refuse an option ``discretise`` does not take; the order is its own dimension."""
+def check_formulation_options(spec: SequenceSpec, scene=None) -> None:
+    """Refuse an option ``discretise`` does not take; the order is its own dimension. With the
+    spec's ``scene``, also every value: the formulation discretises the scene's coarsest mesh
+    with them, so its own checks refuse a bad value before any run."""
     if any(k == "order" for k, _ in spec.formulation_options):
         raise ValueError(f"formulation {spec.formulation!r}: give the polynomial order with "
                          "--order (RunConfig.orders), not as a formulation option")
-    check_parameters("formulation", spec.formulation, spec.formulation_options,
-                     get_formulation(spec.formulation))
+    discretise = get_formulation(spec.formulation)
+    check_parameters("formulation", spec.formulation, spec.formulation_options, discretise)
+    if scene is not None:
+        try:
+            discretise(scene, scene.mesh, order=spec.order, **dict(spec.formulation_options))
+        except (ValueError, TypeError) as error:
+            raise ValueError(f"formulation {spec.formulation!r}: {error}") from None

@@ -87,6 +87,10 @@ def load_or_build(scene, max_dofs: int, recipe: str = PRIMARY) -> Reference:
                   "rebuilding it", file=sys.stderr)
             path.unlink(missing_ok=True)
             _checksum_path(path).unlink(missing_ok=True)
+    print(f"building the {recipe} reference of scene {scene.name!r} with up to {max_dofs} "
+          f"DOFs into {path} (once; later runs load it)", file=sys.stderr, flush=True)
     ref = build_reference(scene, max_dofs, recipe)
     save_reference(ref, path)
+    print(f"built the {scene.name!r} reference: {ref.ndofs} DOFs in {ref.build_seconds:.1f} s",
+          file=sys.stderr, flush=True)
     return ref

@@ -19,6 +19,7 @@ from __future__ import annotations
 import functools
 import hashlib
 import json
+import sys
 import time
 from dataclasses import asdict, dataclass
 
@@ -120,6 +121,27 @@ class TruthError(ValueError):
     """A reference that cannot be built or cannot be trusted for the runs it would judge."""
 
 
+class LevelProgress:
+    """Progress of a long sequence on standard error: one line rewritten in place on a
+    terminal, one line per level otherwise (level, DOFs, elapsed seconds)."""
+
+    def __init__(self, title: str, max_dofs: int, stream=None):
+        self.stream = sys.stderr if stream is None else stream
+        self.live = self.stream.isatty()
+        self.title, self.max_dofs, self.start = title, max_dofs, time.perf_counter()
+
+    def __call__(self, level: int, ndofs: int) -> None:
+        line = (f"[{self.title}] level {level:2d}: {ndofs:9d} DOFs (budget {self.max_dofs}), "
+                f"{time.perf_counter() - self.start:6.1f} s elapsed")
+        self.stream.write(f"\r{line} " if self.live else f"{line}\n")
+        self.stream.flush()
+
+    def close(self) -> None:
+        if self.live:
+            self.stream.write("\n")
+            self.stream.flush()
+
+
 def reference_levels(scene, max_dofs: int, recipe: Recipe):
     """The recipe's adaptive sequence: yields (ndofs, solution, energy-norm difference to the
     level before or None); TruthError if a level fails."""
@@ -144,7 +166,9 @@ def reference_levels(scene, max_dofs: int, recipe: Recipe):
 def build_reference(scene, max_dofs: int, recipe: str = PRIMARY) -> Reference:
     start = time.perf_counter()
     ndofs, differences, sol = [], [], None
+    show = LevelProgress(f"reference {scene.name}/{recipe}", max_dofs)
     for n, level_solution, difference in reference_levels(scene, max_dofs, RECIPES[recipe]):
+        show(len(ndofs), n)
         ndofs.append(n)
         sol = level_solution
         if difference is not None:
@@ -153,6 +177,7 @@ def build_reference(scene, max_dofs: int, recipe: str = PRIMARY) -> Reference:
         raise TruthError(f"reference_dofs={max_dofs} leaves the {scene.name!r} reference one "
                          f"level ({ndofs[-1]} DOFs): its own error cannot be estimated; "
                          "give a larger budget")
+    show.close()
     bar = error_bar(ndofs, differences)
     s, values = _sampled_pressure(sol)
     return Reference(key=reference_key(scene, max_dofs, recipe), recipe=recipe,
