@@ -31,11 +31,16 @@ class ResultsError(ValueError):
 
 
 def read_results(folder: str | Path) -> pd.DataFrame | None:
-    """The rows of ``folder/results.parquet`` (None if there is none). An unreadable parquet
-    falls back to the CSV mirror when that is intact (with a note on standard error); when
+    """The rows of ``folder`` (None if it has none). The partitions in ``sequences/`` are the
+    source of truth: when ``results.parquet`` is missing, unreadable or holds other rows than
+    they do, both tables are rebuilt from them (with a note on standard error). Without
+    partitions, an unreadable parquet falls back to the CSV mirror when that is intact; when
     both are unreadable, ResultsError names the file and what to do."""
     folder = Path(folder)
     parquet, csv = folder / "results.parquet", folder / "results.csv"
+    partitions = folder / "sequences"
+    if any(partitions.glob("*.parquet")):
+        return _rebuilt_if_stale(folder)
     if not parquet.exists():
         return None
     try:
@@ -51,6 +56,38 @@ def read_results(folder: str | Path) -> pd.DataFrame | None:
                            "away or rerun with --overwrite") from None
     print(f"note: {why}; using its CSV mirror {csv} ({len(table)} rows)", file=sys.stderr)
     return table
+
+
+def _rebuilt_if_stale(folder: Path) -> pd.DataFrame:
+    """The consolidated table of ``folder``'s partitions; the tables on disk are rewritten
+    from them if they are missing, unreadable or differ in their rows."""
+    parquet, csv = folder / "results.parquet", folder / "results.csv"
+    table = partition_table(folder / "sequences")
+    try:
+        on_disk = read_snapshot(parquet)
+        csv_rows = len(pd.read_csv(csv, usecols=["sequence_key"]))
+        why = None if len(on_disk) == len(table) == csv_rows and \
+            set(on_disk["sequence_key"]) == set(table["sequence_key"]) else \
+            f"{parquet} or {csv.name} holds other rows than the partitions"
+    except Exception as error:  # missing or damaged: pyarrow and pandas raise several types
+        why = f"{parquet} or {csv.name} is missing or unreadable " \
+              f"({type(error).__name__}: {error})"
+    if why is None:
+        return on_disk
+    store = ResultStore(folder)
+    table = store.consolidate().reset_index(drop=True)
+    print(f"note: {why}; rebuilt both from the partitions in {store.partitions} "
+          f"({len(table)} rows)", file=sys.stderr)
+    return table
+
+
+def partition_table(partitions: Path) -> pd.DataFrame:
+    """Every row of the partitions ``partitions/*.parquet``, with every column."""
+    frames = [read_snapshot(path) for path in sorted(partitions.glob("*.parquet"))]
+    frames = [f for f in frames if len(f)]
+    if not frames:
+        return pd.DataFrame(columns=COLUMNS)
+    return with_labels(pd.concat(frames, ignore_index=True).reindex(columns=COLUMNS))
 
 
 def read_snapshot(path: Path) -> pd.DataFrame:
@@ -143,11 +180,7 @@ class ResultStore:
 
     def table(self) -> pd.DataFrame:
         """All rows in the folder, from every partition: earlier runs and this run's."""
-        frames = [read_snapshot(path) for path in sorted(self.partitions.glob("*.parquet"))]
-        frames = [f for f in frames if len(f)]
-        if not frames:
-            return pd.DataFrame(columns=COLUMNS)
-        return with_labels(pd.concat(frames, ignore_index=True).reindex(columns=COLUMNS))
+        return partition_table(self.partitions)
 
     def consolidate(self) -> pd.DataFrame:
         """results.parquet and results.csv from every partition (under the folder's lock)."""

@@ -2,6 +2,7 @@
 recovery, never in a traceback or a machine out of memory."""
 
 import os
+import shutil
 import signal
 import subprocess
 import sys
@@ -137,23 +138,50 @@ def small_results(tmp_path):
     return out
 
 
-def test_a_truncated_parquet_falls_back_to_its_csv_mirror(small_results, tmp_path, capsys):
+def test_a_truncated_parquet_without_partitions_falls_back_to_its_csv_mirror(small_results,
+                                                                             tmp_path, capsys):
     parquet = small_results / "results.parquet"
+    rows = len(pd.read_csv(small_results / "results.csv"))
+    shutil.rmtree(small_results / "sequences")  # a folder of an older version: tables only
     parquet.write_bytes(parquet.read_bytes()[:200])
     assert main(["report", "--results", str(small_results), "--out", str(tmp_path / "rep")]) == 0
     assert "using its CSV mirror" in capsys.readouterr().err
-    # a run into the folder rebuilds the tables from the sequences' partitions
-    rows = len(pd.read_csv(small_results / "results.csv"))
+    # a run into the folder takes the CSV rows over as a partition and rebuilds the tables
     assert main(["run", "--max-dofs", "300", "--out", str(small_results)]) == 0
     assert len(pd.read_parquet(parquet)) == rows
 
 
-def test_a_results_folder_with_both_tables_broken_is_named(small_results, tmp_path, capsys):
+def test_both_tables_broken_without_partitions_are_named(small_results, tmp_path, capsys):
+    shutil.rmtree(small_results / "sequences")
     (small_results / "results.parquet").write_bytes(b"PAR1 garbage")
     (small_results / "results.csv").write_bytes(b"\x00\x01 not a table")
     assert main(["report", "--results", str(small_results), "--out", str(tmp_path / "x")]) == 2
     err = capsys.readouterr().err
     assert "results.parquet is unreadable" in err and "--overwrite" in err
+
+
+@pytest.mark.parametrize("damage", ["both-garbled", "header-only-csv", "missing", "stale"])
+def test_damaged_tables_are_rebuilt_from_the_partitions(small_results, tmp_path, capsys,
+                                                        damage):
+    parquet, csv = small_results / "results.parquet", small_results / "results.csv"
+    rows = len(pd.read_parquet(parquet))
+    if damage == "both-garbled":
+        parquet.write_bytes(b"PAR1 garbage")
+        csv.write_bytes(b"\x00\x01 not a table")
+    elif damage == "header-only-csv":  # the case that once gave "0 result rows"
+        parquet.write_bytes(parquet.read_bytes()[:4])
+        csv.write_text("scene,level\n")
+    elif damage == "missing":
+        parquet.unlink()
+        csv.unlink()
+    else:  # readable, but a row short of the partitions
+        pd.read_parquet(parquet).iloc[:-1].to_parquet(parquet)
+    assert main(["report", "--results", str(small_results), "--out", str(tmp_path / "r")]) == 0
+    assert "rebuilt both from the partitions" in capsys.readouterr().err
+    assert len(pd.read_parquet(parquet)) == len(pd.read_csv(csv)) == rows
+    assert f"{rows} result rows" in (tmp_path / "r" / "README.md").read_text()
+    main(["report", "--results", str(small_results), "--out", str(tmp_path / "r")])
+    assert "rebuilt" not in capsys.readouterr().err  # sound again: read as it is
 
 
 def test_names_from_a_results_table_cannot_escape_the_report_folder(small_results, tmp_path):
