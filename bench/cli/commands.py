@@ -5,9 +5,11 @@
 from __future__ import annotations
 
 import sys
+import time
 
 import pandas as pd
 
+from bench.cli.compare_block import check_readme, write_compare_block
 from bench.cli.guards import InputError, check_output_folders
 from bench.cli.parser import build_parser
 from bench.cli.progress import Progress
@@ -138,12 +140,21 @@ def compare_command(args) -> int:
         crosscheck_dofs=args.crosscheck_dofs, max_memory_gib=args.max_memory, out=args.out,
         overwrite=True, workers=args.workers, scheduler=args.scheduler, cache=args.cache,
         command=" ".join(["python -m bench", *args.argv]))
+    if args.readme is not None:
+        try:
+            check_readme(args.readme)
+        except ValueError as error:
+            raise InputError(str(error)) from None
+    start = time.perf_counter()
     status = run_config(config)
     if config is None:
         return status
     args.case = None
     hard_status = hard_command(args)
     print(f"wrote {write_report(read_results(args.out), args.reports, args.out)}")
+    if args.readme is not None:
+        write_compare_block(args.readme, args.out, time.perf_counter() - start)
+        print(f"wrote the compare figures into {args.readme}")
     return status or hard_status
 
 

@@ -1,0 +1,49 @@
+"""The default comparison's figures for the README, written between its ``compare`` markers by
+``python -m bench compare --readme README.md``, so that every count there comes from a run."""
+
+from __future__ import annotations
+
+import platform
+from pathlib import Path
+
+import pandas as pd
+
+from bench.hard import check_expected
+from bench.perf.scaling import replace_in_readme
+from bench.verify import load_expected
+
+README_START, README_END = "<!-- compare:start -->", "<!-- compare:end -->"
+
+
+def compare_block(table: pd.DataFrame, hard: pd.DataFrame | None, seconds: float) -> str:
+    """One Markdown paragraph: rows by status, sequences, hard verdicts and wall time."""
+    statuses = table["status"].value_counts()
+    by_status = ", ".join(f"{statuses[s]} {s}" for s in sorted(statuses.index))
+    sequences = table["sequence_key"].nunique()
+    text = (f"Last `python -m bench compare` on this machine ({platform.machine()}, Python "
+            f"{platform.python_version()}): **{len(table)} result rows** ({by_status}) in "
+            f"{sequences} sequences")
+    if hard is not None:
+        checks = check_expected(hard, load_expected().get("hard", []))
+        passed = sum(c["passed"] for c in checks)
+        text += f"; {passed} of {len(checks)} hard verdicts as expected"
+    return text + f"; {seconds:.0f} s wall time in all (run, hard cases and report)."
+
+
+def write_compare_block(readme: str | Path, results: str | Path, seconds: float) -> None:
+    """Replace the README's compare block with the figures of the results folder."""
+    from bench.matrix.store import read_results
+
+    hard_csv = Path(results) / "hard.csv"
+    hard = pd.read_csv(hard_csv) if hard_csv.exists() else None
+    replace_in_readme(readme, README_START, README_END,
+                      compare_block(read_results(results), hard, seconds))
+
+
+def check_readme(readme: str | Path) -> None:
+    """Refuse, before the comparison runs, a README that cannot take the block."""
+    path = Path(readme)
+    text = path.read_text() if path.is_file() else ""
+    if README_START not in text or README_END not in text:
+        raise ValueError(f"--readme={str(readme)!r} is not a file with the markers "
+                         f"{README_START} ... {README_END}")
