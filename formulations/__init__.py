@@ -4,7 +4,7 @@ Importing this package registers every formulation module listed below; adding a
 one new module with a ``@register_formulation`` ``discretise`` function and one import line here.
 """
 
-from formulations import mixed, penalty, vi  # noqa: F401  (register themselves)
+from formulations import mixed, nitsche, penalty, vi  # noqa: F401  (register themselves)
 from formulations.base import (
     STATUS_FAILED,
     STATUS_INACCURATE,

@@ -37,7 +37,7 @@ def inf_sup_constant(discretisation, backend: str | None = None,
     """beta_h (see the module docstring); NaN for a formulation without a multiplier space.
     ``condensed``: B K^-1 B' if the caller already has it (else computed here)."""
     qp, multiplier_gram = discretisation.qp, discretisation.multiplier_gram
-    if multiplier_gram is None or qp.m == 0:
+    if multiplier_gram is None or qp is None or qp.m == 0:
         return float("nan")
     if condensed is None:
         solve = factorise(qp.K, backend)

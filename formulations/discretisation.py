@@ -11,27 +11,33 @@ from formulations.base import STATUS_FAILED, ContactQP, DiscreteSolution, QPSolu
 from formulations.contact import ContactTrace
 from formulations.elasticity import Elasticity
 from formulations.kkt import final_status, qp_residuals
-from formulations.solvers import get_solver
+from formulations.semismooth import SemismoothSystem
+from formulations.solvers.registry import SOLVERS, SYSTEM_SOLVERS
 
 
 @dataclass(frozen=True, eq=False)
 class Discretisation:
-    """What a formulation's ``discretise`` returns: the assembled QP on the free DOFs and how to
-    turn a solver's answer into a ``DiscreteSolution`` (``recover(qp_solution, residuals,
-    status, reason)``). ``row_coordinate`` places each constraint row on Gamma_C (the scene's
-    contact coordinate of its segment's middle or its node). ``multiplier_gram`` (optional)
-    makes the discrete inf-sup constant computable."""
+    """What a formulation's ``discretise`` returns: the assembled QP on the free DOFs (or None
+    when the formulation has no QP form, ``no_qp`` saying why), optionally a
+    ``SemismoothSystem`` (formulations.semismooth), and how to turn a solver's answer into a
+    ``DiscreteSolution`` (``recover(qp_solution, residuals, status, reason)``; the answer's u
+    and multipliers are those of the problem it solved).
+    ``row_coordinate`` places each constraint row (or quadrature point of a system) on Gamma_C
+    (the scene's contact coordinate). ``multiplier_gram`` (optional) makes the discrete inf-sup
+    constant computable."""
 
     formulation: str
     elasticity: Elasticity
     trace: ContactTrace
-    qp: ContactQP
+    qp: ContactQP | None
     recover: Callable[[QPSolution, Residuals, str, str], DiscreteSolution]
     row_coordinate: np.ndarray
     transfer: Callable[[DiscreteSolution], np.ndarray] | None = None
     # Gram matrix (its diagonal if 1-D) of the mesh-dependent H^-1/2 norm of the multipliers, for
     # formulations whose constraint rows are a multiplier space (formulations.diagnostics)
     multiplier_gram: np.ndarray | None = None
+    system: SemismoothSystem | None = None
+    no_qp: str = ""  # why qp is None
 
     def warm_start(self, previous: DiscreteSolution) -> np.ndarray:
         """Initial multipliers for this QP from a solution on another (coarser) mesh: the
@@ -44,6 +50,23 @@ class Discretisation:
     @property
     def ndofs(self) -> int:
         return self.elasticity.ndofs
+
+    @property
+    def n_constraints(self) -> int:
+        """Quadrature points of the system, or constraint rows of the QP."""
+        return self.system.nq if self.system is not None else self.qp.m
+
+    @property
+    def objective_scale(self) -> float:
+        """Young's modulus, the scale of K."""
+        return (self.qp or self.system).objective_scale
+
+    @property
+    def gap_scale(self) -> float:
+        """The largest gap (a length; 0 if every gap is 0)."""
+        if self.qp is not None:
+            return self.qp.gap_scale
+        return float(np.abs(self.system.gap).max(initial=0.0))
 
 
 def discrete_solution(formulation: str, elasticity: Elasticity, trace: ContactTrace,
@@ -61,19 +84,44 @@ def discrete_solution(formulation: str, elasticity: Elasticity, trace: ContactTr
         multipliers=np.maximum(answer.multipliers, 0.0), **specific)
 
 
+def uses_system(discretisation: Discretisation, solver: str) -> bool:
+    """Whether ``solver`` solves the discretisation's semismooth system (else its QP)."""
+    return discretisation.system is not None and solver in SYSTEM_SOLVERS.names()
+
+
+def why_unsolvable(discretisation: Discretisation, solver: str) -> str | None:
+    """Why ``solver`` has no method for what the discretisation offers, or None."""
+    if uses_system(discretisation, solver) or (discretisation.qp is not None
+                                               and solver in SOLVERS.names()):
+        return None
+    if discretisation.qp is None:
+        return (f"solver {solver!r} needs a QP and formulation "
+                f"{discretisation.formulation!r} has none here: {discretisation.no_qp}")
+    return f"solver {solver!r} has no method for a QP"
+
+
 def solve(discretisation: Discretisation, solver: str, **options) -> DiscreteSolution:
-    """Solve with the named solver, compute the KKT residuals from the returned arrays, and
-    give the final status. A failed solve carries status ``failed`` and NaN arrays (never
-    silently)."""
-    answer = get_solver(solver)(discretisation.qp, **options)
+    """Solve with the named solver, compute the residuals (KKT for a QP, the nonlinear
+    residual for a system) from the returned arrays, and give the final status. A failed
+    solve carries status ``failed`` and NaN arrays (never silently)."""
+    why = why_unsolvable(discretisation, solver)
+    if why is not None:
+        raise ValueError(why)
+    system = discretisation.system if uses_system(discretisation, solver) else None
+    if system is not None:
+        answer = SYSTEM_SOLVERS.get(solver)(system, **options)
+        n, m = system.n, system.nq
+    else:
+        answer = SOLVERS.get(solver)(discretisation.qp, **options)
+        n, m = discretisation.qp.n, discretisation.qp.m
     if answer.u is None or answer.multipliers is None:
-        nan = np.full(discretisation.qp.n, np.nan)
-        answer = QPSolution(nan, np.full(discretisation.qp.m, np.nan), answer.status or
+        answer = QPSolution(np.full(n, np.nan), np.full(m, np.nan), answer.status or
                             STATUS_FAILED, answer.reason, answer.iterations, answer.solve_time,
                             answer.solver, answer.backend, answer.diagnostics)
         residuals = Residuals(*(4 * [float("nan")]))
         status, reason = final_status(answer, None)
     else:
-        residuals = qp_residuals(discretisation.qp, answer.u, answer.multipliers)
+        residuals = (system.residuals(answer.u) if system is not None else
+                     qp_residuals(discretisation.qp, answer.u, answer.multipliers))
         status, reason = final_status(answer, residuals)
     return discretisation.recover(answer, residuals, status, reason)

@@ -40,6 +40,18 @@ class PointEvaluation:
         cols = self.basis.element_dofs[:, self.cells].ravel()
         return sparse.csr_matrix((vals, (rows, cols)), shape=(self.size, self.basis.N))
 
+    def normal_stress_matrix(self, normal: np.ndarray, lame: tuple[float, float]
+                             ) -> sparse.csr_matrix:
+        """The sparse operator u -> sigma_nn(u_h)(x_i) = n_i . sigma(u_h) n_i with
+        sigma = lam tr(eps) I + 2 mu eps (docs/theory.md, section 1)."""
+        lam, mu = lame
+        vals = np.concatenate([lam * (g[0, 0] + g[1, 1])
+                               + 2 * mu * np.einsum("in,ijn,jn->n", normal, g, normal)
+                               for g in self.gradients])
+        rows = np.tile(np.arange(self.size), len(self.gradients))
+        cols = self.basis.element_dofs[:, self.cells].ravel()
+        return sparse.csr_matrix((vals, (rows, cols)), shape=(self.size, self.basis.N))
+
     def value(self, u: np.ndarray) -> np.ndarray:
         """u_h at the points, shape (2, n)."""
         dofs = self.basis.element_dofs[:, self.cells]

@@ -52,7 +52,7 @@ def _record(case, scene, formulation, disc, sol, variant, level) -> dict:
                 condition_estimate=sol.diagnostics.condition_estimate,
                 inf_sup=np.nan, pressure_oscillation=pressure_oscillation(sol),
                 contact_force=sol.contact_force() if sol.status != STATUS_FAILED else np.nan,
-                active_constraints=sol.active_constraints, n_constraints=disc.qp.m,
+                active_constraints=sol.active_constraints, n_constraints=disc.n_constraints,
                 penetration=penetration(scene, sol) if sol.status != STATUS_FAILED else np.nan,
                 finding="")
 

@@ -13,7 +13,8 @@ from bench.sequence.loop import LevelResult, run_sequence
 from bench.sequence.rows import ResultRow, identity_columns
 from estimators.base import ESTIMATORS
 from formulations import STATUS_FAILED, STATUS_SKIPPED
-from formulations.registry import FORMULATIONS
+from formulations.discretisation import why_unsolvable
+from formulations.registry import FORMULATIONS, get_formulation
 from formulations.solvers.registry import SOLVERS
 from scenes import Scene
 
@@ -25,11 +26,18 @@ class Outcome:
     rows: tuple[ResultRow, ...] = ()
 
 
-def why_skipped(scene: Scene, formulation: str, solver: str, estimator: str) -> str | None:
-    """The reason a combination is impossible (declared by the registrations), or None."""
-    return (FORMULATIONS.why_not(formulation, scene=scene)
-            or SOLVERS.why_not(solver, scene=scene, formulation=formulation)
-            or ESTIMATORS.why_not(estimator, scene=scene, formulation=formulation))
+def why_skipped(scene: Scene, formulation: str, solver: str, estimator: str,
+                options: dict | None = None, order: int = 1) -> str | None:
+    """The reason a combination is impossible (declared by the registrations, or no method of
+    the solver for the problem the formulation offers with these options), or None."""
+    reason = (FORMULATIONS.why_not(formulation, scene=scene)
+              or (SOLVERS.why_not(solver, scene=scene, formulation=formulation)
+                  if solver in SOLVERS.names() else None)
+              or ESTIMATORS.why_not(estimator, scene=scene, formulation=formulation))
+    if reason is not None:
+        return reason
+    coarse = get_formulation(formulation)(scene, scene.mesh, order=order, **(options or {}))
+    return why_unsolvable(coarse, solver)
 
 
 def run_columns(spec: SequenceSpec, run: dict) -> dict:
@@ -65,7 +73,8 @@ def run_spec(spec: SequenceSpec, run: dict, out, truth_of: Callable[[Scene], obj
     try:
         scene = build_scene(spec)
         check_formulation_options(spec)
-        reason = why_skipped(scene, spec.formulation, spec.solver, spec.estimator)
+        reason = why_skipped(scene, spec.formulation, spec.solver, spec.estimator,
+                             dict(spec.formulation_options), spec.order)
         if reason is not None:
             record(whole_sequence_row(names, STATUS_SKIPPED, reason))
             return STATUS_SKIPPED  # also its end reason

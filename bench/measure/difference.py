@@ -18,10 +18,9 @@ def solution_difference(discretisation, solution, other) -> tuple[float, float]:
     du = solution.u - other.u
     t = np.linspace(0.0, 1.0, PRESSURE_SAMPLES)
     lam, lam_other = solution.pressure(t), other.pressure(t)
-    qp = discretisation.qp
-    scale = max(np.sqrt(other.u @ K @ other.u), np.sqrt(qp.objective_scale) * qp.gap_scale,
-                1e-300)
-    pressure_scale = max(np.abs(lam_other).max(), qp.objective_scale * qp.gap_scale
+    young, gap = discretisation.objective_scale, discretisation.gap_scale
+    scale = max(np.sqrt(other.u @ K @ other.u), np.sqrt(young) * gap, 1e-300)
+    pressure_scale = max(np.abs(lam_other).max(), young * gap
                          / discretisation.trace.length.sum(), 1e-300)
     return (float(np.sqrt(du @ K @ du) / scale),
             float(np.abs(lam - lam_other).max() / pressure_scale))

@@ -84,7 +84,7 @@ def level_columns(disc, sol, mesh, options: dict) -> dict:
         ndofs=disc.ndofs, n_elements=mesh.t.shape[1], h_max=float(h.max()),
         h_min=float(h.min()), max_h_over_H=sol.max_h_over_H, energy=sol.energy,
         contact_force=sol.contact_force(), active_constraints=sol.active_constraints,
-        n_constraints=disc.qp.m, iterations=sol.iterations, backend=sol.backend,
+        n_constraints=disc.n_constraints, iterations=sol.iterations, backend=sol.backend,
         warm_started="warm_start" in options, t_solve=sol.solve_time, status=sol.status,
         reason=sol.reason, **vars(sol.residuals))
 

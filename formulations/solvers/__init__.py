@@ -1,11 +1,14 @@
 """Solvers for the discrete contact problems; importing registers each module listed here."""
 
-from formulations.solvers import active_set, reference  # noqa: F401  (registers them)
+from formulations.solvers import active_set, reference, semismooth_newton  # noqa: F401
 from formulations.solvers.registry import (
     get_solver,
+    get_system_solver,
     register_solver,
+    register_system_solver,
     solver_descriptions,
     solver_names,
 )
 
-__all__ = ["get_solver", "register_solver", "solver_descriptions", "solver_names"]
+__all__ = ["get_solver", "get_system_solver", "register_solver", "register_system_solver",
+           "solver_descriptions", "solver_names"]

@@ -1,0 +1,152 @@
+"""``nitsche``: Nitsche's method for unilateral contact (Chouly, Hild, Renard; docs/theory.md,
+section 12).
+
+With the outer normal n, the constraint u_n <= g, sigma_nn = n . sigma n, the Nitsche pressure
+P_gamma(u) = sigma_nn(u) + gamma (g - u_n) and [x]_- = min(x, 0), find u_h in V_h with
+
+    a(u_h, v) - theta/gamma (sigma_nn(u_h), sigma_nn(v))_C
+        + 1/gamma ([P_gamma(u_h)]_-, theta sigma_nn(v) - gamma v_n)_C = L(v)   for all v,
+
+gamma = gamma_0 E / h_F on each contact facet F (GetFEM writes gamma_0 h for the inverse,
+1/gamma). The discrete pressure is lambda_h = -[P_gamma(u_h)]_- >= 0, a function of u_h on
+every point of Gamma_C. theta = 1 (symmetric, the default), 0 or -1 (skew-symmetric) is the
+option ``theta`` (any value in [-1, 1] is accepted); gamma_0 the option ``gamma_0``.
+
+The contact integrals use p + 1 Gauss points per facet (exact for the smooth parts, degree 2p;
+the kink of [.]_- inside a facet costs O(h^2p+2) per facet, far below the discretisation
+error). The problem is a ``SemismoothSystem``; for theta = 1 it is also the optimality
+condition of the convex functional
+
+    J(u) = 1/2 a(u, u) - L(u) - 1/(2 gamma) ||sigma_nn(u)||^2_C + 1/(2 gamma) ||[P_gamma(u)]_-||^2_C
+
+(convex when gamma_0 is large enough, docs/theory.md 12.2), written as a QP with one slack per
+Gauss point, [x]_-^2 = min {s^2 : s >= -x, s >= 0}, so that the reference solver can judge it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+from scipy import sparse
+from skfem import MeshTri
+
+from formulations.base import ContactQP, DiscreteSolution, QPSolution, Residuals
+from formulations.contact import contact_trace, gauss_legendre
+from formulations.discretisation import Discretisation, discrete_solution
+from formulations.elasticity import assemble_elasticity, check_order
+from formulations.evaluation import evaluate_on_trace
+from formulations.registry import register_formulation
+from formulations.semismooth import SemismoothSystem
+from scenes import Scene
+from scenes.base import is_number
+
+# gamma_0 of gamma = gamma_0 E / h_F: large enough for the symmetric variant to be coercive
+# at every order here (docs/theory.md 12.2: the smallest coercive gamma_0 measured on the paper
+# scene is 0.9 (P1), 3.1 (P2), 6.6 (P3)), small enough to keep the contact block within a
+# factor ~1e2 of the stiffness
+DEFAULT_GAMMA_0 = 100.0
+
+
+@dataclass(frozen=True, eq=False)
+class NitscheDetails:
+    """Nitsche's own numbers: its parameters and gamma per contact facet."""
+
+    theta: float
+    gamma_0: float
+    gamma: np.ndarray
+
+
+def convex_form(system: SemismoothSystem) -> ContactQP:
+    """The theta = 1 system as a QP in (u, s') with s' = s / gamma a length (module
+    docstring): min 1/2 u'(K - S'(W/gamma)S)u - F'u + 1/2 s'(W gamma)s' subject to
+    N u - S u / gamma - s' <= g and -s' <= 0."""
+    nq = system.nq
+    eye = sparse.identity(nq, format="csr")
+    K = system.K - system.S.T @ sparse.diags(system.weight / system.gamma) @ system.S
+    rows = system.N - sparse.diags(1.0 / system.gamma) @ system.S
+    return ContactQP(K=sparse.block_diag([K, sparse.diags(system.weight * system.gamma)],
+                                         format="csr"),
+                     F=np.concatenate([system.F, np.zeros(nq)]),
+                     B=sparse.bmat([[rows, -eye], [None, -eye]], format="csr"),
+                     G=np.concatenate([system.gap, np.zeros(nq)]), row_scale=np.ones(2 * nq),
+                     objective_scale=system.objective_scale)
+
+
+def check_options(theta, gamma_0) -> None:
+    if not (is_number(theta) and np.isfinite(theta) and -1.0 <= theta <= 1.0):
+        raise ValueError(f"theta={theta!r} is not a number in [-1, 1] (1: symmetric, "
+                         "0, -1: skew-symmetric)")
+    if not (is_number(gamma_0) and np.isfinite(gamma_0) and gamma_0 > 0):
+        raise ValueError(f"gamma_0={gamma_0!r} is not a finite number > 0")
+
+
+def pressure_function(scene: Scene, elasticity, trace, gamma_facet: np.ndarray,
+                      u_free: np.ndarray):
+    """lambda_h(t) = -min(P_gamma(u_h), 0) at local coordinates t of every contact facet."""
+    u = elasticity.expand(u_free)
+
+    def pressure(t):
+        t = np.asarray(t, dtype=float)
+        at = evaluate_on_trace(elasticity.basis, trace, t)
+        normal = np.repeat(trace.normal, t.size, axis=1)
+        sigma = at.normal_stress_matrix(normal, elasticity.lame) @ u
+        u_n = at.matrix(normal) @ u
+        gap = np.asarray(scene.gap(trace.points(t).reshape(2, -1)), dtype=float)
+        argument = sigma + np.repeat(gamma_facet, t.size) * (gap - u_n)
+        return -np.minimum(argument, 0.0).reshape(trace.size, t.size)
+
+    return pressure
+
+
+def nitsche_system(scene: Scene, elasticity, trace, t: np.ndarray, w: np.ndarray,
+                   gamma_facet: np.ndarray, theta: float) -> SemismoothSystem:
+    """The discrete equation of the module docstring as a ``SemismoothSystem``."""
+    free, nq = elasticity.free, t.size
+    at = evaluate_on_trace(elasticity.basis, trace, t)
+    normal = np.repeat(trace.normal, nq, axis=1)
+    return SemismoothSystem(
+        K=elasticity.K_free, F=elasticity.F[free],
+        S=at.normal_stress_matrix(normal, elasticity.lame)[:, free].tocsr(),
+        N=at.matrix(normal)[:, free].tocsr(),
+        gap=np.asarray(scene.gap(trace.points(t).reshape(2, -1)), dtype=float),
+        weight=np.tile(w, trace.size) * np.repeat(trace.length, nq),
+        gamma=np.repeat(gamma_facet, nq), theta=float(theta),
+        objective_scale=float(scene.material.young_modulus))
+
+
+@register_formulation("nitsche", "Nitsche's method, theta = 1 (symmetric, default), 0 or -1 "
+                                 "(option theta), gamma = gamma_0 E / h_F (option gamma_0, "
+                                 f"default {DEFAULT_GAMMA_0:g}), lambda_h = -[P_gamma(u_h)]_-")
+def discretise(scene: Scene, mesh: MeshTri, theta: float = 1.0,
+               gamma_0: float = DEFAULT_GAMMA_0, order: int = 1) -> Discretisation:
+    check_options(theta, gamma_0)
+    elasticity = assemble_elasticity(scene, mesh, check_order(order))
+    trace = contact_trace(scene, mesh)
+    t, w = gauss_legendre(elasticity.order + 1)
+    gamma_facet = gamma_0 * float(scene.material.young_modulus) / trace.length
+    system = nitsche_system(scene, elasticity, trace, t, w, gamma_facet, theta)
+    n, s_points = system.n, trace.coordinates_at(t).ravel()
+    details = NitscheDetails(theta=float(theta), gamma_0=float(gamma_0), gamma=gamma_facet)
+
+    def recover(answer: QPSolution, residuals: Residuals, status: str,
+                reason: str) -> DiscreteSolution:
+        u_free = answer.u[:n]  # the QP route carries one slack per Gauss point after u
+        pressure_at_points = system.pressure(u_free)
+        return discrete_solution(
+            "nitsche", elasticity, trace, replace(answer, multipliers=pressure_at_points),
+            residuals, status, reason, u_free=u_free,
+            pressure=pressure_function(scene, elasticity, trace, gamma_facet, u_free),
+            multiplier_breaks=np.append(trace.coordinate[0], trace.coordinate[1, -1]),
+            active_constraints=int((pressure_at_points > 0).sum()), details=details)
+
+    def transfer(previous: DiscreteSolution) -> np.ndarray:
+        return previous.pressure_at(s_points)  # > 0 where the previous level pressed
+
+    symmetric = theta == 1
+    return Discretisation(
+        formulation="nitsche", elasticity=elasticity, trace=trace,
+        qp=convex_form(system) if symmetric else None, recover=recover,
+        row_coordinate=s_points, transfer=transfer, system=system,
+        no_qp="" if symmetric else f"theta={theta:g} is not the optimality condition of a "
+                                   "convex functional (only theta = 1 is)")
