@@ -119,3 +119,14 @@ def contact_trace(scene: Scene, mesh: MeshTri) -> ContactTrace:
     length, normal = outer_normals(mesh, v0, v1, element)
     return ContactTrace(mesh=mesh, facets=facets, vertices=np.array([v0, v1]), normal=normal,
                         length=length, coordinate=np.array([s0, s1]), element=element)
+
+
+def gap_interpolant(scene: Scene, trace, order: int):
+    """g_h: the P_order Lagrange interpolant of g on each contact facet, as a function of the
+    local coordinates t (n_facets, len(t)). The penalty and Nitsche's method use it
+    (docs/theory.md, sections 3 and 12) so that g - g_h, multiplied by 1/eps or gamma, cannot
+    spoil lambda_h between quadrature points."""
+    nodes = lagrange_nodes(order)
+    values = np.asarray(scene.gap(trace.points(nodes).reshape(2, -1)),
+                        dtype=float).reshape(trace.size, nodes.size)
+    return lambda t: values @ lagrange_basis_1d(order, np.asarray(t, dtype=float))

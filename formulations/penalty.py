@@ -51,10 +51,9 @@ from formulations.base import (
 )
 from formulations.contact import (
     contact_trace,
+    gap_interpolant,
     gauss_legendre,
     lagrange_basis,
-    lagrange_basis_1d,
-    lagrange_nodes,
 )
 from formulations.discretisation import Discretisation, discrete_solution
 from formulations.elasticity import assemble_elasticity, check_order
@@ -109,15 +108,6 @@ def slack_qp(elasticity, P: sparse.csr_matrix, gap: np.ndarray, D: np.ndarray,
                      B=sparse.bmat([[P, -eye], [None, -eye]], format="csr"),
                      G=np.concatenate([gap, np.zeros(ns)]), row_scale=np.ones(2 * ns),
                      objective_scale=young)
-
-
-def gap_interpolant(scene: Scene, trace, order: int):
-    """g_h: the P_order Lagrange interpolant of g on each contact facet, as a function of the
-    local coordinates t (n_facets, len(t)) (module docstring)."""
-    nodes = lagrange_nodes(order)
-    values = np.asarray(scene.gap(trace.points(nodes).reshape(2, -1)),
-                        dtype=float).reshape(trace.size, nodes.size)
-    return lambda t: values @ lagrange_basis_1d(order, np.asarray(t, dtype=float))
 
 
 def penalty_pressure(elasticity, trace, gap_h, epsilon: np.ndarray, u_free: np.ndarray,
