@@ -5,7 +5,7 @@ new module with a ``@register_estimator`` ``estimate(scene, solution)`` function
 line here.
 """
 
-from estimators import averaging, residual  # noqa: F401  (register themselves)
+from estimators import averaging, nitsche_residual, residual  # noqa: F401  (register themselves)
 from estimators.base import (
     Estimate,
     estimator_descriptions,

@@ -31,6 +31,7 @@ from bench.measure.contact import penetration
 from bench.measure.difference import solution_difference
 from formulations import STATUS_FAILED, STATUS_OK, get_formulation, solve, solver_names
 from formulations.diagnostics import inf_sup_constant, pressure_oscillation
+from formulations.discretisation import why_unsolvable
 from scenes import Scene
 
 LOSS_TOLERANCE = 1e-6  # the same bar as a residual for status "ok" (formulations.kkt)
@@ -66,10 +67,11 @@ def verdict(status: str, loss: float, pressure_loss: float = 0.0) -> str:
 
 def solve_both(case: str, scene: Scene, formulation: str, mesh, variant: str = "",
                level: int = 0, inf_sup: bool = False, **options) -> tuple[list[dict], list]:
-    """Every solver on one discrete problem: records with loss and verdict, and the
-    solutions (in the order of ``solver_names()``)."""
+    """Every solver that has a method for the discrete problem: records with loss and
+    verdict, and the solutions (in the order of ``solver_names()``)."""
     disc = get_formulation(formulation)(scene, mesh, **options)
-    solutions = [solve(disc, solver) for solver in solver_names()]
+    solutions = [solve(disc, solver) for solver in solver_names()
+                 if why_unsolvable(disc, solver) is None]
     records = [_record(case, scene, formulation, disc, sol, variant, level)
                for sol in solutions]
     best = int(np.argmin([r["max_residual"] if np.isfinite(r["max_residual"]) else np.inf

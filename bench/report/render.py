@@ -12,7 +12,8 @@ import pandas as pd
 
 from bench.hard import LOSS_TOLERANCE, PRESSURE_TOLERANCE, hard_display
 from bench.matrix.rates import RATE_LEVELS, rates_table
-from bench.report import figures
+from bench.report import figures, hard_figures
+from bench.report.hard_figures import NITSCHE_CAPTION
 from bench.report.orders import order_section
 from bench.report.sections import Figures, scene_section
 from bench.report.tables import (
@@ -59,9 +60,10 @@ def _hard_section(results: Path | None, figs: Figures) -> tuple[pd.DataFrame | N
     if results is None or not (results / "hard.csv").exists():
         return None, []
     raw = pd.read_csv(results / "hard.csv")
-    item = figs.add(figures.hard_stability(raw, PRESSURE_TOLERANCE), "hard-stability",
-                    HARD_CAPTION)
-    return hard_display(raw), [item] if item is not None else []
+    items = [figs.add(figures.hard_stability(raw, PRESSURE_TOLERANCE), "hard-stability",
+                      HARD_CAPTION),
+             figs.add(hard_figures.nitsche_parameters(raw), "hard-nitsche", NITSCHE_CAPTION)]
+    return hard_display(raw), [item for item in items if item is not None]
 
 
 def _tables(everything: pd.DataFrame, rows: pd.DataFrame, hard) -> dict:

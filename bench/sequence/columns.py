@@ -8,8 +8,8 @@ import time
 
 from bench.measure.difference import solution_difference
 from formulations import STATUS_FAILED, STATUS_SKIPPED, SolverDiagnostics, solve
-from formulations.discretisation import why_unsolvable
 from formulations.diagnostics import inf_sup_constant, pressure_oscillation
+from formulations.discretisation import why_unsolvable
 
 
 def error_columns(truth, solution, estimate) -> dict:

@@ -2,8 +2,11 @@
 passes its own KKT checks, and the verdicts below hold."""
 
 import numpy as np
+import pandas as pd
 import pytest
 
+from bench.hard import check_expected
+from bench.verify import load_expected
 from formulations import formulation_names, get_formulation, solve
 from scenes import get_scene, scene_names
 
@@ -15,29 +18,43 @@ def test_the_catalogue_has_the_hard_scenes():
             "traction", "corner", "graded"} <= set(HARD)
 
 
+def expected_to_fail(case: str, formulation: str, solver: str) -> bool:
+    """Whether bench/verify/expected.toml expects this hard-scene solve to fail (the
+    symmetric Nitsche functional is not convex on some hard scenes: no reference)."""
+    row = pd.DataFrame([{"case": case, "formulation": formulation, "solver": solver,
+                         "variant": "", "verdict": "failed"}])
+    return check_expected(row, load_expected().get("hard", []))[0]["expected"] == "failed"
+
+
 @pytest.fixture(scope="module", params=[(s, f) for s in HARD for f in formulation_names()],
                 ids=lambda p: "-".join(p))
 def solved(request):
     name, formulation = request.param
     scene = get_scene(name)
     disc = get_formulation(formulation)(scene, scene.mesh.refined(2))
-    return scene, disc, solve(disc, "active-set"), solve(disc, "reference")
+    reference = solve(disc, "reference")
+    if expected_to_fail(name, formulation, "reference"):
+        assert reference.status == "failed"
+        reference = None
+    return scene, disc, solve(disc, "active-set"), reference
 
 
 def test_both_solvers_succeed_and_the_fast_one_is_exact(solved):
     _, _, fast, reference = solved
     assert fast.status == "ok", fast.reason
-    assert reference.status == "ok", reference.reason
+    assert reference is None or reference.status == "ok", reference.reason
     assert max(vars(fast.residuals).values()) < 1e-9
 
 
 def test_fast_and_reference_agree(solved):
     scene, disc, fast, reference = solved
+    if reference is None:
+        pytest.skip("the reference has no convex form to solve here (expected.toml)")
     K = disc.elasticity.K
     du = fast.u - reference.u
     # relative to the solution, or to sqrt(E) x the gap scale when the solution vanishes
     scale = max(np.sqrt(reference.u @ K @ reference.u),
-                np.sqrt(scene.material.young_modulus) * disc.qp.gap_scale)
+                np.sqrt(scene.material.young_modulus) * disc.gap_scale)
     # measured: <= 6e-9 everywhere except where Clarabel (not the active-set solver, whose
     # residuals stay at round-off) loses accuracy: the 50:1 strip, up to 8.8e-5 (vi), and the
     # degenerate grazing contact, up to 1.6e-6 (vi; interior points need strict
