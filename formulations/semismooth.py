@@ -21,6 +21,7 @@ A solution checks itself: ``residuals`` computes the relative nonlinear residual
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from scipy import sparse
@@ -50,9 +51,9 @@ class SemismoothSystem:
     def nq(self) -> int:
         return int(self.gap.size)
 
-    @property
+    @cached_property
     def T(self) -> sparse.csr_matrix:
-        """u -> z = (S u, N u)."""
+        """u -> z = (S u, N u) (built once)."""
         return sparse.vstack([self.S, self.N], format="csr")
 
     def pressure_argument(self, z: np.ndarray) -> np.ndarray:

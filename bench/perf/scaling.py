@@ -20,6 +20,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from bench.perf.system_scaling import measure_systems, system_table
+
 # (initial_divisions, uniform refinements) of the paper scene for ~10^4, 10^5, 10^6 DOFs
 SIZES = {"1e4": (9, 3), "1e5": (14, 4), "1e6": (11, 6)}
 README_START, README_END = "<!-- scaling:start -->", "<!-- scaling:end -->"
@@ -84,6 +86,7 @@ def measure(size: str, backend: str | None = None, reference: bool = True,
     start = time.perf_counter()
     get_estimator("residual")(scene, fast)
     row["t_estimate"] = time.perf_counter() - start
+    row.update(measure_systems(scene, mesh, order, backend))
     row["peak_gib_without_reference"] = peak_gib()
     row.update(t_reference_solve=np.nan, reference_iterations=0, reference_status="not run",
                energy_norm_difference=np.nan, max_lambda_difference=np.nan)
@@ -191,7 +194,10 @@ def write_scaling(frame: pd.DataFrame, out: str | Path, readme: str | Path | Non
     out.mkdir(parents=True, exist_ok=True)
     frame.to_csv(out / "scaling.csv", index=False)
     text = markdown_table(frame)
-    phases = phase_table(frame)
+    phases, systems = phase_table(frame), system_table(frame)
+    if systems:
+        text += ("\n\nFormulations that are a semismooth system, solved by active-set "
+                 f"(semismooth Newton, cold start):\n\n{systems}")
     (out / "scaling.md").write_text(text + "\n" + (
         f"\nPhases of the fast contact solve:\n\n{phases}\n" if phases else ""))
     if readme is not None:

@@ -38,6 +38,9 @@ from formulations.semismooth import SemismoothSystem
 from formulations.solvers.backends import check_backend, condenses, factorise_condensed
 from formulations.solvers.registry import register_system_solver
 
+# relative nonlinear residual at which iterative refinement stops (one step reaches 1e-13 ..
+# 3e-12 from the ~1e-9 the partial factorisation leaves, measured to 5e5 DOFs)
+REFINED = 1e-11
 MERIT_TOLERANCE = 1e-13  # |R| relative to |z0| + |M phi| at which the damped phase stops
 ARMIJO = 1e-4
 
@@ -73,18 +76,70 @@ def dense_step(J: np.ndarray, rhs: np.ndarray) -> tuple[np.ndarray, float]:
     return linalg.lu_solve((lu, piv), rhs, check_finite=False), 1.0 / max(rcond, 1e-300)
 
 
-def condensed_problem(system: SemismoothSystem, M: np.ndarray, z0: np.ndarray) -> Linearised:
-    def residual(z):
-        return z - z0 + M @ system.phi(z)
+@dataclass(frozen=True, eq=False)
+class ReducedPressure:
+    """The condensed equation z = z0 - M phi(z) in m = [P]_- alone (docs/theory.md 12.3):
+    with Theta = theta W / gamma, (I - M_SS Theta) s = s0 + (M_SN W - M_SS Theta) m, and
+    P = s + gamma (g - v) becomes P = P0 - G m. G depends on M only; ``free(z0, gap)`` gives
+    P0 (and s for m = 0) for any right-hand side, ``phi(s_free, m)`` phi from m."""
 
-    def step(active, z):
-        D, c = system.phi_affine(active)
-        MD = (D.T @ M.T).T  # M D_A, D sparse
-        r = z - z0 + MD @ z + M @ c
-        return dense_step(np.eye(z0.size) + MD, -r)
+    system: SemismoothSystem
+    L: tuple  # LU factors of I - M_SS Theta
+    LR: np.ndarray  # (I - M_SS Theta)^-1 (M_SN W - M_SS Theta)
+    E: np.ndarray  # I - gamma M_NS Theta
+    G: np.ndarray
 
-    return Linearised(residual, system.pressure_argument, step,
-                      lambda z: np.linalg.norm(z0) + np.linalg.norm(M @ system.phi(z)))
+    def free(self, z0: np.ndarray, gap: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        nq, gamma = self.system.nq, self.system.gamma
+        s_free = linalg.lu_solve(self.L, z0[:nq], check_finite=False)
+        return self.E @ s_free + gamma * (gap - z0[nq:]), s_free
+
+    def phi(self, s_free: np.ndarray, m: np.ndarray) -> np.ndarray:
+        system = self.system
+        s, w = s_free + self.LR @ m, system.weight
+        return np.concatenate([system.theta / system.gamma * w * (m - s), -w * m])
+
+
+def reduced_pressure(system: SemismoothSystem, M: np.ndarray) -> ReducedPressure:
+    """The matrices of ``ReducedPressure`` from M = T K^-1 T' (one nq x nq factorisation)."""
+    nq, w, gamma = system.nq, system.weight, system.gamma
+    Mss, Msn, Mns, Mnn = M[:nq, :nq], M[:nq, nq:], M[nq:, :nq], M[nq:, nq:]
+    Theta = system.theta * w / gamma
+    L = linalg.lu_factor(np.eye(nq) - Mss * Theta[None, :], check_finite=False)
+    LR = linalg.lu_solve(L, Msn * w[None, :] - Mss * Theta[None, :], check_finite=False)
+    E = np.eye(nq) - gamma[:, None] * Mns * Theta[None, :]
+    G = -(E @ LR + gamma[:, None] * (Mns * Theta[None, :] - Mnn * w[None, :]))
+    return ReducedPressure(system, L, LR, E, G)
+
+
+def active_solve(G: np.ndarray, active: np.ndarray, P0: np.ndarray) -> np.ndarray:
+    """m with m_A = (I + G_AA)^-1 P0_A and 0 off A: the fixed point of m = chi (P0 - G m)."""
+    m = np.zeros(P0.size)
+    if active.any():
+        m[active] = linalg.solve(np.eye(active.sum()) + G[np.ix_(active, active)], P0[active])
+    return m
+
+
+def condensed_problem(G: np.ndarray, P0: np.ndarray) -> Linearised:
+    """R(m) = m - [P0 - G m]_-; for the active set A, J_A = [[I + G_AA, G_AI], [0, I]], so a
+    step costs one |A| x |A| solve."""
+
+    def residual(m):
+        return m - np.minimum(P0 - G @ m, 0.0)
+
+    def step(active, m):
+        r = m - np.where(active, P0 - G @ m, 0.0)  # R_A(m)
+        dm = -r  # rows off A: dm_I = -r_I
+        if active.any():
+            rhs = -r[active] - G[np.ix_(active, ~active)] @ dm[~active]
+            dm[active], condition = dense_step(np.eye(active.sum()) + G[np.ix_(active, active)],
+                                               rhs)
+        else:
+            condition = 1.0
+        return dm, condition
+
+    return Linearised(residual, lambda m: P0 - G @ m, step,
+                      lambda m: np.linalg.norm(P0) + np.linalg.norm(G @ m))
 
 
 def sparse_problem(system: SemismoothSystem) -> Linearised:
@@ -164,10 +219,10 @@ def solve_semismooth(system: SemismoothSystem, warm_start: np.ndarray | None = N
         factor = factorise_condensed(system.K, np.unique(T.indices), backend)
         clock = time.perf_counter()
         u0 = factor.solve(system.F)
-        M = factor.condensed(T)
-        z0 = T @ u0
+        reduced = reduced_pressure(system, factor.condensed(T))
+        P0, s_free = reduced.free(T @ u0, system.gap)
         phases = [*factor.phases, ("condense", time.perf_counter() - clock)]
-        problem, x = condensed_problem(system, M, z0), z0
+        problem, x = condensed_problem(reduced.G, P0), np.zeros(system.nq)
     else:
         phases, problem, x = [], sparse_problem(system), np.zeros(system.n)
     active = (np.asarray(warm_start) > 0) if warm_start is not None else \
@@ -178,7 +233,8 @@ def solve_semismooth(system: SemismoothSystem, warm_start: np.ndarray | None = N
     u = result.x
     if condenses(backend):
         clock = time.perf_counter()
-        u = refine(system, factor.solve, M, u0 - factor.solve(T.T @ system.phi(result.x)))
+        u = refine(system, factor.solve, reduced,
+                   u0 - factor.solve(T.T @ reduced.phi(s_free, result.x)))
         phases.append(("back-substitute", time.perf_counter() - clock))
     diagnostics = SolverDiagnostics(active_set_changes=result.changes, cycled=result.cycled,
                                     safeguard=result.safeguard,
@@ -190,19 +246,22 @@ def solve_semismooth(system: SemismoothSystem, warm_start: np.ndarray | None = N
                       backend=backend, diagnostics=diagnostics)
 
 
-def refine(system: SemismoothSystem, solve: Callable, M: np.ndarray, u: np.ndarray,
+def refine(system: SemismoothSystem, solve: Callable, reduced: ReducedPressure, u: np.ndarray,
            steps: int = 3) -> np.ndarray:
-    """Iterative refinement of u in the full space with the final active set: the partial
-    factorisation and the Schur complement leave |R(u)| ~1e-9 relative where a plain
-    sparse solve leaves round-off. The correction solves (K + T' D T) du = -R(u) by the
-    Woodbury form K^-1 - K^-1 T' D (I + M D)^-1 T K^-1 (two solves with the factor)."""
+    """Iterative refinement of u in the full space with the final active set A: the partial
+    factorisation and the Schur complement leave |R(u)| ~1e-9 relative where a plain sparse
+    solve leaves round-off. The correction du = y - K^-1 T' phi, y = -K^-1 R(u), solves
+    (K + T' D_A T) du = -R(u): phi is that of the linear equation dz = T y - M phi(dz) (the
+    reduced one with zero gap), two solves with the factor and one |A| x |A| solve a step."""
     T = system.T
-    D, _ = system.phi_affine(system.pressure_argument(T @ u) < 0)
-    lu = linalg.lu_factor(np.eye(M.shape[0]) + (D.T @ M.T).T, check_finite=False)
+    active = system.pressure_argument(T @ u) < 0
     r = system.residual(u)
     for _ in range(steps):
+        if system.residuals(u).stationarity <= REFINED:
+            break
         y = -solve(r)
-        du = y - solve(T.T @ (D @ linalg.lu_solve(lu, T @ y, check_finite=False)))
+        P0, s_free = reduced.free(T @ y, np.zeros(system.nq))
+        du = y - solve(T.T @ reduced.phi(s_free, active_solve(reduced.G, active, P0)))
         trial = system.residual(u + du)
         if np.linalg.norm(trial) >= np.linalg.norm(r):
             break
