@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from bench.perf.system_scaling import measure_systems, system_table
+from bench.perf.system_scaling import measure_systems, system_table, warm_up_systems
 
 # (initial_divisions, uniform refinements) of the paper scene for ~10^4, 10^5, 10^6 DOFs
 SIZES = {"1e4": (9, 3), "1e5": (14, 4), "1e6": (11, 6)}
@@ -113,6 +113,7 @@ def warm_up(backend: str) -> None:
     qp = cycling_qp()
     factorise(qp.K, backend)(qp.F)
     solve_active_set(qp, backend=backend)
+    warm_up_systems(backend)
 
 
 def phase_column(phase: str) -> str:

@@ -31,7 +31,9 @@ def measure_systems(scene, mesh, order: int, backend: str) -> dict:
         sol = solve(disc, "active-set", backend=backend)
         row.update({f"t_{name}_solve": sol.solve_time, f"{name}_iterations": sol.iterations,
                     f"{name}_status": sol.status,
-                    f"{name}_max_residual": max(vars(sol.residuals).values())})
+                    f"{name}_max_residual": max(vars(sol.residuals).values()),
+                    f"{name}_phases": ", ".join(f"{phase} {seconds:.2f}"
+                                                for phase, seconds in sol.diagnostics.phases)})
     return row
 
 
@@ -52,4 +54,16 @@ def system_table(frame: pd.DataFrame) -> str:
         table[f"{name} Newton iterations"] = frame[f"{name}_iterations"]
         table[f"{name} residual"] = frame[f"{name}_max_residual"].map(
             lambda r: "" if not np.isfinite(r) else f"{r:.1e}")
+        table[f"{name} phases [s]"] = frame[f"{name}_phases"]
     return table.to_markdown(index=False)
+
+
+def warm_up_systems(backend: str) -> None:
+    """One small solve of every system formulation before any clock (library set-up on first
+    use, as ``scaling.warm_up`` does for the QP route)."""
+    from formulations import get_formulation, solve
+    from scenes import get_scene
+
+    scene = get_scene("paper")
+    for name in system_formulations(scene):
+        solve(get_formulation(name)(scene, scene.mesh.refined(2)), "active-set", backend=backend)
