@@ -4,8 +4,10 @@
 
 from __future__ import annotations
 
+import os
 import sys
 import time
+from pathlib import Path
 
 import pandas as pd
 
@@ -14,6 +16,7 @@ from bench.cli.guards import InputError, check_output_folders
 from bench.cli.parser import build_parser
 from bench.cli.progress import Progress
 from bench.cli.study import study_command
+from bench.export import export_results
 from bench.hard import (
     check_expected,
     hard_case_descriptions,
@@ -167,6 +170,17 @@ def report_command(args) -> int:
     return 0
 
 
+def export_command(args) -> int:
+    if args.out is None:
+        args.out = str(Path(args.results) / "fields")
+    if not (Path(args.results) / "artifacts").is_dir():
+        raise InputError(f"--results={args.results!r} holds no artifacts/ (written by run and "
+                         "compare); give a results folder")
+    written = export_results(args.results, args.out, args.format)
+    print(f"wrote {len(written)} files ({len(written) // 2} combinations) to {args.out}")
+    return 0
+
+
 def verify_command(args) -> int:
     verdicts, _, closed_form = verify(args.out, on_level=progress)
     print("\n" + closed_form.to_markdown(index=False, floatfmt=".4g") + "\n")
@@ -207,6 +221,7 @@ def sequence_command(args) -> int:
 
 
 COMMANDS = {"run": run_command, "compare": compare_command, "report": report_command,
+            "export": export_command,
             "verify": verify_command, "hard": hard_command, "scaling": scaling_command,
             "list": list_command, "study": study_command}
 
@@ -221,6 +236,9 @@ def main(argv: list[str] | None = None) -> int:
     except (InputError, ResultsError, RunRefused) as error:
         print(f"error: {error}", file=sys.stderr)
         return 2
+    except BrokenPipeError:  # the reader went away (e.g. `| head`): stop quietly
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 1
     except KeyboardInterrupt:
         print(f"interrupted: every finished row is kept in {getattr(args, 'out', 'the output')}"
               " (results.parquet, results.csv)", file=sys.stderr)

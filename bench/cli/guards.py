@@ -8,6 +8,7 @@ from pathlib import Path
 
 # the folder options of each command that will be written to
 OUTPUT_OPTIONS = {"run": ("out",), "compare": ("out", "reports"), "report": ("out",),
+                  "export": (),
                   "verify": ("out",), "hard": ("out",), "scaling": ("out",),
                   "study": ("out", "report")}
 

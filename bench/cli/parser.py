@@ -15,6 +15,7 @@ from bench.cli.option_types import (
     sequence_budgets,
     theta_value,
 )
+from bench.export import FORMATS
 from bench.hard import hard_case_names
 from bench.matrix.run import COMPARE_REFERENCE_DOFS
 from bench.perf.scaling import SIZES
@@ -121,6 +122,21 @@ def _report_parser(sub) -> None:
     report.add_argument("--out", default="reports", help="report folder (default: reports)")
 
 
+def _export_parser(sub) -> None:
+    export = sub.add_parser("export", help="write each combination's last-level fields for "
+                            "ParaView (meshio)",
+                            description="Write, per combination of RESULTS, the mesh with the "
+                            "displacement, stress tensor, von Mises stress, estimator "
+                            "indicators and (exact truth) error density, and Gamma_C with "
+                            "lambda_h and the gap, from RESULTS/artifacts (nothing recomputed).")
+    export.add_argument("--results", default="results",
+                        help="results folder with artifacts/ (default: results)")
+    export.add_argument("--format", choices=list(FORMATS), default="vtu",
+                        help="file format (default: vtu)")
+    export.add_argument("--out", default=None,
+                        help="folder for the files (default: RESULTS/fields)")
+
+
 def _scaling_parser(sub) -> None:
     scaling = sub.add_parser(
         "scaling", help="time assembly, linear solve, fast and reference contact solves and "
@@ -209,6 +225,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     _run_parser(sub)
     _report_parser(sub)
+    _export_parser(sub)
     _scaling_parser(sub)
     _compare_parser(sub)
     _verify_parser(sub)

@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from bench.measure.contact import contact_zone
+from bench.measure.discretisation_error import element_energy_errors
 from bench.sequence.rows import KEYS
 from formulations.elasticity import von_mises
 
@@ -28,24 +29,44 @@ def artifact_path(out: str | Path, row) -> Path:
     return Path(out) / "artifacts" / f"{file_stem(*(getattr(row, k) for k in KEYS))}.npz"
 
 
-def save_artifact(out: str | Path, result) -> Path | None:
+def save_artifact(out: str | Path, result, scene=None) -> Path | None:
     """Write the last level of a sequence (``bench.sequence.loop.LevelResult``); None if it has no
-    solution."""
+    solution. Fields per element: the centroid stress (s11, s22, s12), von Mises, the
+    estimator's squared indicators and, where ``scene`` has an exact solution, the squared
+    energy-norm error per element; on Gamma_C: the facets' vertices, lambda_h and the gap at
+    the facet ends (the fields ``python -m bench export`` writes)."""
     sol = result.solution
     if sol is None or not np.all(np.isfinite(sol.u)):
         return None
     mesh = sol.elasticity.mesh
+    n_elements = mesh.t.shape[1]
+    stress = sol.elasticity.element_stress(sol.u)
+    estimate = result.estimate
+    indicators = (estimate.indicators if estimate is not None
+                  else np.full(n_elements, np.nan))
+    ends = sol.pressure(np.array([0.0, 1.0]))  # (n_facets, 2)
+    gap = (np.asarray(scene.gap(mesh.p[:, sol.trace.vertices].reshape(2, -1)), dtype=float)
+           .reshape(2, -1) if scene is not None else np.full(sol.trace.vertices.shape, np.nan))
     path = artifact_path(out, result.row)
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_suffix(".tmp.npz")
     np.savez_compressed(
-        tmp, p=mesh.p, t=mesh.t, u=sol.elasticity.nodal(sol.u),
-        von_mises=von_mises(sol.elasticity.element_stress(sol.u)),
+        tmp, p=mesh.p, t=mesh.t, u=sol.elasticity.nodal(sol.u), stress=stress,
+        von_mises=von_mises(stress), indicators=indicators,
+        error_density=element_error_density(scene, sol, n_elements),
+        trace_vertices=sol.trace.vertices, trace_pressure=ends.T, trace_gap=gap,
         trace_coordinate=sol.trace.coordinate, pressure=sol.pressure(PRESSURE_SAMPLES),
         zone=np.array(contact_zone(sol)), contact_force=sol.contact_force(),
         ndofs=sol.elasticity.ndofs, level=result.row.level)
     os.replace(tmp, path)
     return path
+
+
+def element_error_density(scene, sol, n_elements: int) -> np.ndarray:
+    """||u - u_h||^2 per element against the scene's exact solution (NaN without one)."""
+    if scene is None or scene.exact is None:
+        return np.full(n_elements, np.nan)
+    return element_energy_errors(scene, sol)
 
 
 def load_artifact(path: str | Path) -> dict | None:

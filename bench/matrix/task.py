@@ -84,7 +84,7 @@ def run_spec(spec: SequenceSpec, run: dict, out, truth_of: Callable[[Scene], obj
             truth=truth_of(scene), crosscheck_dofs=spec.crosscheck_dofs,
             formulation_options=dict(spec.formulation_options)), record)
         if last is not None:
-            save_artifact(out, last)
+            save_artifact(out, last, scene)
         return end
     except Exception as error:  # recorded, never silent: the row carries type and message
         record(whole_sequence_row(names, STATUS_FAILED, f"{type(error).__name__}: {error}"))

@@ -64,12 +64,18 @@ def errors_from(energy_error: float, solution: DiscreteSolution, true_pressure,
                   zone_error(zone, true_zone), *zone)
 
 
-def exact_errors(scene, solution: DiscreteSolution) -> Errors:
-    exact = scene.exact
+def element_energy_errors(scene, solution: DiscreteSolution) -> np.ndarray:
+    """||u - u_h||^2_T per element against ``scene.exact`` (quadrature of order
+    EXACT_INTORDER + 2(p - 1))."""
     order = solution.elasticity.order
     basis = Basis(solution.elasticity.mesh, solution.elasticity.basis.elem,
                   intorder=EXACT_INTORDER + 2 * (order - 1))
     grad_h = basis.interpolate(solution.u).grad
-    diff = exact.gradient(np.asarray(basis.global_coordinates())) - grad_h
-    energy = float((energy_density(diff, *solution.elasticity.lame) * basis.dx).sum())
+    diff = scene.exact.gradient(np.asarray(basis.global_coordinates())) - grad_h
+    return (energy_density(diff, *solution.elasticity.lame) * basis.dx).sum(axis=1)
+
+
+def exact_errors(scene, solution: DiscreteSolution) -> Errors:
+    exact = scene.exact
+    energy = float(element_energy_errors(scene, solution).sum())
     return errors_from(np.sqrt(max(energy, 0.0)), solution, exact.pressure, exact.contact_zone)

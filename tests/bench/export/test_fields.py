@@ -1,0 +1,74 @@
+"""Field output: the files read back with meshio carry the run's own arrays."""
+
+import subprocess
+import sys
+
+import meshio
+import numpy as np
+import pytest
+
+from bench.cli import main
+from bench.measure.discretisation_error import exact_errors
+from bench.sequence.loop import LoopConfig, run_sequence
+from estimators import get_estimator
+from formulations.elasticity import von_mises
+from scenes import get_scene
+
+
+@pytest.fixture(scope="module")
+def results(tmp_path_factory):
+    out = tmp_path_factory.mktemp("results")
+    assert main(["run", "--scene", "free-boundary", "--formulation", "mixed,nitsche",
+                 "--solver", "active-set", "--strategy", "uniform", "--max-dofs", "600",
+                 "--out", str(out)]) == 0
+    return out
+
+
+@pytest.mark.parametrize("fmt", ["vtu", "xdmf"])
+def test_fields_read_back_equal_the_runs_own(results, tmp_path, fmt):
+    assert main(["export", "--results", str(results), "--format", fmt,
+                 "--out", str(tmp_path)]) == 0
+    body = meshio.read(tmp_path / f"free-boundary-nitsche-active-set-residual-uniform-1.{fmt}")
+    contact = meshio.read(
+        tmp_path / f"free-boundary-nitsche-active-set-residual-uniform-1-contact.{fmt}")
+    # the same last level recomputed independently of the artifact (deterministic solve)
+    scene = get_scene("free-boundary")
+    last = list(run_sequence(scene, "nitsche", "active-set", "residual",
+                             LoopConfig(strategy="uniform", max_dofs=600)))[-1]
+    sol = last.solution
+    mesh = sol.elasticity.mesh
+    # written as float64 and read back: equal to round-off of the solve (1e-12 relative)
+    assert np.allclose(body.points[:, :2], mesh.p.T, rtol=0, atol=1e-15)
+    u = sol.elasticity.nodal(sol.u).T
+    assert np.allclose(body.point_data["displacement"][:, :2], u, rtol=1e-10,
+                       atol=1e-12 * np.abs(u).max())
+    stress = sol.elasticity.element_stress(sol.u)
+    tensor = body.cell_data["stress"][0].reshape(-1, 3, 3)
+    scale = np.abs(stress).max()
+    assert np.allclose(tensor[:, 0, 0], stress[0], atol=1e-10 * scale)
+    assert np.allclose(tensor[:, 0, 1], stress[2], atol=1e-10 * scale)
+    assert np.allclose(body.cell_data["von_mises"][0], von_mises(stress), atol=1e-10 * scale)
+    indicators = get_estimator("residual")(scene, sol).indicators
+    assert np.allclose(body.cell_data["indicator"][0], indicators, rtol=1e-8)
+    # the error density sums to the squared exact energy-norm error
+    density = body.cell_data["error_density"][0]
+    assert density.sum() == pytest.approx(exact_errors(scene, sol).energy_error ** 2, rel=1e-10)
+    # Gamma_C: one line per contact facet, lambda_h >= 0 and the gap at its ends
+    assert len(contact.cells_dict["line"]) == sol.trace.size
+    ends = sol.pressure(np.array([0.0, 1.0]))
+    assert np.allclose(contact.point_data["lambda_h"],
+                       np.concatenate([ends[:, 0], ends[:, 1]]), rtol=1e-10, atol=1e-9)
+    assert np.isfinite(contact.point_data["gap"]).all()
+
+
+def test_export_without_artifacts_is_refused(tmp_path, capsys):
+    assert main(["export", "--results", str(tmp_path)]) == 2
+    assert "holds no artifacts/" in capsys.readouterr().err
+
+
+def test_the_console_command_runs_the_same_commands():
+    # installed by pip (project.scripts): the same main as python -m bench
+    done = subprocess.run([sys.executable, "-c", "from importlib.metadata import entry_points;"
+                           "print([e.value for e in entry_points(group='console_scripts')"
+                           " if e.name == 'signorini-bench'])"], capture_output=True, text=True)
+    assert "bench.cli:main" in done.stdout, done.stdout + done.stderr
