@@ -27,6 +27,7 @@ from bench.hard import (
 )
 from bench.matrix import RunConfig, run
 from bench.matrix.run import RunRefused
+from bench.matrix.scene_files import load_scene_files, scene_files_in
 from bench.matrix.store import ResultsError, read_results
 from bench.perf.scaling import run_scaling, write_scaling
 from bench.perf.sequence import SEQUENCES, run_sequences, write_sequences
@@ -108,7 +109,7 @@ def run_command(args) -> int:
         reference_crosscheck=args.reference_crosscheck, crosscheck_dofs=args.crosscheck_dofs,
         max_memory_gib=args.max_memory, out=args.out,
         overwrite=args.overwrite, workers=args.workers, scheduler=args.scheduler,
-        cache=args.cache,
+        cache=args.cache, scene_files=tuple(args.scene_file),
         command=" ".join(["python -m bench", *args.argv]))
     return run_config(config)
 
@@ -142,7 +143,7 @@ def compare_command(args) -> int:
         max_dofs=args.max_dofs, reference_dofs=args.reference_dofs,
         crosscheck_dofs=args.crosscheck_dofs, max_memory_gib=args.max_memory, out=args.out,
         overwrite=True, workers=args.workers, scheduler=args.scheduler, cache=args.cache,
-        command=" ".join(["python -m bench", *args.argv]))
+        scene_files=tuple(args.scene_file), command=" ".join(["python -m bench", *args.argv]))
     if args.readme is not None:
         try:
             check_readme(args.readme)
@@ -228,6 +229,11 @@ COMMANDS = {"run": run_command, "compare": compare_command, "report": report_com
 
 def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
+    try:  # before the parser: its lists of valid scenes include the files' scenes
+        load_scene_files(scene_files_in(argv))
+    except ValueError as error:
+        print(f"error: {error}", file=sys.stderr)
+        return 2
     args = build_parser().parse_args(argv)
     args.argv = argv
     try:

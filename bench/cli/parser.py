@@ -29,6 +29,12 @@ from formulations.solvers.backends import backend_names
 from scenes import scene_names
 
 
+def _scene_file_option(parser) -> None:
+    parser.add_argument("--scene-file", action="append", default=[], metavar="FILE",
+                        help="a Python file that registers scenes with scenes.register_scene "
+                             "(repeatable); its scenes join --scene's choices")
+
+
 def _scale_out_options(parser) -> None:
     parser.add_argument("--workers", type=non_negative_int("workers"), default=0,
                         help="run the sequences on a local Dask cluster of this many processes "
@@ -102,6 +108,7 @@ def _run_parser(sub) -> None:
                           "agreement with the P3 one in truth.json (default: off)")
     _memory_option(run)
     _scale_out_options(run)
+    _scene_file_option(run)
     run.add_argument("--crosscheck-dofs", type=non_negative_int("crosscheck_dofs"), default=0,
                      help="also solve levels with at most this many DOFs with the reference "
                           "solver and record the differences (default: 0, never)")
@@ -183,6 +190,7 @@ def _compare_parser(sub) -> None:
                               f"{COMPARE_REFERENCE_DOFS})")
     _memory_option(compare)
     _scale_out_options(compare)
+    _scene_file_option(compare)
     compare.add_argument("--crosscheck-dofs", type=non_negative_int("crosscheck_dofs"),
                          default=3000, help="cross-check levels up to this size with the "
                          "reference solver (default: 3000)")

@@ -14,6 +14,7 @@ from dataclasses import replace
 from pathlib import Path
 from urllib.parse import urlsplit
 
+from bench.matrix.scene_files import load_scene_files
 from bench.matrix.spec import SequenceSpec
 from bench.matrix.store import ResultStore, SequenceWriter
 from bench.matrix.task import Outcome, run_spec
@@ -60,10 +61,12 @@ def check_scheduler(address: str, timeout: float = SCHEDULER_TIMEOUT) -> None:
 
 
 def sequence_task(spec: SequenceSpec, out: str, run: dict, cache: str | None,
-                  max_memory_gib: float | None) -> Outcome:
-    """One sequence on a worker: its rows go to its own partition as they finish."""
+                  max_memory_gib: float | None, scene_files: tuple[str, ...] = ()) -> Outcome:
+    """One sequence on a worker: its rows go to its own partition as they finish (the user's
+    scene files imported first, as in the driver)."""
     if cache is not None:
         os.environ["SIGNORINI_BENCH_CACHE"] = cache
+    load_scene_files(scene_files)
     writer = SequenceWriter(Path(out) / "sequences" / f"{spec.key}.parquet")
     rows = []
 
@@ -103,7 +106,8 @@ def run_on_dask(specs: list[SequenceSpec], store: ResultStore, run: dict, config
         memory = available_gib() / workers
     cache = config.cache or os.environ.get("SIGNORINI_BENCH_CACHE")
     try:
-        futures = {client.submit(sequence_task, spec, str(store.out), run, cache, memory,
+        files = tuple(str(Path(f).expanduser().resolve()) for f in config.scene_files)
+        futures = {client.submit(sequence_task, spec, str(store.out), run, cache, memory, files,
                                  key=f"sequence-{spec.key}-{run['run_id']}", pure=False): spec
                    for spec in specs}
         rows = []

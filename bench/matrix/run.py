@@ -19,6 +19,7 @@ import pandas as pd
 from bench.matrix.distributed import SchedulerError, check_scheduler, scheduler_endpoint
 from bench.matrix.harness import new_run_identity, run_specs, truth_name, write_truth_summary
 from bench.matrix.rates import write_rates
+from bench.matrix.scene_files import load_scene_files, source_digest
 from bench.matrix.spec import (
     SequenceSpec,
     build_scene,
@@ -71,9 +72,12 @@ class RunConfig:
     workers: int = 0  # > 0: a local Dask cluster of this many processes
     scheduler: str | None = None  # the address of an existing Dask cluster
     cache: str | None = None  # reference cache folder (default $SIGNORINI_BENCH_CACHE)
+    scene_files: tuple[str, ...] = ()  # Python files that register scenes (--scene-file)
     command: str = ""  # how the run was asked for, recorded in run.json
 
     def __post_init__(self):
+        object.__setattr__(self, "scene_files", tuple(str(f) for f in self.scene_files))
+        load_scene_files(self.scene_files)  # their scenes are valid names from here on
         for name, valid in NAME_LISTS.items():
             items = tuple(getattr(self, name))
             object.__setattr__(self, name, items)
@@ -112,7 +116,7 @@ class RunConfig:
             self.solvers, self.estimators, self.strategies, self.orders, max_dofs=self.max_dofs,
             max_levels=self.max_levels, marking=self.marking, theta=self.theta,
             nested=self.nested, backend=self.backend, reference_dofs=self.reference_dofs,
-            crosscheck_dofs=self.crosscheck_dofs)
+            crosscheck_dofs=self.crosscheck_dofs, scene_source=source_digest(self.scene_files))
 
     def record(self) -> dict:
         """The configuration as written to run.json."""

@@ -37,10 +37,14 @@ class SequenceSpec:
     backend: str | None = None
     reference_dofs: int | None = None
     crosscheck_dofs: int = 0
+    scene_source: str = ""  # digest of the --scene-file files ('' without)
 
     @property
     def key(self) -> str:
-        text = json.dumps({**asdict(self), "version": SPEC_VERSION}, sort_keys=True, default=str)
+        fields = asdict(self)
+        if not fields["scene_source"]:  # keys of runs without scene files stay as they were
+            del fields["scene_source"]
+        text = json.dumps({**fields, "version": SPEC_VERSION}, sort_keys=True, default=str)
         return hashlib.sha256(text.encode()).hexdigest()[:20]
 
     def loop_config(self, max_memory_gib: float | None = None) -> LoopConfig:

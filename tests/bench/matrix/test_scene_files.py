@@ -1,0 +1,52 @@
+"""Scenes from a user's file (--scene-file): usable in the CLI, in-process and on Dask, refused
+in one line when broken, and part of each sequence's key."""
+
+import json
+from pathlib import Path
+
+import pandas as pd
+
+from bench.cli import main
+from bench.matrix import RunConfig, run
+from bench.matrix.scene_files import source_digest
+
+EXAMPLE = Path(__file__).parents[3] / "examples" / "my_scenes.py"
+
+
+def test_the_example_scene_file_runs_from_the_command_line(tmp_path):
+    assert main(["run", "--scene-file", str(EXAMPLE), "--scene", "wide-block", "--solver",
+                 "active-set", "--strategy", "uniform", "--max-dofs", "600",
+                 "--out", str(tmp_path)]) == 0
+    table = pd.read_csv(tmp_path / "results.csv")
+    assert set(table["scene"]) == {"wide-block"} and (table["status"] == "ok").all()
+    assert table["active_constraints"].max() > 0  # the bump presses
+    record = json.loads((tmp_path / "run.json").read_text())["configuration"]
+    assert record["scene_files"] == [str(EXAMPLE)]
+
+
+def test_a_scene_file_reaches_the_dask_workers(tmp_path):
+    result = run(RunConfig(scenes=("wide-block",), solvers=("active-set",),
+                           strategies=("uniform",), max_dofs=600, workers=1,
+                           scene_files=(str(EXAMPLE),), out=str(tmp_path)))
+    assert len(result.rows) == 2 and all(r.status == "ok" for r in result.rows)  # 136, 528 DOFs
+
+
+def test_a_broken_scene_file_is_refused_in_one_line(tmp_path, capsys):
+    broken = tmp_path / "broken.py"
+    broken.write_text("raise RuntimeError('no such obstacle')\n")
+    assert main(["run", "--scene-file", str(broken), "--out", str(tmp_path / "r")]) == 2
+    err = capsys.readouterr().err
+    assert f"--scene-file={str(broken)!r} failed to import: RuntimeError: no such obstacle" \
+        in err and "Traceback" not in err
+    assert main(["run", "--scene-file", str(tmp_path / "missing.txt")]) == 2
+    assert "is not a Python file" in capsys.readouterr().err
+
+
+def test_a_changed_scene_file_changes_the_sequence_keys(tmp_path):
+    copy = tmp_path / "scenes_copy.py"
+    copy.write_text(EXAMPLE.read_text())
+    before = source_digest([copy])
+    copy.write_text(EXAMPLE.read_text() + "\n# changed\n")
+    assert source_digest([copy]) != before and source_digest([]) == ""
+    # without scene files the keys are those of earlier versions (no stale-key churn)
+    assert RunConfig().specs()[0].scene_source == ""
