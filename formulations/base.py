@@ -53,6 +53,20 @@ class ContactQP:
         return float(np.abs(self.G / self.row_scale).max(initial=0.0))
 
 
+def slack_qp(K: sparse.spmatrix, F: np.ndarray, P: sparse.spmatrix, gap: np.ndarray,
+             D: np.ndarray, objective_scale: float) -> ContactQP:
+    """min 1/2 u'Ku - F'u + 1/2 s'Ds  s.t.  P u - s <= g, -s <= 0: a squared positive part
+    (x)_+^2 = min {s^2 : s >= x, s >= 0} per row of P, with one slack s each (the penalty, and
+    the convex form of Nitsche's method; docs/theory.md, sections 3 and 12.2)."""
+    ns = gap.size
+    eye = sparse.identity(ns, format="csr")
+    return ContactQP(K=sparse.block_diag([K, sparse.diags(D)], format="csr"),
+                     F=np.concatenate([F, np.zeros(ns)]),
+                     B=sparse.bmat([[P, -eye], [None, -eye]], format="csr"),
+                     G=np.concatenate([gap, np.zeros(ns)]), row_scale=np.ones(2 * ns),
+                     objective_scale=objective_scale)
+
+
 @dataclass(frozen=True, eq=False)
 class SolverDiagnostics:
     """What a solver reports about its own run (``formulations.solvers.active_set``); the

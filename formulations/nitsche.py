@@ -35,7 +35,7 @@ import numpy as np
 from scipy import sparse
 from skfem import MeshTri
 
-from formulations.base import ContactQP, DiscreteSolution, QPSolution, Residuals
+from formulations.base import ContactQP, DiscreteSolution, QPSolution, Residuals, slack_qp
 from formulations.contact import contact_trace, gap_interpolant, gauss_legendre
 from formulations.discretisation import Discretisation, discrete_solution
 from formulations.elasticity import assemble_elasticity, check_order
@@ -66,16 +66,10 @@ def convex_form(system: SemismoothSystem) -> ContactQP:
     """The theta = 1 system as a QP in (u, s') with s' = s / gamma a length (module
     docstring): min 1/2 u'(K - S'(W/gamma)S)u - F'u + 1/2 s'(W gamma)s' subject to
     N u - S u / gamma - s' <= g and -s' <= 0."""
-    nq = system.nq
-    eye = sparse.identity(nq, format="csr")
     K = system.K - system.S.T @ sparse.diags(system.weight / system.gamma) @ system.S
     rows = system.N - sparse.diags(1.0 / system.gamma) @ system.S
-    return ContactQP(K=sparse.block_diag([K, sparse.diags(system.weight * system.gamma)],
-                                         format="csr"),
-                     F=np.concatenate([system.F, np.zeros(nq)]),
-                     B=sparse.bmat([[rows, -eye], [None, -eye]], format="csr"),
-                     G=np.concatenate([system.gap, np.zeros(nq)]), row_scale=np.ones(2 * nq),
-                     objective_scale=system.objective_scale)
+    return slack_qp(K, system.F, rows, system.gap, system.weight * system.gamma,
+                    system.objective_scale)
 
 
 def check_options(theta, gamma_0) -> None:

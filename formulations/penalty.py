@@ -38,16 +38,15 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import sparse
 from skfem import MeshTri
 
 from formulations.base import (
     STATUS_INACCURATE,
     STATUS_OK,
-    ContactQP,
     DiscreteSolution,
     QPSolution,
     Residuals,
+    slack_qp,
 )
 from formulations.contact import (
     contact_trace,
@@ -98,18 +97,6 @@ def pressure_mismatch(penetration: np.ndarray, epsilon: np.ndarray, multipliers:
     return float(np.abs(formula - from_multiplier).max(initial=0.0) / scale) if scale else 0.0
 
 
-def slack_qp(elasticity, P: sparse.csr_matrix, gap: np.ndarray, D: np.ndarray,
-             young: float) -> ContactQP:
-    """min 1/2 u'Ku - F'u + 1/2 s'Ds  s.t.  P u - s <= g, -s <= 0 (module docstring)."""
-    ns = gap.size
-    eye = sparse.identity(ns, format="csr")
-    return ContactQP(K=sparse.block_diag([elasticity.K_free, sparse.diags(D)], format="csr"),
-                     F=np.concatenate([elasticity.F[elasticity.free], np.zeros(ns)]),
-                     B=sparse.bmat([[P, -eye], [None, -eye]], format="csr"),
-                     G=np.concatenate([gap, np.zeros(ns)]), row_scale=np.ones(2 * ns),
-                     objective_scale=young)
-
-
 def penalty_pressure(elasticity, trace, gap_h, epsilon: np.ndarray, u_free: np.ndarray,
                      penetration_at_points: np.ndarray, t: np.ndarray):
     """lambda_h(t) on every contact facet (module docstring): (u_hn - g_h)_+ / eps for P1; for
@@ -151,8 +138,8 @@ def discretise(scene: Scene, mesh: MeshTri, epsilon_0: float = DEFAULT_EPSILON_0
     gap = gap_h(t)
     P = normal_trace_matrix(elasticity.basis, trace, t)[:, elasticity.free]
     # D_q = w_q h_e / eps_e = p^2 E w_q / eps_0
-    qp = slack_qp(elasticity, P, gap.ravel(), order**2 * young / epsilon_0 * np.tile(w, nf),
-                  young)
+    qp = slack_qp(elasticity.K_free, elasticity.F[elasticity.free], P, gap.ravel(),
+                  order**2 * young / epsilon_0 * np.tile(w, nf), young)
     epsilon = epsilon_0 * trace.length / (order**2 * young)
     s_points = trace.coordinates_at(t)
     # per slack row: eps, and Gauss weight x facet length (the row's share of Gamma_C)
