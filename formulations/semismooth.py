@@ -63,8 +63,10 @@ class SemismoothSystem:
 
     def phi(self, z: np.ndarray) -> np.ndarray:
         """(phi_S, phi_N) of the module docstring."""
-        s = z[: self.nq]
-        m = np.minimum(self.pressure_argument(z), 0.0)
+        return self.phi_of(z[: self.nq], np.minimum(self.pressure_argument(z), 0.0))
+
+    def phi_of(self, s: np.ndarray, m: np.ndarray) -> np.ndarray:
+        """(phi_S, phi_N) from sigma_nn = s and m = [P]_- at the quadrature points."""
         w = self.weight
         return np.concatenate([self.theta / self.gamma * w * (m - s), -w * m])
 
@@ -84,14 +86,19 @@ class SemismoothSystem:
 
     def residual(self, u: np.ndarray) -> np.ndarray:
         """K u + T' phi(T u) - F."""
-        return self.K @ u + self.T.T @ self.phi(self.T @ u) - self.F
+        return self.scaled_residual(u)[0]
 
-    def residuals(self, u: np.ndarray) -> Residuals:
-        """The relative nonlinear residual as ``stationarity``, relative to the largest of
-        ||K u||, ||F|| and ||T' phi||; the other residuals vanish by construction."""
+    def scaled_residual(self, u: np.ndarray) -> tuple[np.ndarray, float]:
+        """K u + T' phi(T u) - F and its scale, the largest of ||K u||, ||F|| and ||T' phi||
+        (1 when they all vanish)."""
         contact = self.T.T @ self.phi(self.T @ u)
         Ku = self.K @ u
         scale = max(np.linalg.norm(Ku), np.linalg.norm(self.F), np.linalg.norm(contact))
-        scale = scale if scale > 0 and np.isfinite(scale) else 1.0
+        return Ku + contact - self.F, scale if scale > 0 and np.isfinite(scale) else 1.0
+
+    def residuals(self, u: np.ndarray) -> Residuals:
+        """The relative nonlinear residual as ``stationarity``; the other residuals vanish by
+        construction."""
+        r, scale = self.scaled_residual(u)
         return Residuals(violation=0.0, dual_violation=0.0, complementarity=0.0,
-                         stationarity=float(np.linalg.norm(Ku + contact - self.F) / scale))
+                         stationarity=float(np.linalg.norm(r) / scale))

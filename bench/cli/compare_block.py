@@ -9,6 +9,7 @@ from pathlib import Path
 import pandas as pd
 
 from bench.hard import check_expected
+from bench.matrix.store import read_results
 from bench.perf.scaling import replace_in_readme
 from bench.verify import load_expected
 
@@ -32,8 +33,6 @@ def compare_block(table: pd.DataFrame, hard: pd.DataFrame | None, seconds: float
 
 def write_compare_block(readme: str | Path, results: str | Path, seconds: float) -> None:
     """Replace the README's compare block with the figures of the results folder."""
-    from bench.matrix.store import read_results
-
     hard_csv = Path(results) / "hard.csv"
     hard = pd.read_csv(hard_csv) if hard_csv.exists() else None
     replace_in_readme(readme, README_START, README_END,

@@ -1,25 +1,27 @@
-"""``active-set`` for a ``SemismoothSystem`` (Nitsche): semismooth Newton on the contact values
-(docs/theory.md, section 12.3).
+"""``active-set`` for a ``SemismoothSystem`` (Nitsche): semismooth Newton on the contact
+pressure (docs/theory.md, section 12.3).
 
 The equation K u + T' phi(T u) = F (``formulations.semismooth``) is piecewise linear: fixing the
-active set A = {q : P_q < 0} makes phi affine, phi = D_A z + c_A. With one factorisation of K
-(u0 = K^-1 F) and M = T K^-1 T' from the back-end's Schur complement on the DOFs T touches (the
-same route as the QP active-set solver), u = u0 - K^-1 T' phi(z) and the equation reduces to
-the small dense one
+active set A = {q : P_q < 0} makes phi affine. With one factorisation of K (u0 = K^-1 F) and
+M = T K^-1 T' from the back-end's Schur complement on the DOFs T touches (the same route as the
+QP active-set solver), u = u0 - K^-1 T' phi(z); eliminating sigma_nn at the quadrature points
+(one nq x nq factorisation, ``reduced_pressure``) leaves an equation in m = [P]_- alone,
 
-    R(z) = z - z0 + M phi(z) = 0,   z0 = T u0,   Jacobian J_A = I + M D_A.
+    R(m) = m - [P0 - G m]_- = 0,   Jacobian J_A = [[I + G_AA, G_AI], [0, I]],
 
-A semismooth Newton step from any z lands on J_A^-1 (z0 - M c_A), so the iteration is a
-primal-dual active set method: it stops when the active set of the new iterate is the one it
-was computed with (then R = 0 up to round-off: exact). It starts from the warm start's pressure
-(nested iteration) or from the unconstrained solution's active set.
+so a step costs one |A| x |A| solve. A semismooth Newton step from any m lands on the solution
+of the affine equation of its active set, so the iteration is a primal-dual active set method:
+it stops when the active set of the new iterate is the one it was computed with (then R = 0 up
+to round-off: exact). It starts from the warm start's pressure (nested iteration) or from the
+unconstrained solution's active set; one step of iterative refinement in the full space
+(``refine``) then removes what the partial factorisation leaves.
 
 Safeguard: the plain iteration can cycle for a nonsymmetric J (theta != 1) or a small gamma_0.
 When it revisits an active set or reaches ``max_iter``, it continues from the iterate with the
 smallest |R| as a damped Newton method with Armijo backtracking on the merit |R|^2 (the
 ``safeguard`` diagnostic says so); if that fails too, the status is ``failed`` with the reason.
-Back-ends without a Schur complement (splu) run the same iteration on the full sparse system
-K + T' D_A T, factorised once per iteration.
+Back-ends without a Schur complement (splu) run the same iteration on u with the full sparse
+Jacobian K + T' D_A T, factorised once per iteration.
 """
 
 from __future__ import annotations
@@ -95,9 +97,7 @@ class ReducedPressure:
         return self.E @ s_free + gamma * (gap - z0[nq:]), s_free
 
     def phi(self, s_free: np.ndarray, m: np.ndarray) -> np.ndarray:
-        system = self.system
-        s, w = s_free + self.LR @ m, system.weight
-        return np.concatenate([system.theta / system.gamma * w * (m - s), -w * m])
+        return self.system.phi_of(s_free + self.LR @ m, m)
 
 
 def reduced_pressure(system: SemismoothSystem, M: np.ndarray) -> ReducedPressure:
@@ -146,8 +146,8 @@ def sparse_problem(system: SemismoothSystem) -> Linearised:
     T = system.T
 
     def step(active, u):
-        D, c = system.phi_affine(active)
-        J = (system.K + T.T @ D @ T).tocsc()
+        J = system_matrix(system, active).tocsc()
+        c = system.phi_affine(active)[1]
         return splu(J).solve(-(J @ u + T.T @ c - system.F)), float("nan")
 
     return Linearised(system.residual, lambda u: system.pressure_argument(T @ u), step,
@@ -231,7 +231,8 @@ def solve_semismooth(system: SemismoothSystem, warm_start: np.ndarray | None = N
     result = newton(problem, x, active, max_iter)
     phases.append(("iterate", time.perf_counter() - clock))
     u = result.x
-    if condenses(backend):
+    ok = result.status == STATUS_OK
+    if ok and condenses(backend):
         clock = time.perf_counter()
         u = refine(system, factor.solve, reduced,
                    u0 - factor.solve(T.T @ reduced.phi(s_free, result.x)))
@@ -239,7 +240,6 @@ def solve_semismooth(system: SemismoothSystem, warm_start: np.ndarray | None = N
     diagnostics = SolverDiagnostics(active_set_changes=result.changes, cycled=result.cycled,
                                     safeguard=result.safeguard,
                                     condition_estimate=result.condition, phases=tuple(phases))
-    ok = result.status == STATUS_OK
     return QPSolution(u=u if ok else None, multipliers=system.pressure(u) if ok else None,
                       status=result.status, reason=result.reason, iterations=result.iterations,
                       solve_time=time.perf_counter() - start, solver="active-set",
@@ -255,17 +255,17 @@ def refine(system: SemismoothSystem, solve: Callable, reduced: ReducedPressure, 
     reduced one with zero gap), two solves with the factor and one |A| x |A| solve a step."""
     T = system.T
     active = system.pressure_argument(T @ u) < 0
-    r = system.residual(u)
+    r, scale = system.scaled_residual(u)
     for _ in range(steps):
-        if system.residuals(u).stationarity <= REFINED:
+        if np.linalg.norm(r) <= REFINED * scale:
             break
         y = -solve(r)
         P0, s_free = reduced.free(T @ y, np.zeros(system.nq))
         du = y - solve(T.T @ reduced.phi(s_free, active_solve(reduced.G, active, P0)))
-        trial = system.residual(u + du)
+        trial, trial_scale = system.scaled_residual(u + du)
         if np.linalg.norm(trial) >= np.linalg.norm(r):
             break
-        u, r = u + du, trial
+        u, r, scale = u + du, trial, trial_scale
     return u
 
 
