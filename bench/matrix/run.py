@@ -166,8 +166,8 @@ def _truths(specs: list[SequenceSpec], out, crosscheck: bool) -> dict:
         judged[truth_name(spec)] = (max(dofs, spec.max_dofs), max(order, spec.order), first)
     truths = {}
     for name, (dofs, order, spec) in judged.items():
-        truths[name] = truth_for(build_scene(spec), spec.reference_dofs, dofs, order,
-                                 crosscheck)
+        truths[name] = truth_for(scenes[spec.scene, spec.scene_parameters],
+                                 spec.reference_dofs, dofs, order, crosscheck)
         write_truth_summary(out, name, truths[name])
         if truths[name] is None:
             print(f"note: scene {spec.scene!r} has no exact solution and no reference budget "
