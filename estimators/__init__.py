@@ -5,14 +5,15 @@ new module with a ``@register_estimator`` ``estimate(scene, solution)`` function
 line here.
 """
 
-from estimators import averaging, nitsche_residual, residual  # noqa: F401  (register themselves)
+from estimators import averaging, equilibrated, nitsche_residual, residual  # noqa: F401  (register themselves)
 from estimators.base import (
     Estimate,
     estimator_descriptions,
     estimator_names,
     get_estimator,
+    guaranteed_estimators,
     register_estimator,
 )
 
 __all__ = ["Estimate", "estimator_descriptions", "estimator_names", "get_estimator",
-           "register_estimator"]
+           "guaranteed_estimators", "register_estimator"]

@@ -25,6 +25,7 @@ class Estimate:
     eta_geometric: float
     eta_complementarity: float
     indicators: np.ndarray
+    guaranteed: bool = False  # eta is an upper bound of ||u - u_h|| with no unknown constant
 
 
 def combine(estimator: str, volume: np.ndarray, contact) -> Estimate:
@@ -40,7 +41,22 @@ def combine(estimator: str, volume: np.ndarray, contact) -> Estimate:
 
 
 ESTIMATORS = Registry("estimator")
-register_estimator = ESTIMATORS.register
+_GUARANTEED: set[str] = set()
+
+
+def register_estimator(name: str, description: str, applies=None, guaranteed: bool = False):
+    """Register ``estimate(scene, solution) -> Estimate`` under ``name``; ``guaranteed``: its
+    eta is an upper bound of the energy error with every constant computed (what
+    ``--target-error`` needs)."""
+    if guaranteed:
+        _GUARANTEED.add(name)
+    return ESTIMATORS.register(name, description, applies)
+
+
+def guaranteed_estimators() -> list[str]:
+    return sorted(n for n in _GUARANTEED if n in ESTIMATORS.names())
+
+
 estimator_names = ESTIMATORS.names
 estimator_descriptions = ESTIMATORS.descriptions
 get_estimator = ESTIMATORS.get

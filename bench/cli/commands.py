@@ -109,7 +109,7 @@ def run_command(args) -> int:
         reference_crosscheck=args.reference_crosscheck, crosscheck_dofs=args.crosscheck_dofs,
         max_memory_gib=args.max_memory, out=args.out,
         overwrite=args.overwrite, workers=args.workers, scheduler=args.scheduler,
-        cache=args.cache, scene_files=tuple(args.scene_file),
+        cache=args.cache, scene_files=tuple(args.scene_file), target_error=args.target_error,
         command=" ".join(["python -m bench", *args.argv]))
     return run_config(config)
 

@@ -4,6 +4,7 @@ value and what is allowed."""
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 
 from bench.matrix.distributed import SchedulerError, scheduler_endpoint
@@ -105,6 +106,20 @@ def gib(text: str) -> float:
     if not (value > 0 and value < float("inf")):
         raise argparse.ArgumentTypeError(f"max_memory={text!r} is not a number of GiB > 0")
     return value
+
+
+def positive_float(name: str):
+    """A finite number > 0, named ``name`` in the error."""
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            value = float("nan")
+        if not (math.isfinite(value) and value > 0):
+            raise argparse.ArgumentTypeError(f"{name}={text!r} is not a number > 0")
+        return value
+
+    return parse
 
 
 def theta_value(text: str) -> float:

@@ -10,6 +10,7 @@ from bench.cli.option_types import (
     name_list,
     non_negative_int,
     order_list,
+    positive_float,
     positive_int,
     scheduler_address,
     sequence_budgets,
@@ -88,6 +89,11 @@ def _run_parser(sub) -> None:
                      help="DOF budget: stop before a level with more unknowns (default: 20000)")
     run.add_argument("--max-levels", type=positive_int("max_levels"), default=40,
                      help="maximum number of levels (default: 40)")
+    run.add_argument("--target-error", type=positive_float("target_error"), default=None,
+                     metavar="TOL",
+                     help="stop each sequence at the first level whose guaranteed error bound "
+                          "is at most TOL (energy norm; needs a guaranteed estimator such as "
+                          "equilibrated; default: off)")
     run.add_argument("--marking", choices=MARKINGS, default="doerfler",
                      help="adaptive marking: doerfler (bulk) or maximum (default: doerfler)")
     run.add_argument("--theta", type=theta_value, default=0.5,

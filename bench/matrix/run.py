@@ -31,7 +31,7 @@ from bench.matrix.store import ResultStore
 from bench.sequence.loop import STRATEGIES, LevelResult
 from bench.sequence.rows import COLUMNS, ResultRow
 from bench.truth import truth_for
-from estimators import estimator_names
+from estimators import estimator_names, guaranteed_estimators
 from formulations import STATUS_FAILED, formulation_names, solver_names
 from formulations.elasticity import ORDERS, check_order
 from formulations.solvers.backends import check_backend
@@ -73,6 +73,7 @@ class RunConfig:
     scheduler: str | None = None  # the address of an existing Dask cluster
     cache: str | None = None  # reference cache folder (default $SIGNORINI_BENCH_CACHE)
     scene_files: tuple[str, ...] = ()  # Python files that register scenes (--scene-file)
+    target_error: float | None = None  # stop each sequence once its guaranteed eta is below
     command: str = ""  # how the run was asked for, recorded in run.json
 
     def __post_init__(self):
@@ -107,6 +108,11 @@ class RunConfig:
             raise ValueError(f"out={self.out!r} is empty; give an output folder")
         if self.scheduler is not None:
             scheduler_endpoint(self.scheduler)
+        unsafe = [e for e in self.estimators if e not in guaranteed_estimators()]
+        if self.target_error is not None and unsafe:
+            raise ValueError(f"target_error={self.target_error!r} needs estimators whose eta is "
+                             f"a guaranteed bound ({', '.join(guaranteed_estimators())}); "
+                             f"{', '.join(unsafe)} bound the error only up to a constant")
         self.specs()[0].loop_config(self.max_memory_gib)  # validates the loop's options
 
     def specs(self) -> list[SequenceSpec]:
@@ -116,7 +122,8 @@ class RunConfig:
             self.solvers, self.estimators, self.strategies, self.orders, max_dofs=self.max_dofs,
             max_levels=self.max_levels, marking=self.marking, theta=self.theta,
             nested=self.nested, backend=self.backend, reference_dofs=self.reference_dofs,
-            crosscheck_dofs=self.crosscheck_dofs, scene_source=source_digest(self.scene_files))
+            crosscheck_dofs=self.crosscheck_dofs, scene_source=source_digest(self.scene_files),
+            target_error=self.target_error)
 
     def record(self) -> dict:
         """The configuration as written to run.json."""

@@ -38,12 +38,14 @@ class SequenceSpec:
     reference_dofs: int | None = None
     crosscheck_dofs: int = 0
     scene_source: str = ""  # digest of the --scene-file files ('' without)
+    target_error: float | None = None  # --target-error (None without)
 
     @property
     def key(self) -> str:
         fields = asdict(self)
-        if not fields["scene_source"]:  # keys of runs without scene files stay as they were
-            del fields["scene_source"]
+        for name in ("scene_source", "target_error"):  # keys without them stay as they were
+            if not fields[name]:
+                del fields[name]
         text = json.dumps({**fields, "version": SPEC_VERSION}, sort_keys=True, default=str)
         return hashlib.sha256(text.encode()).hexdigest()[:20]
 
@@ -51,6 +53,7 @@ class SequenceSpec:
         return LoopConfig(strategy=self.strategy, order=self.order, max_dofs=self.max_dofs,
                           max_levels=self.max_levels, marking=self.marking, theta=self.theta,
                           nested=self.nested, max_memory_gib=max_memory_gib,
+                          target_error=self.target_error,
                           solver_options={"backend": self.backend} if self.backend else {})
 
     @property

@@ -53,6 +53,9 @@ class LoopConfig:
     # refuse a level whose predicted peak memory exceeds this (GiB); None: what the machine has
     # available minus a margin (bench.sequence.memory)
     max_memory_gib: float | None = None
+    # stop at the first level whose guaranteed bound eta is at most this (needs an estimator
+    # whose Estimate is guaranteed)
+    target_error: float | None = None
 
     def __post_init__(self):
         if self.strategy not in STRATEGIES:
@@ -63,6 +66,9 @@ class LoopConfig:
             if not (is_integer(value) and value > 0):
                 raise ValueError(f"{name}={value!r} is not a positive integer")
         check_marking(self.marking, self.theta)
+        if self.target_error is not None and not (
+                is_number(self.target_error) and self.target_error > 0):
+            raise ValueError(f"target_error={self.target_error!r} is not a number > 0")
         if self.max_memory_gib is not None and not (
                 is_number(self.max_memory_gib) and self.max_memory_gib > 0):
             raise ValueError(f"max_memory_gib={self.max_memory_gib!r} is not a number > 0")
@@ -119,7 +125,8 @@ def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
                  formulation_options: dict | None = None) -> Generator[LevelResult, None, str]:
     """Yield one ``LevelResult`` per level until the DOF budget or the level count is reached,
     or a level fails (its row says why); return why it ended (``budget``, ``max_levels``,
-    ``memory``, ``failed``). With a ``truth`` (``bench.truth``) every level also gets its
+    ``memory``, ``failed``, ``target``: the guaranteed bound reached ``config.target_error``).
+    With a ``truth`` (``bench.truth``) every level also gets its
     errors and effectivity indices; ``identity``: the run's columns (run id, provenance, sweep
     labels); ``formulation_options`` go to the formulation's ``discretise``, with the
     configuration's ``order``."""
@@ -163,9 +170,16 @@ def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
                 numbers.update(error_columns(truth, sol, est))
             if solver != "reference" and disc.ndofs <= crosscheck_dofs:
                 numbers.update(crosscheck_columns(disc, sol))
+        reached = (not failed and config.target_error is not None and est.guaranteed
+                   and est.eta <= config.target_error)
+        if reached:
+            numbers["reason"] = (f"{numbers['reason']}; " if numbers["reason"] else "") + (
+                f"target reached: guaranteed eta={est.eta:.4g} <= {config.target_error:g}")
         yield LevelResult(ResultRow(**ident, **numbers), sol, est)
         if failed:
             return "failed"
+        if reached:
+            return "target"
         if config.strategy == "uniform" and predict_uniform_free_dofs(
                 scene, mesh, config.order) > config.max_dofs:
             return "budget"

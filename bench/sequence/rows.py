@@ -73,7 +73,7 @@ class ResultRow:
     scene_parameters: str = ""  # a sweep's scene parameters, "name=value:name=value"
     formulation_options: str = ""  # a sweep's formulation options, the same way
     sequence_key: str = ""  # hash of everything that determines the sequence
-    sequence_end: str = ""  # why it ended: budget, max_levels, memory, failed, interrupted
+    sequence_end: str = ""  # why it ended: budget, max_levels, memory, failed, target, interrupted
     run_id: str = ""
     commit: str = ""
     python: str = ""
@@ -90,7 +90,7 @@ KEYS = ["scene", "formulation", "solver", "estimator", "strategy", "order", "sce
         "formulation_options"]
 LABELS = ["scene_parameters", "formulation_options"]
 # sequence_end of a complete sequence; INTERRUPTED (or no end at all) marks one cut short
-FINISHED = ("budget", "max_levels", "memory", "failed", "skipped")
+FINISHED = ("budget", "max_levels", "memory", "failed", "skipped", "target")
 INTERRUPTED = "interrupted"
 # the phases of a level whose wall times add up to the level's time
 PHASE_TIMES = ["t_assemble", "t_solve", "t_estimate", "t_refine"]

@@ -1,0 +1,87 @@
+"""The two domain constants of the guaranteed bound (docs/theory.md, section 13.4).
+
+* Korn-type: C_K^2 = sup_v ||skw grad v||^2 / a(v, v) over v = 0 on Gamma_D, which bounds the
+  skew-symmetric part of a row-wise reconstruction;
+* trace: C_T^2 = sup_v ||v . n||_{0,Gamma_C}^2 / a(v, v), which bounds the dual norm of a
+  negative part of the auxiliary contact traction;
+* Friedrichs: C_F^2 = sup_v ||v||_0^2 / a(v, v), which bounds the dual norm of the load that
+  restores the balance of patches the discrete solution does not balance exactly.
+
+Each is the largest eigenvalue of a generalised eigenproblem on P2 finite elements of the
+scene's initial mesh refined uniformly. Discrete suprema approach the true ones from below; the
+value used is the one on the finer of two meshes plus the change between them, once per scene
+and process.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.sparse.linalg import eigsh
+from skfem import Basis, BilinearForm, FacetBasis, asm
+from skfem.helpers import dot
+
+from formulations.elasticity import assemble_elasticity
+
+MIN_DOFS = 1500  # the coarser of the two meshes has at least this many P2 DOFs
+
+
+@dataclass(frozen=True)
+class DomainConstants:
+    korn: float        # C_K
+    trace: float       # C_T
+    friedrichs: float  # C_F
+    coarse: tuple[float, float, float]  # the three on the coarser mesh
+    dofs: int          # free DOFs of the finer mesh
+
+
+@BilinearForm
+def _skew(u, v, w):
+    a = 0.5 * (u.grad[0, 1] - u.grad[1, 0])
+    b = 0.5 * (v.grad[0, 1] - v.grad[1, 0])
+    return 2.0 * a * b
+
+
+@BilinearForm
+def _mass(u, v, w):
+    return dot(u, v)
+
+
+def _largest(scene, mesh) -> tuple[list[float], int]:
+    elasticity = assemble_elasticity(scene, mesh, order=2)
+    free = elasticity.free
+    K = elasticity.K[free][:, free].tocsc()
+    skew = asm(_skew, Basis(mesh, elasticity.basis.elem, intorder=2))[free][:, free]
+    facets = scene.contact_facets(mesh)
+
+    @BilinearForm
+    def normal_mass(u, v, w):
+        return dot(u, w.n) * dot(v, w.n)
+
+    trace = asm(normal_mass, FacetBasis(mesh, elasticity.basis.elem, facets=facets,
+                                        intorder=4))[free][:, free]
+    mass = asm(_mass, Basis(mesh, elasticity.basis.elem, intorder=4))[free][:, free]
+    values = []
+    for A in (skew, trace, mass):
+        top = eigsh(A.tocsc(), k=1, M=K, which="LA", return_eigenvectors=False)
+        values.append(float(np.sqrt(max(top[0], 0.0))))
+    return values, int(free.size)
+
+
+_CACHE: dict[str, DomainConstants] = {}
+
+
+def domain_constants(scene) -> DomainConstants:
+    """C_K, C_T and C_F of ``scene`` (cached per scene name and parameters)."""
+    key = f"{scene.name}:{sorted(scene.parameters.items())!r}"
+    if key not in _CACHE:
+        mesh = scene.mesh
+        while 2 * (mesh.p.shape[1] + mesh.facets.shape[1]) < MIN_DOFS:
+            mesh = mesh.refined()
+        coarse, _ = _largest(scene, mesh)
+        fine, dofs = _largest(scene, mesh.refined())
+        korn, trace, friedrichs = (f + abs(f - c) for f, c in zip(fine, coarse, strict=True))
+        _CACHE[key] = DomainConstants(korn=korn, trace=trace, friedrichs=friedrichs,
+                                      coarse=tuple(coarse), dofs=dofs)
+    return _CACHE[key]

@@ -1,0 +1,145 @@
+"""``equilibrated``: a guaranteed upper bound of the energy error from an equilibrated stress
+and Theorem 1 of the seed paper with every constant computed (docs/theory.md, section 13).
+
+    A   = ||C^{-1/2}(sym sigma* - sigma_h)|| + C_K ||skw sigma*|| + osc  >= ||u_0 - u_h||,
+    D   = ||d|| >= ||(g - u_hn)_-||'_{1/2},     N = C_T ||lambda*_-||_{0,Gamma_C},
+    B   = (lambda*_+, g - u_hn - d . n)_{Gamma_C},
+    eta = (a + sqrt(a^2 + 4 b)) / 2,  a = A + D + N,  b = A D + B,
+
+with u_0 the solution of the auxiliary problem (4) with contact traction lambda*, sigma* its
+equilibrated stress (``estimators.equilibration``), d an extension of (g - u_hn)_-
+(``estimators.guaranteed_contact``), C_K and C_T the domain constants
+(``estimators.constants``) and osc the data oscillation with the Poincare constant 1/pi and a
+computed trace constant. eta_0 reports A, eta_geometric D and eta_complementarity sqrt(B).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from skfem import Basis, ElementDG, FacetBasis
+
+from estimators.averaging import compliance_energy, element_areas
+from estimators.base import Estimate, register_estimator
+from estimators.constants import domain_constants
+from estimators.equilibration import (
+    BoundaryData,
+    boundary_balance,
+    interior_data,
+    rebalanced,
+    reconstruct,
+)
+from estimators.guaranteed_contact import (
+    balanced_traction,
+    contact_bound,
+    traction_at,
+)
+from formulations import DiscreteSolution
+from formulations.elasticity import ELEMENTS, element_diameters, stress_from_gradient
+
+# The bound needs the patch data to balance (docs/theory.md, 13.2); past this relative
+# imbalance (round-off is ~1e-12) the stress is not equilibrated and no bound is claimed.
+BALANCE_TOLERANCE = 1e-8
+
+
+class NotEquilibrated(RuntimeError):
+    """The discrete solution does not balance the auxiliary problem's hat functions."""
+
+
+def nitsche_consistency(scene=None, formulation: str = "", options=None, **_) -> str | None:
+    theta = (options or {}).get("theta", 1.0)
+    if formulation == "nitsche" and theta != 0:
+        return (f"equilibrated needs u_h to satisfy the auxiliary problem (4) with a contact "
+                f"traction; Nitsche's theta={theta!r} adds a consistency term in sigma_nn(v) "
+                f"that is no traction (theta=0 is)")
+    return None
+
+
+@register_estimator("equilibrated", "guaranteed upper bound: equilibrated RT stress on vertex "
+                                    "patches (Prager-Synge) plus Theorem 1's contact terms, "
+                                    "every constant computed", applies=nitsche_consistency,
+                    guaranteed=True)
+def estimate(scene, solution: DiscreteSolution) -> Estimate:
+    elasticity = solution.elasticity
+    mesh, order = elasticity.mesh, elasticity.order
+    lam, mu = elasticity.lame
+    intorder = max(4, 2 * order + 2)
+
+    def stress(basis):
+        grad = Basis(mesh, elasticity.basis.elem, quadrature=basis.quadrature).interpolate(
+            solution.u).grad
+        s11, s22, s12 = stress_from_gradient(grad, lam, mu)
+        return np.array([[s11, s12], [s12, s22]])
+
+    clamped = np.zeros(mesh.p.shape[1], dtype=bool)
+    clamped[mesh.facets[:, scene.dirichlet_facets(mesh)].ravel()] = True
+    interior = interior_data(mesh, stress, scene.body_force, order, intorder)
+    trace = solution.trace
+    neumann = BoundaryData(scene.neumann_facets(mesh), scene.traction or (lambda x: 0.0 * x))
+    raw = BoundaryData(trace.facets, lambda x: traction_at(trace, solution.pressure, x))
+    defect = interior.total - boundary_balance(interior, [neumann, raw])
+    lam_star = balanced_traction(trace, solution.pressure, defect, clamped)
+    contact = BoundaryData(trace.facets, lambda x: traction_at(trace, lam_star, x))
+    defect = interior.total - boundary_balance(interior, [neumann, contact])
+    interior, load = rebalanced(interior, defect, clamped)
+    rec = reconstruct(interior, [neumann, contact], clamped)
+    if rec.imbalance > BALANCE_TOLERANCE:
+        raise NotEquilibrated(f"the patch data do not balance (relative imbalance "
+                              f"{rec.imbalance:.1e} > {BALANCE_TOLERANCE:g}): no bound")
+    constants = domain_constants(scene)
+    diff = rec.values - interior.sigma_h
+    sym = np.array([diff[0, 0], diff[1, 1], 0.5 * (diff[0, 1] + diff[1, 0])])
+    compliance = (compliance_energy(sym, lam, mu) * rec.basis.dx).sum(axis=1)
+    skew = ((rec.values[0, 1] - rec.values[1, 0]) ** 2 / 2 * rec.basis.dx).sum(axis=1)
+    osc = oscillation(scene, rec.basis, [neumann, contact])
+    grad_constant = np.sqrt(1 / (2 * mu) + constants.korn**2)
+    A = (np.sqrt(compliance.sum()) + constants.korn * np.sqrt(skew.sum())
+         + grad_constant * np.sqrt((osc**2).sum()) + constants.friedrichs * np.sqrt(load.sum()))
+    bound = contact_bound(scene, solution, lam_star, clamped)
+    a = A + bound.extension + constants.trace * bound.negative
+    b = A * bound.extension + bound.complementarity
+    eta = 0.5 * (a + np.sqrt(a * a + 4 * b))
+    local = (np.sqrt(compliance) + constants.korn * np.sqrt(skew) + grad_constant * osc
+             + constants.friedrichs * np.sqrt(load)) ** 2
+    local = local + bound.per_element
+    if local.sum() > 0:
+        local = local * eta**2 / local.sum()
+    return Estimate(estimator="equilibrated", eta=float(eta), eta_0=float(A),
+                    eta_geometric=bound.extension,
+                    eta_complementarity=float(np.sqrt(bound.complementarity)), indicators=local,
+                    guaranteed=True)
+
+
+def oscillation(scene, rt: Basis, boundary: list[BoundaryData]) -> np.ndarray:
+    """Per element, (h_T / pi) ||f - Pi_k f||_T + sum_e C_e ||t - Pi_k t||_e over its facets
+    with Neumann data, C_e^2 = |e| h_T^2 / |T| (1/pi^2 + 1/pi) (docs/theory.md, 13.3)."""
+    mesh, k = rt.mesh, rt.elem.k
+    out = np.zeros(mesh.t.shape[1])
+    if scene.body_force is not None:
+        dg = Basis(mesh, ElementDG(ELEMENTS[k]()), quadrature=rt.quadrature)
+        f = scene.body_force(rt.global_coordinates().value)
+        out += element_diameters(mesh) / np.pi * np.sqrt(_projection_error(dg, f))
+    for part in boundary:
+        if part.facets.size == 0:
+            continue
+        fb = FacetBasis(mesh, ELEMENTS[k](), facets=part.facets, intorder=8)
+        t = part.traction(fb.global_coordinates().value)
+        err = _projection_error(fb, t)
+        length = np.linalg.norm(mesh.p[:, mesh.facets[0, part.facets]]
+                                - mesh.p[:, mesh.facets[1, part.facets]], axis=0)
+        element = fb.tind
+        c_e = np.sqrt(length * element_diameters(mesh)[element] ** 2
+                      / element_areas(mesh)[element] * (1 / np.pi**2 + 1 / np.pi))
+        out += np.bincount(element, c_e * np.sqrt(err), mesh.t.shape[1])
+    return out
+
+
+def _projection_error(basis, values: np.ndarray) -> np.ndarray:
+    """||v - Pi v||^2 per element or facet of ``basis`` for v (2, n, nq), Pi the L2 projection
+    onto the span of the basis's local functions (on a facet the P_k functions of the triangle
+    span P_k(e) with repetitions: the pseudo-inverse of their Gram matrix)."""
+    phi = np.array([b[0].value for b in basis.basis])           # (m, n, nq)
+    gram = np.einsum("jnp,lnp,np->njl", phi, phi, basis.dx)
+    moments = np.einsum("jnp,rnp,np->nrj", phi, values, basis.dx)
+    coef = np.einsum("njl,nrl->nrj", np.linalg.pinv(gram, rcond=1e-10), moments)
+    projected = np.einsum("nrj,jnp->rnp", coef, phi)
+    return (((values - projected) ** 2).sum(axis=0) * basis.dx).sum(axis=1)

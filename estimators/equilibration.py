@@ -1,0 +1,326 @@
+"""Equilibrated stress reconstruction on vertex patches (docs/theory.md, section 13.2).
+
+For the auxiliary problem (4) of the seed paper with Neumann data t (q on Gamma_N, -lambda* n on
+Gamma_C), each row of the reconstructed stress sigma* is a Raviart-Thomas field RT_k of the
+degree k of the displacements (``estimators.raviart_thomas``: normal traces P_k per facet,
+divergence P_k per element), built as sigma* = sum_a sigma_a over the mesh vertices a, with
+sigma_a on the patch omega_a of a:
+
+    minimise ||sigma_a - psi_a sigma_h||_{0, omega_a}   (row by row, Frobenius)
+    subject to  div sigma_a = Pi_k (sigma_h grad psi_a - psi_a f)   on every element,
+                sigma_a n = 0                   on the facets of the patch opposite to a,
+                sigma_a n = Pi_k (psi_a t)      on the facets at a on Gamma_N and Gamma_C,
+
+(Braess-Schoeberl; Ern-Vohralik), psi_a the hat function of a and Pi_k the L2 projection onto
+P_k per element or facet. Off Gamma_D the constraints are solvable exactly when the patch data
+balance (the translations psi_a e_i are test functions of the discrete problem); the row of one
+constant multiplier is then redundant and dropped. The sum satisfies div sigma* + Pi_k f = 0 and
+sigma* n = Pi_k t on Gamma_N and Gamma_C. The patches are small dense saddle-point systems, solved
+in batches of equal size (no loop over patches).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+from skfem import (
+    Basis,
+    ElementDG,
+    ElementTriP0,
+    ElementTriP1,
+    ElementTriP4,
+    ElementVector,
+    FacetBasis,
+)
+from skfem.quadrature import get_quadrature
+from skfem.refdom import RefTri
+
+from estimators.patches import FIXED, FREE, ZERO, PairMatrices, layout, solve_patches
+from estimators.raviart_thomas import ElementTriRTk
+from formulations.elasticity import ELEMENTS
+from formulations.load import body_load
+
+# local facets of scikit-fem's triangles: 0 = (v0, v1), 1 = (v1, v2), 2 = (v0, v2); the k + 1
+# RT_k DOFs of local facet f are (k + 1) f .. (k + 1) f + k, the interior ones follow.
+_OPPOSITE_FACET = np.array([1, 2, 0])
+# weak symmetry only from k = 2, where V_h contains psi_a r_a and the rotation moments balance:
+# at k = 1 it made the bound larger on `paper` (docs/theory.md, 13.2)
+WEAK_SYMMETRY_FROM = 2
+_SCALARS = {0: ElementTriP0, **ELEMENTS, 4: ElementTriP4}
+
+
+@dataclass(frozen=True, eq=False)
+class Reconstruction:
+    """sigma* row by row as RT DOF vectors on ``basis`` (shape (2, basis.N)), the element values
+    of sigma* (2, 2, n_elements, n_points) at the quadrature points of ``basis``, and how far
+    the patch data were from balance (max over patches, relative to the largest patch datum)."""
+
+    basis: Basis
+    dofs: np.ndarray
+    values: np.ndarray
+    imbalance: float
+
+
+def element_matrices(rt: Basis):
+    """Local RT_k mass matrices (n_el, n_rt, n_rt), divergence matrices (n_el, n_dg, n_rt)
+    against the discontinuous P_k basis, symmetry matrices (n_el, n_sym, 2, n_rt): row r's
+    share of (sigma_12 - sigma_21, gamma) for gamma in the discontinuous P_(k-1) basis, and the
+    P_k DG basis on the same quadrature."""
+    k = rt.elem.k
+    dg = Basis(rt.mesh, ElementDG(ELEMENTS[k]()), quadrature=rt.quadrature)
+    rotation = Basis(rt.mesh, ElementDG(_SCALARS[k - 1]()), quadrature=rt.quadrature)
+    phi = np.array([b[0].value for b in rt.basis])          # (n_rt, 2, n_el, nq)
+    div = np.array([b[0].div for b in rt.basis])            # (n_rt, n_el, nq)
+    q = np.array([b[0].value for b in dg.basis])            # (n_dg, n_el, nq)
+    gamma = np.array([b[0].value for b in rotation.basis])  # (n_sym, n_el, nq)
+    mass = np.einsum("jiep,liep,ep->ejl", phi, phi, rt.dx)
+    divergence = np.einsum("lep,jep,ep->elj", q, div, rt.dx)
+    symmetry = np.stack([np.einsum("gep,jep,ep->egj", gamma, phi[:, 1], rt.dx),
+                         -np.einsum("gep,jep,ep->egj", gamma, phi[:, 0], rt.dx)], axis=2)
+    return mass, divergence, symmetry, dg
+
+
+def patch_rhs(rt: Basis, dg: Basis, hats: np.ndarray, sigma_h: np.ndarray,
+              hat_gradients: np.ndarray):
+    """r = (phi_j, psi_a sigma_h row) and c = (sigma_h grad psi_a, q_l) for every element,
+    local vertex a and row; sigma_h (2, 2, n_el, nq), hats (3, n_el, nq), hat_gradients
+    (3, 2, n_el). The load's part of c is ``load_moments``."""
+    phi = np.array([b[0].value for b in rt.basis])
+    q = np.array([b[0].value for b in dg.basis])
+    rhs = np.einsum("jkep,aep,rkep,ep->earj", phi, hats, sigma_h, rt.dx)
+    data = np.einsum("rkep,ake->arep", sigma_h, hat_gradients)
+    divergence = np.einsum("arep,lep,ep->earl", data, q, rt.dx)
+    return rhs, divergence
+
+
+def load_moments(mesh, body_force, k: int) -> np.ndarray:
+    """int_T f_r psi_a q_l per element, local vertex a, row r and P_k DG function q_l
+    (n_el, 3, 2, n_dg), with the load rule of ``formulations.load`` (refined where f is rough,
+    as for the load vector of the discrete problem): psi_a q_l is P_(k+1), so these are
+    combinations of the P_(k+1) DG load entries with its values at the P_(k+1) nodes."""
+    fine = _SCALARS[k + 1]()
+    basis = Basis(mesh, ElementVector(ElementDG(fine)), intorder=2 * k)
+    F = body_load(body_force, basis)[basis.element_dofs]                  # (2 n_fine, n_el)
+    per_node = F.reshape(-1, 2, mesh.t.shape[1])                           # node m, row r
+    nodes = fine.doflocs.T
+    hats = np.array([ElementTriP1().lbasis(nodes, a)[0] for a in range(3)])
+    coarse = ELEMENTS[k]()
+    q = np.array([coarse.lbasis(nodes, j)[0] for j in range(coarse.doflocs.shape[0])])
+    return np.einsum("mre,am,lm->earl", per_node, hats, q)
+
+
+def boundary_flux(mesh, facets: np.ndarray, traction, k: int, intorder: int):
+    """The prescribed RT_k DOF values of Pi_k (psi_a t) on boundary ``facets`` for both facet
+    vertices a: values (n_f, 2 vertices, 2 rows, k + 1 facet DOFs), the integrals of psi_a t
+    (n_f, 2, 2), the vertices (2, n_f), the elements (n_f,) and their local facet (n_f,).
+    ``traction(x)`` returns t (2, n_f, nq) at points x (2, n_f, nq)."""
+    fb = FacetBasis(mesh, ElementTriRTk(k), facets=facets, intorder=intorder)
+    hats = FacetBasis(mesh, ElementTriP1(), facets=facets, quadrature=fb.quadrature)
+    local = _local_facet(mesh, facets, fb.tind)
+    rows = np.arange(facets.size)
+    normal_trace = np.array([np.einsum("ifp,ifp->fp", b[0].value, fb.normals)
+                             for b in fb.basis])            # (8, n_f, nq)
+    own = (k + 1) * local[None, :] + np.arange(k + 1)[:, None]         # (k + 1, n_f)
+    trace = normal_trace[own, rows[None, :]]                           # (k + 1, n_f, nq)
+    gram = np.einsum("jfp,lfp,fp->fjl", trace, trace, fb.dx)
+    t = traction(fb.global_coordinates().value)
+    ends = mesh.facets[:, facets]
+    vertex_local = (mesh.t[:, fb.tind][None, :, :] == ends[:, None, :]).argmax(axis=1)
+    psi = np.array([b[0].value for b in hats.basis])[vertex_local, rows[None, :]]  # (2, n_f, nq)
+    moments = np.einsum("vfp,rfp,jfp,fp->fvrj", psi, t, trace, fb.dx)
+    values = np.linalg.solve(gram[:, None, None], moments[..., None])[..., 0]
+    integrals = np.einsum("vfp,rfp,fp->fvr", psi, t, fb.dx)
+    x = fb.global_coordinates().value
+    arm = x[None] - mesh.p[:, ends].transpose(1, 0, 2)[..., None]      # x - x_a, (2, 2, n_f, nq)
+    turn = t[1][None] * arm[:, 0] - t[0][None] * arm[:, 1]              # t . r_a
+    return values, integrals, ends, fb.tind, local, np.einsum("vfp,vfp,fp->fv", psi, turn, fb.dx)
+
+
+def _local_facet(mesh, facets: np.ndarray, elements: np.ndarray) -> np.ndarray:
+    return (mesh.t2f[:, elements] == facets[None, :]).argmax(axis=0)
+
+
+@dataclass(frozen=True)
+class BoundaryData:
+    """Neumann data t on boundary ``facets``: ``traction(x)`` gives t (2, n_f, nq) at the points
+    x (2, n_f, nq) of those facets (in that order)."""
+
+    facets: np.ndarray
+    traction: object
+
+
+@dataclass(frozen=True, eq=False)
+class Interior:
+    """The element data of the patch problems (independent of the boundary data): the RT_k
+    basis, sigma_h at its quadrature points (2, 2, n_el, nq), the element matrices, the pair
+    right-hand sides rhs (n_el, 3, 2, n_rt) and divergence data (n_el, 3, 2, n_dg), per vertex
+    sum_T int_T (sigma_h grad psi_a - psi_a f) (n_vertices, 2), and the degree k and the
+    quadrature order used."""
+
+    rt: Basis
+    sigma_h: np.ndarray
+    mass: np.ndarray
+    divergence: np.ndarray
+    symmetry: np.ndarray
+    rhs: np.ndarray
+    data: np.ndarray
+    total: np.ndarray
+    k: int
+    intorder: int
+
+
+def interior_data(mesh, sigma_h, body_force, k: int, intorder: int) -> Interior:
+    """``sigma_h(basis)`` returns sigma(u_h) (2, 2, n_el, nq) at the quadrature points of a
+    basis; ``body_force`` f (2, ...) at points, or None; k the RT degree."""
+    rt = Basis(mesh, ElementTriRTk(k), intorder=intorder)
+    mass, divergence, symmetry, dg = element_matrices(rt)
+    hats = np.array([b[0].value for b in Basis(mesh, ElementTriP1(),
+                                               quadrature=rt.quadrature).basis])
+    stress = sigma_h(rt)
+    rhs, data = patch_rhs(rt, dg, hats, stress, hat_gradients(mesh))
+    if body_force is not None:
+        data = data - load_moments(mesh, body_force, k)
+    total = np.array([np.bincount(mesh.t.T.ravel(), data[:, :, r].sum(axis=-1).ravel(),
+                                  minlength=mesh.p.shape[1]) for r in (0, 1)]).T
+    return Interior(rt=rt, sigma_h=stress, mass=mass, divergence=divergence,
+                    symmetry=symmetry, rhs=rhs, data=data, total=total, k=k, intorder=intorder)
+
+
+def boundary_balance(interior: Interior, boundary: list[BoundaryData]) -> np.ndarray:
+    """int psi_a t over the boundary, per vertex (n_vertices, 2)."""
+    mesh = interior.rt.mesh
+    balance = np.zeros((mesh.p.shape[1], 2))
+    for part in boundary:
+        if part.facets.size:
+            _, integrals, ends, _, _, _ = boundary_flux(mesh, part.facets, part.traction,
+                                                     interior.k, interior.intorder)
+            for v in (0, 1):
+                np.add.at(balance, ends[v], integrals[:, v])
+    return balance
+
+
+def rebalanced(interior: Interior, defect: np.ndarray,
+               clamped: np.ndarray) -> tuple[Interior, np.ndarray]:
+    """The patch data with the load rho = sum_a (defect_a / int psi_a) psi_a (off Gamma_D)
+    added, so that every patch balances, and ||rho||_{0,T}^2 per element (docs/theory.md,
+    13.2): sum_T int_T (data) then equals the boundary fluxes for every vertex."""
+    mesh = interior.rt.mesh
+    area = element_area(mesh)
+    weight = np.bincount(mesh.t.ravel(), np.tile(area / 3, 3), minlength=mesh.p.shape[1])
+    c = np.where(clamped[:, None], 0.0, defect / weight[:, None])      # (n_vertices, 2)
+    local = c[mesh.t]                                                  # (3, n_el, 2)
+    data = interior.data - np.einsum("ier,il,e->eirl", local, _hat_moments(interior.k), area)
+    norm2 = area / 12 * ((local**2).sum(axis=0) + local.sum(axis=0) ** 2).sum(axis=-1)
+    total = interior.total - np.where(clamped[:, None], 0.0, defect)
+    return replace(interior, data=data, total=total), norm2
+
+
+def _hat_moments(k: int) -> np.ndarray:
+    """int_T lambda_i q_l / |T| for the barycentric lambda_i and the P_k DG basis q_l, (3, n_dg)
+    (the same on every triangle)."""
+    X, W = get_quadrature(RefTri, k + 1)
+    element = ELEMENTS[k]()
+    q = np.array([element.lbasis(X, j)[0] for j in range(element.doflocs.shape[0])])
+    hats = np.array([ElementTriP1().lbasis(X, a)[0] for a in range(3)])
+    return np.einsum("ap,lp,p->al", hats, q, W) / W.sum()
+
+
+def element_area(mesh) -> np.ndarray:
+    p = mesh.p[:, mesh.t]
+    return 0.5 * np.abs((p[0, 1] - p[0, 0]) * (p[1, 2] - p[1, 0])
+                        - (p[0, 2] - p[0, 0]) * (p[1, 1] - p[1, 0]))
+
+
+def reconstruct(interior: Interior, boundary: list[BoundaryData],
+                clamped: np.ndarray) -> Reconstruction:
+    """sigma* of the module docstring; ``clamped`` (n_vertices,) marks the vertices on
+    Gamma_D (their patches have no balance condition)."""
+    rt, k = interior.rt, interior.k
+    mesh = rt.mesh
+    n_el, n_v = mesh.t.shape[1], mesh.p.shape[1]
+    patch = mesh.t.T.ravel()                     # pair p = 3 e + i
+    element = np.repeat(np.arange(n_el), 3)
+    dofs = rt.element_dofs.T[element]
+    n_rt, n_dg = interior.rhs.shape[-1], interior.data.shape[-1]
+    facet_of_dof = np.concatenate([np.repeat(np.arange(3), k + 1), np.full(k * (k + 1), -1)])
+    status = np.full((patch.size, n_rt), FREE)
+    status[facet_of_dof[None, :] == _OPPOSITE_FACET[np.tile(np.arange(3), n_el)][:, None]] = ZERO
+    fixed = np.zeros((patch.size, n_rt, 2))
+    balance, turning = np.zeros((n_v, 2)), np.zeros(n_v)
+    for part in boundary:
+        if part.facets.size == 0:
+            continue
+        values, integrals, ends, elements, local, turn = boundary_flux(
+            mesh, part.facets, part.traction, k, interior.intorder)
+        for v in (0, 1):
+            p = 3 * elements + (mesh.t[:, elements] == ends[v][None, :]).argmax(axis=0)
+            for j in range(k + 1):
+                status[p, (k + 1) * local + j] = FIXED
+                fixed[p, (k + 1) * local + j] = values[:, v, :, j]
+            np.add.at(balance, ends[v], integrals[:, v])
+            np.add.at(turning, ends[v], turn[:, v])
+    data = interior.data.reshape(-1, 2, n_dg)
+    n_sym = interior.symmetry.shape[1] if k >= WEAK_SYMMETRY_FROM else 0
+    pairs = PairMatrices(mass=interior.mass[element], divergence=interior.divergence[element],
+                         symmetry=interior.symmetry[element][:, :n_sym],
+                         rhs=interior.rhs.reshape(-1, 2, n_rt).transpose(0, 2, 1),
+                         data=data.transpose(0, 2, 1),
+                         skew=skew_data(interior, data, turning, clamped)[:, :n_sym], fixed=fixed)
+    lay = layout(patch, dofs, status, rt.N, n_v)
+    free_values = solve_patches(lay, pairs, clamped)
+    sigma = np.zeros((2, rt.N))
+    for r in (0, 1):
+        np.add.at(sigma[r], lay.key_dof, free_values[:, r])
+        np.add.at(sigma[r], dofs[status == FIXED], fixed[..., r][status == FIXED])
+    values = field_values(rt, sigma)
+    gap = (interior.total - balance)[~clamped]
+    scale = np.abs(interior.total).max() + np.abs(balance).max() + np.finfo(float).tiny
+    return Reconstruction(basis=rt, dofs=sigma, values=values,
+                          imbalance=float(np.abs(gap).max(initial=0.0) / scale))
+
+
+def field_values(rt: Basis, dofs: np.ndarray) -> np.ndarray:
+    """The values (2, 2, n_el, nq) of the RT fields with DOFs ``dofs`` (2, rt.N) at the
+    quadrature points (row, component, element, point)."""
+    local = dofs[:, rt.element_dofs]                                    # (2, n_rt, n_el)
+    out = np.zeros((2, 2) + rt.dx.shape)
+    for j, phi in enumerate(rt.basis):
+        out += local[:, j][:, None, :, None] * phi[0].value[None]
+    return out
+
+
+def skew_data(interior: Interior, data: np.ndarray, turning: np.ndarray,
+              clamped: np.ndarray) -> np.ndarray:
+    """The right-hand side (P, n_sym) of the weak symmetry constraint: the rotation moment
+    R_a = (data, r_a) - int psi_a t . r_a of each patch off Gamma_D (r_a the rotation about a;
+    zero when u_h balances psi_a r_a, which V_h contains from k = 2), spread over the patch's
+    elements by their share of int psi_a (docs/theory.md, 13.2). Its integral over the patch is
+    then R_a, which makes the patch problem solvable."""
+    mesh, k = interior.rt.mesh, interior.k
+    n_v = mesh.p.shape[1]
+    bary = np.column_stack([1 - ELEMENTS[k]().doflocs.sum(axis=1), ELEMENTS[k]().doflocs])
+    nodes = np.einsum("li,cie->ecl", bary, mesh.p[:, mesh.t])          # (n_el, 2, n_dg)
+    vertex = mesh.p[:, mesh.t.T.ravel()].T                             # (P, 2)
+    arm = np.repeat(nodes, 3, axis=0) - vertex[:, :, None]             # (P, 2, n_dg)
+    moment = (data[:, 1] * arm[:, 0] - data[:, 0] * arm[:, 1]).sum(axis=-1)
+    rotation = np.bincount(mesh.t.T.ravel(), moment, minlength=n_v) - turning
+    rotation[clamped] = 0.0
+    area = element_area(mesh)
+    weight = np.bincount(mesh.t.ravel(), np.tile(area / 3, 3), minlength=n_v)
+    share = np.repeat(area / 3, 3) / weight[mesh.t.T.ravel()]
+    X, W = get_quadrature(RefTri, k)
+    scalar = _SCALARS[k - 1]()
+    mean = np.array([(scalar.lbasis(X, g)[0] * W).sum() / W.sum()
+                     for g in range(scalar.doflocs.shape[0])])
+    return (rotation[mesh.t.T.ravel()] * share)[:, None] * mean[None, :]
+
+
+def hat_gradients(mesh) -> np.ndarray:
+    """Gradients of the three barycentric coordinates of every triangle, (3, 2, n_el)."""
+    p = mesh.p[:, mesh.t]                                    # (2, 3, n_el)
+    d1, d2 = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
+    det = d1[0] * d2[1] - d1[1] * d2[0]
+    g1 = np.array([d2[1], -d2[0]]) / det
+    g2 = np.array([-d1[1], d1[0]]) / det
+    return np.array([-g1 - g2, g1, g2])

@@ -1,0 +1,140 @@
+"""The auxiliary contact traction and the contact terms of the guaranteed bound
+(docs/theory.md, sections 13.1 and 13.3).
+
+lambda* is the formulation's pressure lambda_h plus a continuous piecewise linear correction
+delta on Gamma_C chosen so that u_h balances the hat functions psi_a e_i of every vertex off
+Gamma_D for the auxiliary problem with traction -lambda* n (exactly zero for the mixed method up
+to its solver's tolerance; the quadrature and nodal reactions of penalty and vi). The extension
+d = sum_a c_a psi_a nu_a of w = (g - u_hn)_- has d . n <= w on every contact facet, so its
+energy bounds the dual-type norm of Theorem 1 from above.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import sparse
+from scipy.sparse.linalg import spsolve
+
+from estimators.equilibration import hat_gradients
+from formulations.contact import gauss_legendre
+from formulations.evaluation import evaluate_on_trace
+
+SAMPLES = 33        # points per contact facet at which w is sampled for min_e w (ends included)
+QUADRATURE = 10     # Gauss points per contact facet for the kinked integrands
+
+
+@dataclass(frozen=True, eq=False)
+class ContactTraction:
+    """lambda*(t) = lambda_h(t) + delta_start (1 - t) + delta_end t on each contact facet."""
+
+    pressure: object            # the formulation's lambda_h(t), (n_f, len(t))
+    delta: np.ndarray           # (2, n_f): the correction at the start and end of each facet
+
+    def __call__(self, t: np.ndarray) -> np.ndarray:
+        return self.pressure(t) + self.delta[0][:, None] * (1 - t) + self.delta[1][:, None] * t
+
+
+def facet_parameter(trace, x: np.ndarray) -> np.ndarray:
+    """Local coordinate t in [0, 1] of points x (2, n_f, nq) on the contact facets."""
+    a = trace.mesh.p[:, trace.vertices[0]][:, :, None]
+    b = trace.mesh.p[:, trace.vertices[1]][:, :, None]
+    return ((x - a) * (b - a)).sum(axis=0) / ((b - a) ** 2).sum(axis=0)
+
+
+def traction_at(trace, pressure, x: np.ndarray) -> np.ndarray:
+    """-pressure n at points x (2, n_f, nq) of the contact facets, with ``pressure(t)`` as
+    ``DiscreteSolution.pressure`` (the same local points on every facet, in any order)."""
+    t = facet_parameter(trace, x)
+    common = np.unique(np.round(t, 12))
+    values = pressure(common)
+    index = np.abs(t[:, :, None] - common[None, None, :]).argmin(axis=-1)
+    return -np.take_along_axis(values, index, axis=1)[None] * trace.normal[:, :, None]
+
+
+def balanced_traction(trace, pressure, defect: np.ndarray, clamped: np.ndarray):
+    """lambda* from lambda_h and the per-vertex imbalance ``defect`` (n_vertices, 2) of the
+    auxiliary problem with lambda_h: M delta = -defect . nu on the contact vertices off Gamma_D
+    (M the P1 mass matrix of Gamma_C), and the imbalance left in tangential directions."""
+    start, end = trace.vertices
+    n_v = trace.mesh.p.shape[1]
+    h = trace.length
+    rows = np.concatenate([start, start, end, end])
+    cols = np.concatenate([start, end, start, end])
+    vals = np.concatenate([h / 3, h / 6, h / 6, h / 3])
+    M = sparse.coo_matrix((vals, (rows, cols)), shape=(n_v, n_v)).tocsr()
+    nu = vertex_normals(trace)
+    on = np.unique(np.concatenate([start, end]))
+    on = on[~clamped[on]]
+    delta = np.zeros(n_v)
+    if on.size:
+        rhs = -(defect[on] * nu[:, on].T).sum(axis=1)
+        delta[on] = np.atleast_1d(spsolve(M[on][:, on].tocsc(), rhs))
+    return ContactTraction(pressure=pressure, delta=np.array([delta[start], delta[end]]))
+
+
+def vertex_normals(trace) -> np.ndarray:
+    """Length-weighted mean outer normals at the contact vertices, unit (2, n_vertices)."""
+    n_v = trace.mesh.p.shape[1]
+    nu = np.zeros((2, n_v))
+    for v in trace.vertices:
+        for i in (0, 1):
+            nu[i] += np.bincount(v, trace.normal[i] * trace.length, minlength=n_v)
+    norm = np.linalg.norm(nu, axis=0)
+    return nu / np.where(norm > 0, norm, 1.0)
+
+
+@dataclass(frozen=True)
+class ContactBound:
+    extension: float        # D = ||d||, d . n <= w on Gamma_C
+    negative: float         # ||lambda*_-||_{0,Gamma_C}
+    complementarity: float  # (lambda*_+, g - u_hn - d . n)_{Gamma_C} >= 0
+    per_element: np.ndarray  # shares of D^2 + complementarity per element
+
+
+def contact_bound(scene, solution, traction: ContactTraction, clamped: np.ndarray) -> ContactBound:
+    trace = solution.trace
+    mesh = trace.mesh
+    s = np.linspace(0.0, 1.0, SAMPLES)
+    x_gap = _gap_minus_displacement(scene, solution, s)                 # (n_f, SAMPLES)
+    w_min = np.minimum(x_gap, 0.0).min(axis=1)
+    nu = vertex_normals(trace)
+    c = np.zeros(mesh.p.shape[1])
+    for v in trace.vertices:
+        ratio = w_min / np.einsum("if,if->f", nu[:, v], trace.normal)
+        np.minimum.at(c, v, ratio)
+    c[clamped] = 0.0
+    energy = _p1_energy(mesh, c * nu, solution.elasticity.lame)
+    t, w = gauss_legendre(QUADRATURE)
+    d_n = (np.einsum("if,if->f", nu[:, trace.vertices[0]], trace.normal)[:, None]
+           * c[trace.vertices[0]][:, None] * (1 - t)
+           + np.einsum("if,if->f", nu[:, trace.vertices[1]], trace.normal)[:, None]
+           * c[trace.vertices[1]][:, None] * t)
+    lam = traction(t)
+    slack = trace.integrate(np.maximum(lam, 0.0) * (_gap_minus_displacement(scene, solution, t)
+                                                    - d_n), w)
+    negative = float(np.sqrt(trace.integrate(np.minimum(lam, 0.0) ** 2, w).sum()))
+    per_element = energy + np.bincount(trace.element, np.abs(slack), mesh.t.shape[1])
+    return ContactBound(extension=float(np.sqrt(energy.sum())), negative=negative,
+                        complementarity=float(max(slack.sum(), 0.0)), per_element=per_element)
+
+
+def _gap_minus_displacement(scene, solution, t: np.ndarray) -> np.ndarray:
+    """g - u_hn at local points t of every contact facet, (n_f, len(t))."""
+    trace = solution.trace
+    at = evaluate_on_trace(solution.elasticity.basis, trace, t)
+    normal = np.repeat(trace.normal, t.size, axis=1)
+    u_n = np.einsum("in,in->n", at.value(solution.u), normal).reshape(trace.size, t.size)
+    return scene.gap(trace.points(t)) - u_n
+
+
+def _p1_energy(mesh, nodal: np.ndarray, lame: tuple[float, float]) -> np.ndarray:
+    """a(d, d) per element for the P1 field with vertex values ``nodal`` (2, n_vertices)."""
+    lam, mu = lame
+    grad = np.einsum("iae,ake->ike", nodal[:, mesh.t], hat_gradients(mesh))  # du_i/dx_k
+    eps = 0.5 * (grad + grad.transpose(1, 0, 2))
+    p = mesh.p[:, mesh.t]
+    area = 0.5 * np.abs((p[0, 1] - p[0, 0]) * (p[1, 2] - p[1, 0])
+                        - (p[0, 2] - p[0, 0]) * (p[1, 1] - p[1, 0]))
+    return area * (2 * mu * (eps**2).sum(axis=(0, 1)) + lam * (eps[0, 0] + eps[1, 1]) ** 2)
