@@ -1,16 +1,18 @@
 """``equilibrated``: a guaranteed upper bound of the energy error from an equilibrated stress
 and Theorem 1 of the seed paper with every constant computed (docs/theory.md, section 13).
 
-    A   = ||C^{-1/2}(sym sigma* - sigma_h)|| + C_K ||skw sigma*|| + osc  >= ||u_0 - u_h||,
+    A   = ||C^{-1/2}(sym sigma* - sigma_h)|| + C_K ||skw sigma*|| + C_G osc + C_F ||rho||
+        >= ||u_0 - u_h||,
     D   = ||d|| >= ||(g - u_hn)_-||'_{1/2},     N = C_T ||lambda*_-||_{0,Gamma_C},
     B   = (lambda*_+, g - u_hn - d . n)_{Gamma_C},
     eta = (a + sqrt(a^2 + 4 b)) / 2,  a = A + D + N,  b = A D + B,
 
 with u_0 the solution of the auxiliary problem (4) with contact traction lambda*, sigma* its
-equilibrated stress (``estimators.equilibration``), d an extension of (g - u_hn)_-
-(``estimators.guaranteed_contact``), C_K and C_T the domain constants
-(``estimators.constants``) and osc the data oscillation with the Poincare constant 1/pi and a
-computed trace constant. eta_0 reports A, eta_geometric D and eta_complementarity sqrt(B).
+equilibrated stress and rho the load that balances the patches u_h does not balance exactly
+(``estimators.equilibration``), d an extension of (g - u_hn)_- (``estimators.guaranteed_
+contact``), osc the data oscillation (Payne-Weinberger's 1/pi and a trace constant derived in
+13.3), C_G = (1/(2 mu) + C_K^2)^(1/2), and C_K, C_T, C_F the domain constants
+(``estimators.constants``). eta_0 reports A, eta_geometric D and eta_complementarity sqrt(B).
 """
 
 from __future__ import annotations
@@ -21,18 +23,13 @@ from skfem import Basis, ElementDG, FacetBasis
 from estimators.averaging import compliance_energy, element_areas
 from estimators.base import Estimate, register_estimator
 from estimators.constants import domain_constants
-from estimators.equilibration import (
-    BoundaryData,
-    boundary_balance,
-    interior_data,
-    rebalanced,
-    reconstruct,
-)
+from estimators.equilibration import BoundaryData, boundary_balance, reconstruct
 from estimators.guaranteed_contact import (
     balanced_traction,
     contact_bound,
     traction_at,
 )
+from estimators.patch_data import interior_data, rebalanced
 from formulations import DiscreteSolution
 from formulations.elasticity import ELEMENTS, element_diameters, stress_from_gradient
 
@@ -45,24 +42,41 @@ class NotEquilibrated(RuntimeError):
     """The discrete solution does not balance the auxiliary problem's hat functions."""
 
 
-def nitsche_consistency(scene=None, formulation: str = "", options=None, **_) -> str | None:
-    theta = (options or {}).get("theta", 1.0)
-    if formulation == "nitsche" and theta != 0:
-        return (f"equilibrated needs u_h to satisfy the auxiliary problem (4) with a contact "
-                f"traction; Nitsche's theta={theta!r} adds a consistency term in sigma_nn(v) "
-                f"that is no traction (theta=0 is)")
-    return None
-
-
 @register_estimator("equilibrated", "guaranteed upper bound: equilibrated RT stress on vertex "
                                     "patches (Prager-Synge) plus Theorem 1's contact terms, "
-                                    "every constant computed", applies=nitsche_consistency,
-                    guaranteed=True)
+                                    "every constant computed", guaranteed=True)
 def estimate(scene, solution: DiscreteSolution) -> Estimate:
+    rec, interior, load, lam_star, boundary, clamped = equilibrate(scene, solution)
+    lam, mu = solution.elasticity.lame
+    constants = domain_constants(scene)
+    diff = rec.values - interior.sigma_h
+    sym = np.array([diff[0, 0], diff[1, 1], 0.5 * (diff[0, 1] + diff[1, 0])])
+    compliance = (compliance_energy(sym, lam, mu) * rec.basis.dx).sum(axis=1)
+    skew = ((rec.values[0, 1] - rec.values[1, 0]) ** 2 / 2 * rec.basis.dx).sum(axis=1)
+    osc = oscillation(scene, rec.basis, boundary)
+    grad_constant = np.sqrt(1 / (2 * mu) + constants.korn**2)
+    A = (np.sqrt(compliance.sum()) + constants.korn * np.sqrt(skew.sum())
+         + grad_constant * np.sqrt((osc**2).sum()) + constants.friedrichs * np.sqrt(load.sum()))
+    bound = contact_bound(scene, solution, lam_star, clamped)
+    a = A + bound.extension + constants.trace * bound.negative
+    b = A * bound.extension + bound.complementarity
+    eta = 0.5 * (a + np.sqrt(a * a + 4 * b))
+    local = (np.sqrt(compliance) + constants.korn * np.sqrt(skew) + grad_constant * osc
+             + constants.friedrichs * np.sqrt(load)) ** 2 + bound.per_element
+    if local.sum() > 0:  # marking shares, scaled to sum to eta^2
+        local = local * eta**2 / local.sum()
+    return Estimate(estimator="equilibrated", eta=float(eta), eta_0=float(A),
+                    eta_geometric=bound.extension,
+                    eta_complementarity=float(np.sqrt(bound.complementarity)), indicators=local,
+                    guaranteed=True)
+
+
+def equilibrate(scene, solution: DiscreteSolution):
+    """sigma* (a ``Reconstruction``), the patch data, ||rho||_T^2, lambda*, the Neumann data
+    of the auxiliary problem and the clamped vertices (docs/theory.md, 13.2 and 13.3)."""
     elasticity = solution.elasticity
     mesh, order = elasticity.mesh, elasticity.order
     lam, mu = elasticity.lame
-    intorder = max(4, 2 * order + 2)
 
     def stress(basis):
         grad = Basis(mesh, elasticity.basis.elem, quadrature=basis.quadrature).interpolate(
@@ -72,7 +86,7 @@ def estimate(scene, solution: DiscreteSolution) -> Estimate:
 
     clamped = np.zeros(mesh.p.shape[1], dtype=bool)
     clamped[mesh.facets[:, scene.dirichlet_facets(mesh)].ravel()] = True
-    interior = interior_data(mesh, stress, scene.body_force, order, intorder)
+    interior = interior_data(mesh, stress, scene.body_force, order, max(4, 2 * order + 2))
     trace = solution.trace
     neumann = BoundaryData(scene.neumann_facets(mesh), scene.traction or (lambda x: 0.0 * x))
     raw = BoundaryData(trace.facets, lambda x: traction_at(trace, solution.pressure, x))
@@ -85,28 +99,7 @@ def estimate(scene, solution: DiscreteSolution) -> Estimate:
     if rec.imbalance > BALANCE_TOLERANCE:
         raise NotEquilibrated(f"the patch data do not balance (relative imbalance "
                               f"{rec.imbalance:.1e} > {BALANCE_TOLERANCE:g}): no bound")
-    constants = domain_constants(scene)
-    diff = rec.values - interior.sigma_h
-    sym = np.array([diff[0, 0], diff[1, 1], 0.5 * (diff[0, 1] + diff[1, 0])])
-    compliance = (compliance_energy(sym, lam, mu) * rec.basis.dx).sum(axis=1)
-    skew = ((rec.values[0, 1] - rec.values[1, 0]) ** 2 / 2 * rec.basis.dx).sum(axis=1)
-    osc = oscillation(scene, rec.basis, [neumann, contact])
-    grad_constant = np.sqrt(1 / (2 * mu) + constants.korn**2)
-    A = (np.sqrt(compliance.sum()) + constants.korn * np.sqrt(skew.sum())
-         + grad_constant * np.sqrt((osc**2).sum()) + constants.friedrichs * np.sqrt(load.sum()))
-    bound = contact_bound(scene, solution, lam_star, clamped)
-    a = A + bound.extension + constants.trace * bound.negative
-    b = A * bound.extension + bound.complementarity
-    eta = 0.5 * (a + np.sqrt(a * a + 4 * b))
-    local = (np.sqrt(compliance) + constants.korn * np.sqrt(skew) + grad_constant * osc
-             + constants.friedrichs * np.sqrt(load)) ** 2
-    local = local + bound.per_element
-    if local.sum() > 0:
-        local = local * eta**2 / local.sum()
-    return Estimate(estimator="equilibrated", eta=float(eta), eta_0=float(A),
-                    eta_geometric=bound.extension,
-                    eta_complementarity=float(np.sqrt(bound.complementarity)), indicators=local,
-                    guaranteed=True)
+    return rec, interior, load, lam_star, [neumann, contact], clamped
 
 
 def oscillation(scene, rt: Basis, boundary: list[BoundaryData]) -> np.ndarray:

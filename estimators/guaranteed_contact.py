@@ -17,7 +17,7 @@ import numpy as np
 from scipy import sparse
 from scipy.sparse.linalg import spsolve
 
-from estimators.equilibration import hat_gradients
+from estimators.patch_data import hat_gradients
 from formulations.contact import gauss_legendre
 from formulations.evaluation import evaluate_on_trace
 

@@ -33,8 +33,7 @@ def why_skipped(scene: Scene, formulation: str, solver: str, estimator: str,
     reason = (FORMULATIONS.why_not(formulation, scene=scene)
               or (SOLVERS.why_not(solver, scene=scene, formulation=formulation)
                   if solver in SOLVERS.names() else None)
-              or ESTIMATORS.why_not(estimator, scene=scene, formulation=formulation,
-                                     options=options or {}))
+              or ESTIMATORS.why_not(estimator, scene=scene, formulation=formulation))
     if reason is not None:
         return reason
     coarse = get_formulation(formulation)(scene, scene.mesh, order=order, **(options or {}))

@@ -1,0 +1,175 @@
+"""The element data of the vertex-patch problems of the equilibrated stress (docs/theory.md,
+section 13.2): RT_k element matrices, the right-hand sides psi_a sigma_h and the divergence data
+sigma_h grad psi_a - psi_a f per (element, local vertex) pair, the load that balances patches
+the discrete solution does not balance exactly, and the rotation moments of the weak symmetry
+constraint.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+from skfem import Basis, ElementDG, ElementTriP0, ElementTriP1, ElementTriP4, ElementVector
+from skfem.quadrature import get_quadrature
+from skfem.refdom import RefTri
+
+from estimators.raviart_thomas import ElementTriRTk
+from formulations.elasticity import ELEMENTS
+from formulations.load import body_load
+
+# scalar Lagrange triangles by degree (P0 for the multipliers of weak symmetry at k = 1)
+SCALARS = {0: ElementTriP0, **ELEMENTS, 4: ElementTriP4}
+
+
+@dataclass(frozen=True, eq=False)
+class Interior:
+    """The element data of the patch problems (independent of the boundary data): the RT_k
+    basis, sigma_h at its quadrature points (2, 2, n_el, nq), the element matrices, the pair
+    right-hand sides rhs (n_el, 3, 2, n_rt) and divergence data (n_el, 3, 2, n_dg), per vertex
+    sum_T int_T (sigma_h grad psi_a - psi_a f) (n_vertices, 2), and the degree k and the
+    quadrature order used."""
+
+    rt: Basis
+    sigma_h: np.ndarray
+    mass: np.ndarray
+    divergence: np.ndarray
+    symmetry: np.ndarray
+    rhs: np.ndarray
+    data: np.ndarray
+    total: np.ndarray
+    k: int
+    intorder: int
+
+
+def interior_data(mesh, sigma_h, body_force, k: int, intorder: int) -> Interior:
+    """``sigma_h(basis)`` returns sigma(u_h) (2, 2, n_el, nq) at the quadrature points of a
+    basis; ``body_force`` f (2, ...) at points, or None; k the RT degree."""
+    rt = Basis(mesh, ElementTriRTk(k), intorder=intorder)
+    mass, divergence, symmetry, dg = element_matrices(rt)
+    hats = np.array([b[0].value for b in Basis(mesh, ElementTriP1(),
+                                               quadrature=rt.quadrature).basis])
+    stress = sigma_h(rt)
+    rhs, data = patch_rhs(rt, dg, hats, stress, hat_gradients(mesh))
+    if body_force is not None:
+        data = data - load_moments(mesh, body_force, k)
+    total = np.array([np.bincount(mesh.t.T.ravel(), data[:, :, r].sum(axis=-1).ravel(),
+                                  minlength=mesh.p.shape[1]) for r in (0, 1)]).T
+    return Interior(rt=rt, sigma_h=stress, mass=mass, divergence=divergence,
+                    symmetry=symmetry, rhs=rhs, data=data, total=total, k=k, intorder=intorder)
+
+
+def element_matrices(rt: Basis):
+    """Local RT_k mass matrices (n_el, n_rt, n_rt), divergence matrices (n_el, n_dg, n_rt)
+    against the discontinuous P_k basis, symmetry matrices (n_el, n_sym, 2, n_rt): row r's
+    share of (sigma_12 - sigma_21, gamma) for gamma in the discontinuous P_(k-1) basis, and the
+    P_k DG basis on the same quadrature."""
+    k = rt.elem.k
+    dg = Basis(rt.mesh, ElementDG(ELEMENTS[k]()), quadrature=rt.quadrature)
+    rotation = Basis(rt.mesh, ElementDG(SCALARS[k - 1]()), quadrature=rt.quadrature)
+    phi = np.array([b[0].value for b in rt.basis])          # (n_rt, 2, n_el, nq)
+    div = np.array([b[0].div for b in rt.basis])            # (n_rt, n_el, nq)
+    q = np.array([b[0].value for b in dg.basis])            # (n_dg, n_el, nq)
+    gamma = np.array([b[0].value for b in rotation.basis])  # (n_sym, n_el, nq)
+    mass = np.einsum("jiep,liep,ep->ejl", phi, phi, rt.dx)
+    divergence = np.einsum("lep,jep,ep->elj", q, div, rt.dx)
+    symmetry = np.stack([np.einsum("gep,jep,ep->egj", gamma, phi[:, 1], rt.dx),
+                         -np.einsum("gep,jep,ep->egj", gamma, phi[:, 0], rt.dx)], axis=2)
+    return mass, divergence, symmetry, dg
+
+
+def patch_rhs(rt: Basis, dg: Basis, hats: np.ndarray, sigma_h: np.ndarray,
+              hat_gradients: np.ndarray):
+    """r = (phi_j, psi_a sigma_h row) and c = (sigma_h grad psi_a, q_l) for every element,
+    local vertex a and row; sigma_h (2, 2, n_el, nq), hats (3, n_el, nq), hat_gradients
+    (3, 2, n_el). The load's part of c is ``load_moments``."""
+    phi = np.array([b[0].value for b in rt.basis])
+    q = np.array([b[0].value for b in dg.basis])
+    rhs = np.einsum("jkep,aep,rkep,ep->earj", phi, hats, sigma_h, rt.dx)
+    data = np.einsum("rkep,ake->arep", sigma_h, hat_gradients)
+    divergence = np.einsum("arep,lep,ep->earl", data, q, rt.dx)
+    return rhs, divergence
+
+
+def load_moments(mesh, body_force, k: int) -> np.ndarray:
+    """int_T f_r psi_a q_l per element, local vertex a, row r and P_k DG function q_l
+    (n_el, 3, 2, n_dg), with the load rule of ``formulations.load`` (refined where f is rough,
+    as for the load vector of the discrete problem): psi_a q_l is P_(k+1), so these are
+    combinations of the P_(k+1) DG load entries with its values at the P_(k+1) nodes."""
+    fine = SCALARS[k + 1]()
+    basis = Basis(mesh, ElementVector(ElementDG(fine)), intorder=2 * k)
+    F = body_load(body_force, basis)[basis.element_dofs]                  # (2 n_fine, n_el)
+    per_node = F.reshape(-1, 2, mesh.t.shape[1])                           # node m, row r
+    nodes = fine.doflocs.T
+    hats = np.array([ElementTriP1().lbasis(nodes, a)[0] for a in range(3)])
+    coarse = ELEMENTS[k]()
+    q = np.array([coarse.lbasis(nodes, j)[0] for j in range(coarse.doflocs.shape[0])])
+    return np.einsum("mre,am,lm->earl", per_node, hats, q)
+
+
+def rebalanced(interior: Interior, defect: np.ndarray,
+               clamped: np.ndarray) -> tuple[Interior, np.ndarray]:
+    """The patch data with the load rho = sum_a (defect_a / int psi_a) psi_a (off Gamma_D)
+    added, so that every patch balances, and ||rho||_{0,T}^2 per element (docs/theory.md,
+    13.2): sum_T int_T (data) then equals the boundary fluxes for every vertex."""
+    mesh = interior.rt.mesh
+    area = element_area(mesh)
+    weight = np.bincount(mesh.t.ravel(), np.tile(area / 3, 3), minlength=mesh.p.shape[1])
+    c = np.where(clamped[:, None], 0.0, defect / weight[:, None])      # (n_vertices, 2)
+    local = c[mesh.t]                                                  # (3, n_el, 2)
+    data = interior.data - np.einsum("ier,il,e->eirl", local, _hat_moments(interior.k), area)
+    norm2 = area / 12 * ((local**2).sum(axis=0) + local.sum(axis=0) ** 2).sum(axis=-1)
+    total = interior.total - np.where(clamped[:, None], 0.0, defect)
+    return replace(interior, data=data, total=total), norm2
+
+
+def _hat_moments(k: int) -> np.ndarray:
+    """int_T lambda_i q_l / |T| for the barycentric lambda_i and the P_k DG basis q_l, (3, n_dg)
+    (the same on every triangle)."""
+    X, W = get_quadrature(RefTri, k + 1)
+    element = ELEMENTS[k]()
+    q = np.array([element.lbasis(X, j)[0] for j in range(element.doflocs.shape[0])])
+    hats = np.array([ElementTriP1().lbasis(X, a)[0] for a in range(3)])
+    return np.einsum("ap,lp,p->al", hats, q, W) / W.sum()
+
+
+def skew_data(interior: Interior, data: np.ndarray, turning: np.ndarray,
+              clamped: np.ndarray) -> np.ndarray:
+    """The right-hand side (P, n_sym) of the weak symmetry constraint: the rotation moment
+    R_a = (data, r_a) - int psi_a t . r_a of each patch off Gamma_D (r_a the rotation about a;
+    zero when u_h balances psi_a r_a, which V_h contains from k = 2), spread over the patch's
+    elements by their share of int psi_a (docs/theory.md, 13.2). Its integral over the patch is
+    then R_a, which makes the patch problem solvable."""
+    mesh, k = interior.rt.mesh, interior.k
+    n_v = mesh.p.shape[1]
+    bary = np.column_stack([1 - ELEMENTS[k]().doflocs.sum(axis=1), ELEMENTS[k]().doflocs])
+    nodes = np.einsum("li,cie->ecl", bary, mesh.p[:, mesh.t])          # (n_el, 2, n_dg)
+    vertex = mesh.p[:, mesh.t.T.ravel()].T                             # (P, 2)
+    arm = np.repeat(nodes, 3, axis=0) - vertex[:, :, None]             # (P, 2, n_dg)
+    moment = (data[:, 1] * arm[:, 0] - data[:, 0] * arm[:, 1]).sum(axis=-1)
+    rotation = np.bincount(mesh.t.T.ravel(), moment, minlength=n_v) - turning
+    rotation[clamped] = 0.0
+    area = element_area(mesh)
+    weight = np.bincount(mesh.t.ravel(), np.tile(area / 3, 3), minlength=n_v)
+    share = np.repeat(area / 3, 3) / weight[mesh.t.T.ravel()]
+    X, W = get_quadrature(RefTri, k)
+    scalar = SCALARS[k - 1]()
+    mean = np.array([(scalar.lbasis(X, g)[0] * W).sum() / W.sum()
+                     for g in range(scalar.doflocs.shape[0])])
+    return (rotation[mesh.t.T.ravel()] * share)[:, None] * mean[None, :]
+
+
+def element_area(mesh) -> np.ndarray:
+    p = mesh.p[:, mesh.t]
+    return 0.5 * np.abs((p[0, 1] - p[0, 0]) * (p[1, 2] - p[1, 0])
+                        - (p[0, 2] - p[0, 0]) * (p[1, 1] - p[1, 0]))
+
+
+def hat_gradients(mesh) -> np.ndarray:
+    """Gradients of the three barycentric coordinates of every triangle, (3, 2, n_el)."""
+    p = mesh.p[:, mesh.t]                                    # (2, 3, n_el)
+    d1, d2 = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
+    det = d1[0] * d2[1] - d1[1] * d2[0]
+    g1 = np.array([d2[1], -d2[0]]) / det
+    g2 = np.array([-d1[1], d1[0]]) / det
+    return np.array([-g1 - g2, g1, g2])
