@@ -109,13 +109,13 @@ def oscillation(scene, rt: Basis, boundary: list[BoundaryData]) -> np.ndarray:
     out = np.zeros(mesh.t.shape[1])
     if scene.body_force is not None:
         dg = Basis(mesh, ElementDG(ELEMENTS[k]()), quadrature=rt.quadrature)
-        f = scene.body_force(rt.global_coordinates().value)
+        f = scene.body_force(np.asarray(rt.global_coordinates()))
         out += element_diameters(mesh) / np.pi * np.sqrt(_projection_error(dg, f))
     for part in boundary:
         if part.facets.size == 0:
             continue
         fb = FacetBasis(mesh, ELEMENTS[k](), facets=part.facets, intorder=8)
-        t = part.traction(fb.global_coordinates().value)
+        t = part.traction(np.asarray(fb.global_coordinates()))
         err = _projection_error(fb, t)
         length = np.linalg.norm(mesh.p[:, mesh.facets[0, part.facets]]
                                 - mesh.p[:, mesh.facets[1, part.facets]], axis=0)
@@ -130,7 +130,7 @@ def _projection_error(basis, values: np.ndarray) -> np.ndarray:
     """||v - Pi v||^2 per element or facet of ``basis`` for v (2, n, nq), Pi the L2 projection
     onto the span of the basis's local functions (on a facet the P_k functions of the triangle
     span P_k(e) with repetitions: the pseudo-inverse of their Gram matrix)."""
-    phi = np.array([b[0].value for b in basis.basis])           # (m, n, nq)
+    phi = np.array([np.asarray(b[0]) for b in basis.basis])           # (m, n, nq)
     gram = np.einsum("jnp,lnp,np->njl", phi, phi, basis.dx)
     moments = np.einsum("jnp,rnp,np->nrj", phi, values, basis.dx)
     coef = np.einsum("njl,nrl->nrj", np.linalg.pinv(gram, rcond=1e-10), moments)

@@ -68,19 +68,19 @@ def boundary_flux(mesh, facets: np.ndarray, traction, k: int, intorder: int):
     hats = FacetBasis(mesh, ElementTriP1(), facets=facets, quadrature=fb.quadrature)
     local = _local_facet(mesh, facets, fb.tind)
     rows = np.arange(facets.size)
-    normal_trace = np.array([np.einsum("ifp,ifp->fp", b[0].value, fb.normals)
+    normal_trace = np.array([np.einsum("ifp,ifp->fp", np.asarray(b[0]), fb.normals)
                              for b in fb.basis])            # (8, n_f, nq)
     own = (k + 1) * local[None, :] + np.arange(k + 1)[:, None]         # (k + 1, n_f)
     trace = normal_trace[own, rows[None, :]]                           # (k + 1, n_f, nq)
     gram = np.einsum("jfp,lfp,fp->fjl", trace, trace, fb.dx)
-    t = traction(fb.global_coordinates().value)
+    t = traction(np.asarray(fb.global_coordinates()))
     ends = mesh.facets[:, facets]
     vertex_local = (mesh.t[:, fb.tind][None, :, :] == ends[:, None, :]).argmax(axis=1)
-    psi = np.array([b[0].value for b in hats.basis])[vertex_local, rows[None, :]]  # (2, n_f, nq)
+    psi = np.array([np.asarray(b[0]) for b in hats.basis])[vertex_local, rows[None, :]]
     moments = np.einsum("vfp,rfp,jfp,fp->fvrj", psi, t, trace, fb.dx)
     values = np.linalg.solve(gram[:, None, None], moments[..., None])[..., 0]
     integrals = np.einsum("vfp,rfp,fp->fvr", psi, t, fb.dx)
-    x = fb.global_coordinates().value
+    x = np.asarray(fb.global_coordinates())
     arm = x[None] - mesh.p[:, ends].transpose(1, 0, 2)[..., None]      # x - x_a, (2, 2, n_f, nq)
     turn = t[1][None] * arm[:, 0] - t[0][None] * arm[:, 1]              # t . r_a
     return values, integrals, ends, fb.tind, local, np.einsum("vfp,vfp,fp->fv", psi, turn, fb.dx)
@@ -157,5 +157,5 @@ def field_values(rt: Basis, dofs: np.ndarray) -> np.ndarray:
     local = dofs[:, rt.element_dofs]                                    # (2, n_rt, n_el)
     out = np.zeros((2, 2) + rt.dx.shape)
     for j, phi in enumerate(rt.basis):
-        out += local[:, j][:, None, :, None] * phi[0].value[None]
+        out += local[:, j][:, None, :, None] * np.asarray(phi[0])[None]
     return out

@@ -47,7 +47,7 @@ def interior_data(mesh, sigma_h, body_force, k: int, intorder: int) -> Interior:
     basis; ``body_force`` f (2, ...) at points, or None; k the RT degree."""
     rt = Basis(mesh, ElementTriRTk(k), intorder=intorder)
     mass, divergence, symmetry, dg = element_matrices(rt)
-    hats = np.array([b[0].value for b in Basis(mesh, ElementTriP1(),
+    hats = np.array([np.asarray(b[0]) for b in Basis(mesh, ElementTriP1(),
                                                quadrature=rt.quadrature).basis])
     stress = sigma_h(rt)
     rhs, data = patch_rhs(rt, dg, hats, stress, hat_gradients(mesh))
@@ -67,10 +67,10 @@ def element_matrices(rt: Basis):
     k = rt.elem.k
     dg = Basis(rt.mesh, ElementDG(ELEMENTS[k]()), quadrature=rt.quadrature)
     rotation = Basis(rt.mesh, ElementDG(SCALARS[k - 1]()), quadrature=rt.quadrature)
-    phi = np.array([b[0].value for b in rt.basis])          # (n_rt, 2, n_el, nq)
+    phi = np.array([np.asarray(b[0]) for b in rt.basis])          # (n_rt, 2, n_el, nq)
     div = np.array([b[0].div for b in rt.basis])            # (n_rt, n_el, nq)
-    q = np.array([b[0].value for b in dg.basis])            # (n_dg, n_el, nq)
-    gamma = np.array([b[0].value for b in rotation.basis])  # (n_sym, n_el, nq)
+    q = np.array([np.asarray(b[0]) for b in dg.basis])            # (n_dg, n_el, nq)
+    gamma = np.array([np.asarray(b[0]) for b in rotation.basis])  # (n_sym, n_el, nq)
     mass = np.einsum("jiep,liep,ep->ejl", phi, phi, rt.dx)
     divergence = np.einsum("lep,jep,ep->elj", q, div, rt.dx)
     symmetry = np.stack([np.einsum("gep,jep,ep->egj", gamma, phi[:, 1], rt.dx),
@@ -83,8 +83,8 @@ def patch_rhs(rt: Basis, dg: Basis, hats: np.ndarray, sigma_h: np.ndarray,
     """r = (phi_j, psi_a sigma_h row) and c = (sigma_h grad psi_a, q_l) for every element,
     local vertex a and row; sigma_h (2, 2, n_el, nq), hats (3, n_el, nq), hat_gradients
     (3, 2, n_el). The load's part of c is ``load_moments``."""
-    phi = np.array([b[0].value for b in rt.basis])
-    q = np.array([b[0].value for b in dg.basis])
+    phi = np.array([np.asarray(b[0]) for b in rt.basis])
+    q = np.array([np.asarray(b[0]) for b in dg.basis])
     rhs = np.einsum("jkep,aep,rkep,ep->earj", phi, hats, sigma_h, rt.dx)
     data = np.einsum("rkep,ake->arep", sigma_h, hat_gradients)
     divergence = np.einsum("arep,lep,ep->earl", data, q, rt.dx)
