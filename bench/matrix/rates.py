@@ -3,7 +3,8 @@
 The slope of log(y) against log(ndofs) is fitted by least squares (``np.polyfit``) over the last
 ``RATE_LEVELS`` ok levels that have y > 0 (earlier levels are pre-asymptotic: on the paper scene
 nothing touches on the first two). In 2D, O(h^1/2) is slope -1/4 and O(h) is slope -1/2.
-Effectivity statistics use the same levels and skip rows whose reference is too coarse.
+Effectivity statistics use the same levels and skip rows whose reference is too coarse;
+``effectivity_all_min`` is the minimum over every level (for a guaranteed bound).
 """
 
 from __future__ import annotations
@@ -37,6 +38,8 @@ def rates_table(table: pd.DataFrame, levels: int = RATE_LEVELS) -> pd.DataFrame:
         usable = tail[~tail["reference_too_coarse"].astype(bool)
                       & (tail["effectivity_index"] > 0)] if "effectivity_index" in tail else tail
         effectivity = usable["effectivity_index"] if len(usable) else pd.Series(dtype=float)
+        judged = ok[~ok["reference_too_coarse"].astype(bool) & (ok["effectivity_index"] > 0)] \
+            if "effectivity_index" in ok else ok.iloc[:0]
         rows.append({
             **dict(zip(KEYS, key, strict=True)),
             "levels": len(group), "fit_levels": len(tail),
@@ -50,6 +53,9 @@ def rates_table(table: pd.DataFrame, levels: int = RATE_LEVELS) -> pd.DataFrame:
             "effectivity_max": float(effectivity.max()) if len(effectivity) else float("nan"),
             "effectivity_variation": float(effectivity.max() / effectivity.min())
             if len(effectivity) else float("nan"),
+            # over every judged level, not only the last ones: where a bound must hold
+            "effectivity_all_min": float(judged["effectivity_index"].min()) if len(judged)
+            else float("nan"),
             "too_coarse_rows": int(tail["reference_too_coarse"].astype(bool).sum()),
             "truth": str(group["truth"].iloc[-1]),
         })

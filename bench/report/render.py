@@ -20,13 +20,19 @@ from bench.report.tables import (
     accuracy_table,
     agreement_table,
     effectivity_table,
+    estimator_summary,
     failure_table,
+    judged_levels,
     rate_verdicts,
     timing_table,
 )
 from bench.sequence.rows import COLUMNS, INTERRUPTED, KEYS, with_labels
 
 TEMPLATES = Path(__file__).with_name("templates")
+ESTIMATOR_CAPTION = ("Effectivity eta / ||u - u_h|| of every level with a sharp enough truth, "
+                     "per estimator, over all scenes, formulations, orders and strategies "
+                     "(box: quartiles, whiskers: range). Below the line the estimator "
+                     "under-estimates the error.")
 HARD_CAPTION = ("Hard cases: the mixed method's inf-sup constant beta_h against ndofs for "
                 "h/H = 1, 1/2, 1/4 (bounded below only for h/H <= 1/2); the penalty's "
                 "penetration and condition estimate against eps_0; and each solver's pressure "
@@ -69,6 +75,7 @@ def _hard_section(results: Path | None, figs: Figures) -> tuple[pd.DataFrame | N
 def _tables(everything: pd.DataFrame, rows: pd.DataFrame, hard) -> dict:
     rates = rates_table(rows) if len(rows) else pd.DataFrame()
     return {"rates": rate_verdicts(rates), "effectivity": effectivity_table(rates),
+            "estimators": estimator_summary(rows) if len(rows) else pd.DataFrame(),
             "accuracy": accuracy_table(rows), "timing": timing_table(rows),
             "agreement": agreement_table(rows), "failures": failure_table(everything),
             "hard": hard if hard is not None else pd.DataFrame()}
@@ -112,6 +119,8 @@ def write_report(table: pd.DataFrame, out: str | Path, results: str | Path | Non
         "scenes": [scene_section(name, group, results, figs, truth)
                    for name, group in rows.groupby("scene", sort=True)],
         "tables": _tables(everything, rows, hard),
+        "estimator_figure": figs.add(figures.estimator_effectivity(judged_levels(rows))
+                                     if len(rows) else None, "estimators", ESTIMATOR_CAPTION),
         "orders": order_section(rows, figs),
         "hard_run": hard is not None, "hard_figures": hard_figures,
         "n_rows": len(everything), "n_too_coarse": int(rows["reference_too_coarse"]

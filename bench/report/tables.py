@@ -7,6 +7,7 @@ import pandas as pd
 
 from bench.sequence.rows import KEYS, LABELS, phase_time
 from bench.verify import claims
+from estimators import guaranteed_estimators
 from formulations import STATUS_OK
 
 CLAIM_TOLERANCE = 0.1  # |measured - claimed| slope within which we say "agrees"
@@ -57,6 +58,31 @@ def effectivity_table(rates: pd.DataFrame) -> pd.DataFrame:
         "max": rates["effectivity_max"].map(_fmt),
         "max/min": rates["effectivity_variation"].map(_fmt),
         "rows with too coarse reference": rates["too_coarse_rows"]}))
+
+
+def judged_levels(rows: pd.DataFrame) -> pd.DataFrame:
+    """The solved levels with an effectivity index whose truth is sharp enough to judge it."""
+    ok = rows[(rows["status"] == STATUS_OK) & (rows["effectivity_index"] > 0)]
+    return ok[~ok["reference_too_coarse"].fillna(False).astype(bool)]
+
+
+def estimator_summary(rows: pd.DataFrame) -> pd.DataFrame:
+    """Per estimator, over every judged level of every scene, formulation, order and strategy:
+    the effectivity range and how often eta fell below the error (sharp vs safe)."""
+    judged = judged_levels(rows)
+    out = []
+    for name, group in judged.groupby("estimator", sort=True):
+        eff = group["effectivity_index"]
+        late = group.loc[group["ndofs"] >= 1000, "effectivity_index"]
+        out.append({"estimator": name,
+                    "guaranteed bound": "yes" if name in guaranteed_estimators() else "no",
+                    "levels": len(eff), "min": _fmt(eff.min()), "median": _fmt(eff.median()),
+                    "max": _fmt(eff.max()),
+                    "range from 1e3 DOFs": f"{_fmt(late.min())} .. {_fmt(late.max())}"
+                    if len(late) else "",
+                    "levels with eta < error": f"{int((eff < 1).sum())} "
+                                               f"({100 * float((eff < 1).mean()):.0f} %)"})
+    return pd.DataFrame(out)
 
 
 def _total_time(group: pd.DataFrame) -> float:
