@@ -133,8 +133,8 @@ def reconstruct(interior: Interior, boundary: list[BoundaryData],
             np.add.at(turning, ends[v], turn[:, v])
     data = interior.data.reshape(-1, 2, n_dg)
     n_sym = interior.symmetry.shape[1] if k >= WEAK_SYMMETRY_FROM else 0
-    pairs = PairMatrices(mass=interior.mass[element], divergence=interior.divergence[element],
-                         symmetry=interior.symmetry[element][:, :n_sym],
+    pairs = PairMatrices(mass=interior.mass, divergence=interior.divergence,
+                         symmetry=interior.symmetry[:, :n_sym],
                          rhs=interior.rhs.reshape(-1, 2, n_rt).transpose(0, 2, 1),
                          data=data.transpose(0, 2, 1),
                          skew=skew_data(interior, data, turning, clamped)[:, :n_sym], fixed=fixed)

@@ -60,10 +60,11 @@ def layout(patch: np.ndarray, dofs: np.ndarray, status: np.ndarray, n_dofs: int,
 
 @dataclass(frozen=True, eq=False)
 class PairMatrices:
-    """Per pair: ``mass`` (P, n_rt, n_rt), ``divergence`` (P, n_dg, n_rt), ``symmetry``
-    (P, n_sym, 2, n_rt) (row r's contribution to (sigma_12 - sigma_21, gamma)), ``rhs``
-    (P, n_rt, 2), ``data`` (P, n_dg, 2), ``skew`` (P, n_sym) and the prescribed values
-    ``fixed`` (P, n_rt, 2) (zero where not FIXED)."""
+    """Per element (pair p belongs to element p // 3): ``mass`` (n_el, n_rt, n_rt),
+    ``divergence`` (n_el, n_dg, n_rt), ``symmetry`` (n_el, n_sym, 2, n_rt) (row r's share of
+    (sigma_12 - sigma_21, gamma)); per pair: ``rhs`` (P, n_rt, 2), ``data`` (P, n_dg, 2),
+    ``skew`` (P, n_sym) and the prescribed values ``fixed`` (P, n_rt, 2) (zero where not
+    FIXED)."""
 
     mass: np.ndarray
     divergence: np.ndarray
@@ -87,10 +88,12 @@ def solve_patches(lay: PatchLayout, pairs: PairMatrices, clamped: np.ndarray) ->
     two rows as right-hand sides. Off Gamma_D (``clamped`` False) the first multiplier of each
     constraint is dropped: the data balance, so its equation follows from the others
     (docs/theory.md, 13.2)."""
-    fixed = pairs.fixed
-    rhs = pairs.rhs - np.matmul(pairs.mass, fixed)
-    data = pairs.data - np.matmul(pairs.divergence, fixed)
-    skew = pairs.skew - np.einsum("pgrl,plr->pg", pairs.symmetry, fixed)
+    rhs, data, skew = pairs.rhs.copy(), pairs.data.copy(), pairs.skew.copy()
+    touched = np.flatnonzero((lay.status == FIXED).any(axis=1))  # pairs on Gamma_N, Gamma_C
+    fixed, element = pairs.fixed[touched], touched // 3
+    rhs[touched] -= np.matmul(pairs.mass[element], fixed)
+    data[touched] -= np.matmul(pairs.divergence[element], fixed)
+    skew[touched] -= np.einsum("pgrl,plr->pg", pairs.symmetry[element], fixed)
     n_dg, n_sym = pairs.divergence.shape[1], pairs.symmetry.shape[1]
     blocks = 2 if n_sym else 1
     size = blocks * lay.n_free + lay.count * (blocks * n_dg + n_sym)
@@ -117,11 +120,12 @@ def _solve_chunk(lay, chunk, n, pairs, right, clamped, out) -> None:
     sym_at = blocks * nf + blocks * count * n_dg + lay.rank[sel] * n_sym
     entries = _Entries(chunk.size, n, columns)
     both = free[:, :, None] & free[:, None, :]
+    element = sel // 3
     for r in range(blocks):
-        entries.matrix(g, loc[r][:, :, None], loc[r][:, None, :], pairs.mass[sel], both)
-        _constraint(entries, g, div_at[r], loc[r], free, pairs.divergence[sel])
+        entries.matrix(g, loc[r][:, :, None], loc[r][:, None, :], pairs.mass[element], both)
+        _constraint(entries, g, div_at[r], loc[r], free, pairs.divergence[element])
         if n_sym:
-            _constraint(entries, g, sym_at, loc[r], free, pairs.symmetry[sel][:, :, r])
+            _constraint(entries, g, sym_at, loc[r], free, pairs.symmetry[element][:, :, r])
     rows = [div_at[r][:, None] + np.arange(n_dg) for r in range(blocks)]
     for r in (0, 1):
         block, column = (r, 0) if n_sym else (0, r)
