@@ -15,7 +15,8 @@ import numpy as np
 import pytest
 
 from bench.perf.scaling import linear_rhs, paper_problem
-from estimators import get_estimator
+from estimators import estimator_names, get_estimator
+from estimators.base import ESTIMATORS
 from formulations import get_formulation, solve
 from formulations.diagnostics import inf_sup_constant, pressure_oscillation
 from formulations.solvers.backends import default_backend, factorise
@@ -75,9 +76,13 @@ def solution(problem):
     return solve(problem[3], "active-set")
 
 
-def test_estimator(benchmark, problem, solution):
+@pytest.mark.parametrize("estimator", estimator_names())
+def test_estimator(benchmark, problem, solution, estimator):
     size, scene, _, disc = problem
-    est = benchmark.pedantic(get_estimator("residual"), args=(scene, solution),
+    why = ESTIMATORS.why_not(estimator, scene=scene, formulation="mixed")
+    if why is not None:
+        pytest.skip(why)
+    est = benchmark.pedantic(get_estimator(estimator), args=(scene, solution),
                              rounds=ROUNDS[size], iterations=1)
     assert np.isfinite(est.eta) and est.eta > 0
     _info(benchmark, disc, eta=float(est.eta))
