@@ -63,8 +63,8 @@ def test_html_is_self_contained_with_every_section_and_figure(report):
     assert parser.external == []  # no scripts, stylesheets or linked images
     # 2 scenes x (scene, convergence, effectivity, work-precision, meshes, deformed, pressure),
     # less the paper's effectivity: without --reference-dofs it has no error to divide by;
-    # plus the hard cases' figure
-    assert len(parser.images) == 14
+    # plus the hard cases' figure and the estimators' effectivity across scenes
+    assert len(parser.images) == 15
     for src in parser.images:
         assert src.startswith("data:image/png;base64,")
         data = base64.b64decode(src.split(",", 1)[1])
@@ -83,7 +83,7 @@ def test_markdown_links_every_figure_file(report):
     # QP form for the reference, so every registered pair here)
     assert hard.count("| no-contact ") == len(formulation_names()) * len(solver_names())
     figures = sorted(p.name for p in (report / "figures").glob("*.png"))
-    assert len(figures) == 14 and "hard-stability.png" in figures
+    assert len(figures) == 15 and "hard-stability.png" in figures
     for name in figures:
         assert f"figures/{name}" in text
     assert "test command" in text and "agrees" in text  # rates verdicts against the claims
