@@ -30,6 +30,7 @@ from estimators.guaranteed_contact import (
     traction_at,
 )
 from estimators.patch_data import interior_data, rebalanced
+from estimators.residual import stress_tensor
 from formulations import DiscreteSolution
 from formulations.elasticity import ELEMENTS, element_diameters, stress_from_gradient
 
@@ -81,8 +82,7 @@ def equilibrate(scene, solution: DiscreteSolution):
     def stress(basis):
         grad = Basis(mesh, elasticity.basis.elem, quadrature=basis.quadrature).interpolate(
             solution.u).grad
-        s11, s22, s12 = stress_from_gradient(grad, lam, mu)
-        return np.array([[s11, s12], [s12, s22]])
+        return stress_tensor(stress_from_gradient(grad, lam, mu))
 
     clamped = np.zeros(mesh.p.shape[1], dtype=bool)
     clamped[mesh.facets[:, scene.dirichlet_facets(mesh)].ravel()] = True

@@ -17,9 +17,9 @@ import numpy as np
 from scipy import sparse
 from scipy.sparse.linalg import spsolve
 
+from estimators.averaging import element_areas
 from estimators.patch_data import hat_gradients
 from formulations.contact import gauss_legendre
-from formulations.evaluation import evaluate_on_trace
 
 SAMPLES = 33        # points per contact facet at which w is sampled for min_e w (ends included)
 QUADRATURE = 10     # Gauss points per contact facet for the kinked integrands
@@ -122,11 +122,7 @@ def contact_bound(scene, solution, traction: ContactTraction, clamped: np.ndarra
 
 def _gap_minus_displacement(scene, solution, t: np.ndarray) -> np.ndarray:
     """g - u_hn at local points t of every contact facet, (n_f, len(t))."""
-    trace = solution.trace
-    at = evaluate_on_trace(solution.elasticity.basis, trace, t)
-    normal = np.repeat(trace.normal, t.size, axis=1)
-    u_n = np.einsum("in,in->n", at.value(solution.u), normal).reshape(trace.size, t.size)
-    return scene.gap(trace.points(t)) - u_n
+    return scene.gap(solution.trace.points(t)) - solution.normal_displacement(t)
 
 
 def _p1_energy(mesh, nodal: np.ndarray, lame: tuple[float, float]) -> np.ndarray:
@@ -134,7 +130,5 @@ def _p1_energy(mesh, nodal: np.ndarray, lame: tuple[float, float]) -> np.ndarray
     lam, mu = lame
     grad = np.einsum("iae,ake->ike", nodal[:, mesh.t], hat_gradients(mesh))  # du_i/dx_k
     eps = 0.5 * (grad + grad.transpose(1, 0, 2))
-    p = mesh.p[:, mesh.t]
-    area = 0.5 * np.abs((p[0, 1] - p[0, 0]) * (p[1, 2] - p[1, 0])
-                        - (p[0, 2] - p[0, 0]) * (p[1, 1] - p[1, 0]))
-    return area * (2 * mu * (eps**2).sum(axis=(0, 1)) + lam * (eps[0, 0] + eps[1, 1]) ** 2)
+    density = 2 * mu * (eps**2).sum(axis=(0, 1)) + lam * (eps[0, 0] + eps[1, 1]) ** 2
+    return element_areas(mesh) * density

@@ -14,6 +14,7 @@ from skfem import Basis, ElementDG, ElementTriP0, ElementTriP1, ElementTriP4, El
 from skfem.quadrature import get_quadrature
 from skfem.refdom import RefTri
 
+from estimators.averaging import element_areas
 from estimators.raviart_thomas import ElementTriRTk
 from formulations.elasticity import ELEMENTS
 from formulations.load import body_load
@@ -113,7 +114,7 @@ def rebalanced(interior: Interior, defect: np.ndarray,
     added, so that every patch balances, and ||rho||_{0,T}^2 per element (docs/theory.md,
     13.2): sum_T int_T (data) then equals the boundary fluxes for every vertex."""
     mesh = interior.rt.mesh
-    area = element_area(mesh)
+    area = element_areas(mesh)
     weight = np.bincount(mesh.t.ravel(), np.tile(area / 3, 3), minlength=mesh.p.shape[1])
     c = np.where(clamped[:, None], 0.0, defect / weight[:, None])      # (n_vertices, 2)
     local = c[mesh.t]                                                  # (3, n_el, 2)
@@ -149,7 +150,7 @@ def skew_data(interior: Interior, data: np.ndarray, turning: np.ndarray,
     moment = (data[:, 1] * arm[:, 0] - data[:, 0] * arm[:, 1]).sum(axis=-1)
     rotation = np.bincount(mesh.t.T.ravel(), moment, minlength=n_v) - turning
     rotation[clamped] = 0.0
-    area = element_area(mesh)
+    area = element_areas(mesh)
     weight = np.bincount(mesh.t.ravel(), np.tile(area / 3, 3), minlength=n_v)
     share = np.repeat(area / 3, 3) / weight[mesh.t.T.ravel()]
     X, W = get_quadrature(RefTri, k)
@@ -157,12 +158,6 @@ def skew_data(interior: Interior, data: np.ndarray, turning: np.ndarray,
     mean = np.array([(scalar.lbasis(X, g)[0] * W).sum() / W.sum()
                      for g in range(scalar.doflocs.shape[0])])
     return (rotation[mesh.t.T.ravel()] * share)[:, None] * mean[None, :]
-
-
-def element_area(mesh) -> np.ndarray:
-    p = mesh.p[:, mesh.t]
-    return 0.5 * np.abs((p[0, 1] - p[0, 0]) * (p[1, 2] - p[1, 0])
-                        - (p[0, 2] - p[0, 0]) * (p[1, 1] - p[1, 0]))
 
 
 def hat_gradients(mesh) -> np.ndarray:

@@ -29,7 +29,8 @@ from formulations.evaluation import gradients_at, gradients_at_reference
 EDGE_QUADRATURE_POINTS = 4  # Neumann and contact edges: q and lambda_h are not polynomials
 
 
-def _tensor(stress: np.ndarray) -> np.ndarray:
+def stress_tensor(stress: np.ndarray) -> np.ndarray:
+    """(s11, s22, s12, ...) as the symmetric 2 x 2 tensor (2, 2, ...)."""
     s11, s22, s12 = stress
     return np.array([[s11, s12], [s12, s22]])
 
@@ -37,7 +38,7 @@ def _tensor(stress: np.ndarray) -> np.ndarray:
 def stress_at(solution: DiscreteSolution, x: np.ndarray, cells: np.ndarray) -> np.ndarray:
     """sigma(u_h) (2, 2, n) at points x (2, n) of elements ``cells``."""
     grad = gradients_at(solution.elasticity.basis, solution.u, x, cells)
-    return _tensor(stress_from_gradient(grad, *solution.elasticity.lame))
+    return stress_tensor(stress_from_gradient(grad, *solution.elasticity.lame))
 
 
 def stress_divergence(solution: DiscreteSolution, basis: Basis) -> np.ndarray:
@@ -49,7 +50,7 @@ def stress_divergence(solution: DiscreteSolution, basis: Basis) -> np.ndarray:
     dg = Basis(mesh, ElementDG(ELEMENTS[order - 1]()), quadrature=basis.quadrature)
     grad = gradients_at_reference(elasticity.basis, solution.u, dg.elem.doflocs.T)
     dofs = dg.element_dofs.T.ravel()  # element-major, as ``grad``
-    sigma = _tensor(stress_from_gradient(grad, *elasticity.lame).reshape(3, -1))
+    sigma = stress_tensor(stress_from_gradient(grad, *elasticity.lame).reshape(3, -1))
     div = np.zeros((2, mesh.t.shape[1], basis.quadrature[0].shape[1]))
     for i in (0, 1):
         for j in (0, 1):
