@@ -23,7 +23,12 @@ from skfem import Basis, ElementDG, FacetBasis
 from estimators.averaging import compliance_energy, element_areas
 from estimators.base import Estimate, register_estimator
 from estimators.constants import domain_constants
-from estimators.equilibration import BoundaryData, boundary_balance, reconstruct
+from estimators.equilibration import (
+    BoundaryData,
+    boundary_balance,
+    boundary_fluxes,
+    reconstruct,
+)
 from estimators.guaranteed_contact import (
     balanced_traction,
     contact_bound,
@@ -88,14 +93,18 @@ def equilibrate(scene, solution: DiscreteSolution):
     clamped[mesh.facets[:, scene.dirichlet_facets(mesh)].ravel()] = True
     interior = interior_data(mesh, stress, scene.body_force, order, max(4, 2 * order + 2))
     trace = solution.trace
+    n_v = mesh.p.shape[1]
     neumann = BoundaryData(scene.neumann_facets(mesh), scene.traction or (lambda x: 0.0 * x))
     raw = BoundaryData(trace.facets, lambda x: traction_at(trace, solution.pressure, x))
-    defect = interior.total - boundary_balance(interior, [neumann, raw])
+    neumann_flux = boundary_fluxes(interior, [neumann])
+    defect = interior.total - boundary_balance(n_v, neumann_flux
+                                               + boundary_fluxes(interior, [raw]))[0]
     lam_star = balanced_traction(trace, solution.pressure, defect, clamped)
     contact = BoundaryData(trace.facets, lambda x: traction_at(trace, lam_star, x))
-    defect = interior.total - boundary_balance(interior, [neumann, contact])
-    interior, load = rebalanced(interior, defect, clamped)
-    rec = reconstruct(interior, [neumann, contact], clamped)
+    fluxes = neumann_flux + boundary_fluxes(interior, [contact])
+    interior, load = rebalanced(interior, interior.total - boundary_balance(n_v, fluxes)[0],
+                                clamped)
+    rec = reconstruct(interior, fluxes, clamped)
     if rec.imbalance > BALANCE_TOLERANCE:
         raise NotEquilibrated(f"the patch data do not balance (relative imbalance "
                               f"{rec.imbalance:.1e} > {BALANCE_TOLERANCE:g}): no bound")

@@ -59,12 +59,25 @@ class BoundaryData:
     traction: object
 
 
-def boundary_flux(mesh, facets: np.ndarray, traction, k: int, intorder: int):
-    """The prescribed RT_k DOF values of Pi_k (psi_a t) on boundary ``facets`` for both facet
-    vertices a: values (n_f, 2 vertices, 2 rows, k + 1 facet DOFs), the integrals of psi_a t
-    (n_f, 2, 2), the vertices (2, n_f), the elements (n_f,) and their local facet (n_f,).
-    ``traction(x)`` returns t (2, n_f, nq) at points x (2, n_f, nq)."""
-    fb = FacetBasis(mesh, ElementTriRTk(k), facets=facets, intorder=intorder)
+@dataclass(frozen=True, eq=False)
+class Flux:
+    """Pi_k (psi_a t) on boundary facets for both facet vertices a: the prescribed RT_k DOF
+    values (n_f, 2 vertices, 2 rows, k + 1 facet DOFs), the integrals of psi_a t (n_f, 2, 2)
+    and of psi_a t . r_a (n_f, 2) (r_a the rotation about a), the vertices (2, n_f), the
+    elements (n_f,) and their local facet (n_f,)."""
+
+    values: np.ndarray
+    integrals: np.ndarray
+    turning: np.ndarray
+    ends: np.ndarray
+    elements: np.ndarray
+    local: np.ndarray
+
+
+def boundary_flux(interior: Interior, part: BoundaryData) -> Flux:
+    """The ``Flux`` of ``part`` at the RT degree and quadrature of ``interior``."""
+    mesh, k, facets = interior.rt.mesh, interior.k, part.facets
+    fb = FacetBasis(mesh, ElementTriRTk(k), facets=facets, intorder=interior.intorder)
     hats = FacetBasis(mesh, ElementTriP1(), facets=facets, quadrature=fb.quadrature)
     local = _local_facet(mesh, facets, fb.tind)
     rows = np.arange(facets.size)
@@ -73,40 +86,43 @@ def boundary_flux(mesh, facets: np.ndarray, traction, k: int, intorder: int):
     own = (k + 1) * local[None, :] + np.arange(k + 1)[:, None]         # (k + 1, n_f)
     trace = normal_trace[own, rows[None, :]]                           # (k + 1, n_f, nq)
     gram = np.einsum("jfp,lfp,fp->fjl", trace, trace, fb.dx)
-    t = traction(np.asarray(fb.global_coordinates()))
+    x = np.asarray(fb.global_coordinates())
+    t = part.traction(x)
     ends = mesh.facets[:, facets]
     vertex_local = (mesh.t[:, fb.tind][None, :, :] == ends[:, None, :]).argmax(axis=1)
     psi = np.array([np.asarray(b[0]) for b in hats.basis])[vertex_local, rows[None, :]]
     moments = np.einsum("vfp,rfp,jfp,fp->fvrj", psi, t, trace, fb.dx)
     values = np.linalg.solve(gram[:, None, None], moments[..., None])[..., 0]
-    integrals = np.einsum("vfp,rfp,fp->fvr", psi, t, fb.dx)
-    x = np.asarray(fb.global_coordinates())
     arm = x[None] - mesh.p[:, ends].transpose(1, 0, 2)[..., None]      # x - x_a, (2, 2, n_f, nq)
     turn = t[1][None] * arm[:, 0] - t[0][None] * arm[:, 1]              # t . r_a
-    return values, integrals, ends, fb.tind, local, np.einsum("vfp,vfp,fp->fv", psi, turn, fb.dx)
+    return Flux(values=values, integrals=np.einsum("vfp,rfp,fp->fvr", psi, t, fb.dx),
+                turning=np.einsum("vfp,vfp,fp->fv", psi, turn, fb.dx), ends=ends,
+                elements=fb.tind, local=local)
 
 
 def _local_facet(mesh, facets: np.ndarray, elements: np.ndarray) -> np.ndarray:
     return (mesh.t2f[:, elements] == facets[None, :]).argmax(axis=0)
 
 
-def boundary_balance(interior: Interior, boundary: list[BoundaryData]) -> np.ndarray:
-    """int psi_a t over the boundary, per vertex (n_vertices, 2)."""
-    mesh = interior.rt.mesh
-    balance = np.zeros((mesh.p.shape[1], 2))
-    for part in boundary:
-        if part.facets.size:
-            _, integrals, ends, _, _, _ = boundary_flux(mesh, part.facets, part.traction,
-                                                     interior.k, interior.intorder)
-            for v in (0, 1):
-                np.add.at(balance, ends[v], integrals[:, v])
-    return balance
+def boundary_fluxes(interior: Interior, boundary: list[BoundaryData]) -> list[Flux]:
+    """The ``Flux`` of every part with facets."""
+    return [boundary_flux(interior, part) for part in boundary if part.facets.size]
 
 
-def reconstruct(interior: Interior, boundary: list[BoundaryData],
+def boundary_balance(n_vertices: int, fluxes: list[Flux]) -> tuple[np.ndarray, np.ndarray]:
+    """int psi_a t (n_vertices, 2) and int psi_a t . r_a (n_vertices,) over the boundary."""
+    balance, turning = np.zeros((n_vertices, 2)), np.zeros(n_vertices)
+    for flux in fluxes:
+        for v in (0, 1):
+            np.add.at(balance, flux.ends[v], flux.integrals[:, v])
+            np.add.at(turning, flux.ends[v], flux.turning[:, v])
+    return balance, turning
+
+
+def reconstruct(interior: Interior, fluxes: list[Flux],
                 clamped: np.ndarray) -> Reconstruction:
-    """sigma* of the module docstring; ``clamped`` (n_vertices,) marks the vertices on
-    Gamma_D (their patches have no balance condition)."""
+    """sigma* of the module docstring for the boundary data ``fluxes``; ``clamped``
+    (n_vertices,) marks the vertices on Gamma_D (their patches have no balance condition)."""
     rt, k = interior.rt, interior.k
     mesh = rt.mesh
     n_el, n_v = mesh.t.shape[1], mesh.p.shape[1]
@@ -118,19 +134,14 @@ def reconstruct(interior: Interior, boundary: list[BoundaryData],
     status = np.full((patch.size, n_rt), FREE)
     status[facet_of_dof[None, :] == _OPPOSITE_FACET[np.tile(np.arange(3), n_el)][:, None]] = ZERO
     fixed = np.zeros((patch.size, n_rt, 2))
-    balance, turning = np.zeros((n_v, 2)), np.zeros(n_v)
-    for part in boundary:
-        if part.facets.size == 0:
-            continue
-        values, integrals, ends, elements, local, turn = boundary_flux(
-            mesh, part.facets, part.traction, k, interior.intorder)
+    for flux in fluxes:
         for v in (0, 1):
-            p = 3 * elements + (mesh.t[:, elements] == ends[v][None, :]).argmax(axis=0)
+            p = 3 * flux.elements + (mesh.t[:, flux.elements]
+                                     == flux.ends[v][None, :]).argmax(axis=0)
             for j in range(k + 1):
-                status[p, (k + 1) * local + j] = FIXED
-                fixed[p, (k + 1) * local + j] = values[:, v, :, j]
-            np.add.at(balance, ends[v], integrals[:, v])
-            np.add.at(turning, ends[v], turn[:, v])
+                status[p, (k + 1) * flux.local + j] = FIXED
+                fixed[p, (k + 1) * flux.local + j] = flux.values[:, v, :, j]
+    balance, turning = boundary_balance(n_v, fluxes)
     data = interior.data.reshape(-1, 2, n_dg)
     n_sym = interior.symmetry.shape[1] if k >= WEAK_SYMMETRY_FROM else 0
     pairs = PairMatrices(mass=interior.mass, divergence=interior.divergence,
