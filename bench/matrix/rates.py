@@ -28,6 +28,14 @@ def slope(group: pd.DataFrame, column: str, levels: int = RATE_LEVELS) -> float:
     return float(np.polyfit(np.log(ok["ndofs"]), np.log(ok[column]), 1)[0])
 
 
+def judged_levels(rows: pd.DataFrame) -> pd.DataFrame:
+    """The solved levels with an effectivity index whose truth is sharp enough to judge it."""
+    if "effectivity_index" not in rows:
+        return rows.iloc[:0]
+    ok = rows[(rows["status"] == STATUS_OK) & (rows["effectivity_index"] > 0)]
+    return ok[~ok["reference_too_coarse"].fillna(False).astype(bool)]
+
+
 def rates_table(table: pd.DataFrame, levels: int = RATE_LEVELS) -> pd.DataFrame:
     rows = []
     table = with_labels(table[table["level"] >= 0])
@@ -35,11 +43,9 @@ def rates_table(table: pd.DataFrame, levels: int = RATE_LEVELS) -> pd.DataFrame:
         group = group.sort_values("level")
         ok = group[group["status"] == STATUS_OK]
         tail = ok.tail(levels)
-        usable = tail[~tail["reference_too_coarse"].astype(bool)
-                      & (tail["effectivity_index"] > 0)] if "effectivity_index" in tail else tail
+        usable = judged_levels(tail)
         effectivity = usable["effectivity_index"] if len(usable) else pd.Series(dtype=float)
-        judged = ok[~ok["reference_too_coarse"].astype(bool) & (ok["effectivity_index"] > 0)] \
-            if "effectivity_index" in ok else ok.iloc[:0]
+        judged = judged_levels(ok)
         rows.append({
             **dict(zip(KEYS, key, strict=True)),
             "levels": len(group), "fit_levels": len(tail),

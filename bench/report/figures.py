@@ -128,29 +128,6 @@ def effectivity(table: pd.DataFrame):
     return fig
 
 
-def estimator_effectivity(judged: pd.DataFrame):
-    """Every judged level's effectivity per estimator (one column each, jittered points over
-    a box of the quartiles), log scale, with the line eta = error."""
-    if judged.empty:
-        return None
-    names = [n for n in estimator_names() if n in set(judged["estimator"])]
-    fig = Figure(figsize=(8, 3.5))
-    ax = fig.subplots()
-    values = [judged.loc[judged["estimator"] == n, "effectivity_index"].to_numpy()
-              for n in names]
-    ax.boxplot(values, showfliers=False, whis=(0, 100))
-    rng = np.random.default_rng(0)  # fixed jitter: the same picture from the same rows
-    for k, v in enumerate(values, start=1):
-        ax.plot(k + rng.uniform(-0.2, 0.2, v.size), v, ".", markersize=2, alpha=0.5)
-    ax.set_xticks(range(1, len(names) + 1), names)
-    ax.axhline(1.0, color="k", linewidth=0.8)
-    ax.set_yscale("log")
-    ax.set_ylabel("eta / ||u - u_h||")
-    ax.grid(True, which="both", axis="y", alpha=0.3)
-    fig.tight_layout()
-    return fig
-
-
 def work_precision(table: pd.DataFrame):
     """Error (or eta) against cumulative wall time and against the solve time per level."""
     y = "energy_error" if table["energy_error"].gt(0).any() else "eta"

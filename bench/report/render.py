@@ -11,8 +11,9 @@ import jinja2
 import pandas as pd
 
 from bench.hard import LOSS_TOLERANCE, PRESSURE_TOLERANCE, hard_display
-from bench.matrix.rates import RATE_LEVELS, rates_table
+from bench.matrix.rates import RATE_LEVELS, judged_levels, rates_table
 from bench.report import figures, hard_figures
+from bench.report.estimator_figures import ESTIMATOR_CAPTION, estimator_effectivity
 from bench.report.hard_figures import NITSCHE_CAPTION
 from bench.report.orders import order_section
 from bench.report.sections import Figures, scene_section
@@ -22,17 +23,12 @@ from bench.report.tables import (
     effectivity_table,
     estimator_summary,
     failure_table,
-    judged_levels,
     rate_verdicts,
     timing_table,
 )
 from bench.sequence.rows import COLUMNS, INTERRUPTED, KEYS, with_labels
 
 TEMPLATES = Path(__file__).with_name("templates")
-ESTIMATOR_CAPTION = ("Effectivity eta / ||u - u_h|| of every level with a sharp enough truth, "
-                     "per estimator, over all scenes, formulations, orders and strategies "
-                     "(box: quartiles, whiskers: range). Below the line the estimator "
-                     "under-estimates the error.")
 HARD_CAPTION = ("Hard cases: the mixed method's inf-sup constant beta_h against ndofs for "
                 "h/H = 1, 1/2, 1/4 (bounded below only for h/H <= 1/2); the penalty's "
                 "penetration and condition estimate against eps_0; and each solver's pressure "
@@ -119,7 +115,7 @@ def write_report(table: pd.DataFrame, out: str | Path, results: str | Path | Non
         "scenes": [scene_section(name, group, results, figs, truth)
                    for name, group in rows.groupby("scene", sort=True)],
         "tables": _tables(everything, rows, hard),
-        "estimator_figure": figs.add(figures.estimator_effectivity(judged_levels(rows))
+        "estimator_figure": figs.add(estimator_effectivity(judged_levels(rows))
                                      if len(rows) else None, "estimators", ESTIMATOR_CAPTION),
         "orders": order_section(rows, figs),
         "hard_run": hard is not None, "hard_figures": hard_figures,

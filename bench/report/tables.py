@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from bench.matrix.rates import judged_levels
 from bench.sequence.rows import KEYS, LABELS, phase_time
 from bench.verify import claims
 from estimators import guaranteed_estimators
@@ -58,12 +59,6 @@ def effectivity_table(rates: pd.DataFrame) -> pd.DataFrame:
         "max": rates["effectivity_max"].map(_fmt),
         "max/min": rates["effectivity_variation"].map(_fmt),
         "rows with too coarse reference": rates["too_coarse_rows"]}))
-
-
-def judged_levels(rows: pd.DataFrame) -> pd.DataFrame:
-    """The solved levels with an effectivity index whose truth is sharp enough to judge it."""
-    ok = rows[(rows["status"] == STATUS_OK) & (rows["effectivity_index"] > 0)]
-    return ok[~ok["reference_too_coarse"].fillna(False).astype(bool)]
 
 
 def estimator_summary(rows: pd.DataFrame) -> pd.DataFrame:
