@@ -32,8 +32,9 @@ from scenes import scene_names
 
 def _scene_file_option(parser) -> None:
     parser.add_argument("--scene-file", action="append", default=[], metavar="FILE",
-                        help="a Python file that registers scenes with scenes.register_scene "
-                             "(repeatable); its scenes join --scene's choices")
+                        help="a Python file that registers scenes with scenes.register_scene, or "
+                             "a TOML scene (docs/scenes.md) (repeatable); its scenes join "
+                             "--scene's choices")
 
 
 def _scale_out_options(parser) -> None:

@@ -1,5 +1,6 @@
-"""Scenes from a user's Python file (``--scene-file my_scenes.py``): the file registers them
-with the public API (``scenes.register_scene``) when imported. Every process that builds
+"""Scenes from a user's files (``--scene-file``): a Python file registers them with the public
+API (``scenes.register_scene``) when imported; a TOML file describes one scene declaratively
+(``scenes.declarative``, docs/scenes.md). Every process that builds
 scenes imports the same files (the driver, and each Dask task before its sequence), and a file
 is imported once per process."""
 
@@ -10,20 +11,29 @@ import importlib.util
 import sys
 from pathlib import Path
 
+from scenes.base import SceneError
+from scenes.declarative import register_toml_scene
+
 _LOADED: dict[str, str] = {}  # resolved path -> module name, per process
 
 
 def load_scene_files(paths) -> list[str]:
-    """Import each file once in this process; ValueError (one line, naming the option and the
-    value) for a missing file, one that is not Python, or one that fails to import."""
+    """Load each file once in this process; ValueError (one line, naming the option and the
+    value) for a missing file, one that is neither Python nor TOML, or one that fails."""
     names = []
     for path in paths:
         flag = f"--scene-file={str(path)!r}"
         file = Path(path).expanduser()
-        if not file.is_file() or file.suffix != ".py":
-            raise ValueError(f"{flag} is not a Python file (.py) that registers scenes")
+        if not file.is_file() or file.suffix not in (".py", ".toml"):
+            raise ValueError(f"{flag} is not a Python file (.py) that registers scenes or a "
+                             "TOML scene (.toml)")
         key = str(file.resolve())
-        if key not in _LOADED:
+        if key not in _LOADED and file.suffix == ".toml":
+            try:
+                _LOADED[key] = register_toml_scene(file)
+            except (SceneError, ValueError) as error:
+                raise ValueError(f"{flag}: {error}") from None
+        elif key not in _LOADED:
             name = f"signorini_bench_scene_file_{len(_LOADED)}"
             spec = importlib.util.spec_from_file_location(name, file)
             module = importlib.util.module_from_spec(spec)

@@ -1,0 +1,93 @@
+"""A triangle mesh from a file (Gmsh ``.msh`` or any format meshio reads) whose physical groups
+of lines name boundary parts (docs/scenes.md, "Meshes from Gmsh").
+
+A named group becomes a predicate on points: "on one of the group's segments". Refinement puts
+new facet midpoints on the segments of the initial mesh, so the predicate holds on every level.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from skfem import MeshTri
+
+from scenes.base import SceneError
+
+
+@dataclass(frozen=True, eq=False)
+class MeshFile:
+    """The body's triangles and the segments (shape (2, 2, m): end point, coordinate, segment)
+    of each named boundary group."""
+
+    mesh: MeshTri
+    groups: dict[str, np.ndarray]
+
+
+def read_mesh_file(path: str | Path, where: str = "mesh") -> MeshFile:
+    """Triangles and named line groups of ``path``; SceneError (one line) when the file does not
+    read, holds no triangles, or its line groups carry no names."""
+    import meshio  # only scenes from files need it
+
+    try:
+        data = meshio.read(path)
+    except Exception as error:  # meshio raises many types; the user needs the file and reason
+        raise SceneError(f"{where}={str(path)!r} does not read as a mesh: "
+                         f"{type(error).__name__}: {error}") from None
+    triangles = [block.data for block in data.cells if block.type == "triangle"]
+    if not triangles:
+        raise SceneError(f"{where}={str(path)!r} holds no triangles (2D meshes of 3-node "
+                         "triangles are read)")
+    t = np.concatenate(triangles)
+    used, t = np.unique(t, return_inverse=True)
+    t = t.reshape(-1, 3)
+    p = np.asarray(data.points, dtype=float)[used, :2]
+    return MeshFile(_counter_clockwise(p, t), _line_groups(data, path, where))
+
+
+def _counter_clockwise(p: np.ndarray, t: np.ndarray) -> MeshTri:
+    a, b, c = p[t[:, 0]], p[t[:, 1]], p[t[:, 2]]
+    area = (b - a)[:, 0] * (c - a)[:, 1] - (b - a)[:, 1] * (c - a)[:, 0]
+    t = np.where((area < 0)[:, None], t[:, [0, 2, 1]], t)
+    return MeshTri(p.T.copy(), t.T.copy())
+
+
+def _line_groups(data, path, where: str) -> dict[str, np.ndarray]:
+    """Segments of each physical group of lines, by the group's name."""
+    names = {int(tag): name for name, (tag, dim) in data.field_data.items() if int(dim) == 1}
+    tags = data.cell_data.get("gmsh:physical")
+    groups: dict[str, list] = {}
+    if tags is not None:
+        for block, block_tags in zip(data.cells, tags, strict=True):
+            if block.type != "line":
+                continue
+            for tag in np.unique(block_tags):
+                if int(tag) in names:
+                    ends = data.points[block.data[block_tags == tag], :2]  # (m, 2, 2)
+                    groups.setdefault(names[int(tag)], []).append(ends.transpose(1, 2, 0))
+    if not groups:
+        raise SceneError(f"{where}={str(path)!r} has no named physical groups of lines (name the "
+                         "clamped, contact and loaded boundaries with Physical Curve(\"...\"))")
+    return {name: np.concatenate(parts, axis=2) for name, parts in groups.items()}
+
+
+def on_segments(segments: np.ndarray, tolerance: float):
+    """A predicate: points (2, ...) within ``tolerance`` of one of ``segments`` (2, 2, m)."""
+    a, b = segments[0][:, None, :], segments[1][:, None, :]  # (2, 1, m)
+    d = b - a
+    length2 = np.maximum((d**2).sum(axis=0), np.finfo(float).tiny)
+
+    def predicate(x: np.ndarray) -> np.ndarray:
+        x = np.asarray(x, dtype=float)
+        flat = x.reshape(2, -1)
+        hit = np.zeros(flat.shape[1], dtype=bool)
+        step = max(1, 2_000_000 // segments.shape[2])  # bounded memory: points x segments
+        for start in range(0, flat.shape[1], step):
+            q = flat[:, start:start + step, None]
+            s = np.clip(((q - a) * d).sum(axis=0) / length2, 0.0, 1.0)
+            gap = ((q - a - s * d) ** 2).sum(axis=0)
+            hit[start:start + step] = (gap <= tolerance**2).any(axis=1)
+        return hit.reshape(x.shape[1:])
+
+    return predicate
