@@ -17,10 +17,15 @@ from formulations.base import (
     SolverDiagnostics,
 )
 from formulations.discretisation import Discretisation, solve
-from formulations.registry import formulation_descriptions, formulation_names, get_formulation
+from formulations.registry import (
+    formulation_descriptions,
+    formulation_names,
+    get_formulation,
+    register_formulation,
+)
 from formulations.solvers import get_solver, solver_descriptions, solver_names
 
 __all__ = ["STATUS_FAILED", "STATUS_INACCURATE", "STATUS_OK", "STATUS_SKIPPED", "ContactQP",
            "DiscreteSolution", "Discretisation", "QPSolution", "Residuals", "SolverDiagnostics",
            "formulation_descriptions", "formulation_names", "get_formulation", "get_solver",
-           "solve", "solver_descriptions", "solver_names"]
+           "register_formulation", "solve", "solver_descriptions", "solver_names"]

@@ -6,17 +6,42 @@ import it downwards.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from typing import Any
+
+BUILT_IN = "built-in"
+_ORIGINS = [BUILT_IN]  # where registrations come from now (a stack: files, plugins)
+REGISTRIES: list[Registry] = []  # every registry, for listing and for undoing a failed plugin
+
+
+@contextmanager
+def registering_as(origin: str) -> Iterator[None]:
+    """Record ``origin`` (a scene file, a plugin) for every registration inside the block."""
+    _ORIGINS.append(origin)
+    try:
+        yield
+    finally:
+        _ORIGINS.pop()
+
+
+def unregister_origin(origin: str) -> None:
+    """Undo every registration of ``origin`` (a plugin that failed half-way)."""
+    for registry in REGISTRIES:
+        for name in [n for n in registry.names() if registry.origin(n) == origin]:
+            registry.unregister(name)
 
 
 class Registry:
-    """Name -> object with one line of description; unknown names list the valid ones."""
+    """Name -> object with one line of description and its origin (``built-in``, a scene file,
+    a plugin); unknown names list the valid ones."""
 
     def __init__(self, kind: str):
         self.kind = kind
         self._items: dict[str, tuple[Any, str]] = {}
         self._applies: dict[str, Callable[..., str | None]] = {}
+        self._origins: dict[str, str] = {}
+        REGISTRIES.append(self)
 
     def register(self, name: str, description: str,
                  applies: Callable[..., str | None] | None = None) -> Callable[[Any], Any]:
@@ -26,6 +51,7 @@ class Registry:
             if name in self._items:
                 raise ValueError(f"{self.kind} {name!r} is already registered")
             self._items[name] = (item, description)
+            self._origins[name] = _ORIGINS[-1]
             if applies is not None:
                 self._applies[name] = applies
             return item
@@ -35,6 +61,12 @@ class Registry:
     def unregister(self, name: str) -> None:
         self._items.pop(name, None)
         self._applies.pop(name, None)
+        self._origins.pop(name, None)
+
+    def origin(self, name: str) -> str:
+        """Where ``name`` was registered: ``built-in``, ``file PATH`` or ``plugin DIST``."""
+        self.get(name)
+        return self._origins[name]
 
     def why_not(self, name: str, **context) -> str | None:
         """The reason ``name`` does not apply to ``context``, or None."""

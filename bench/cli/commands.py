@@ -25,7 +25,9 @@ from bench.hard import (
     run_hard,
     write_hard,
 )
+from bench.hard.registry import HARD_CASES
 from bench.matrix import RunConfig, run
+from bench.matrix.plugins import FAILURES, load_plugins
 from bench.matrix.run import RunRefused
 from bench.matrix.scene_files import load_scene_files, scene_files_in
 from bench.matrix.store import ResultsError, read_results
@@ -36,10 +38,15 @@ from bench.sequence.loop import LevelResult
 from bench.sequence.rows import KEYS, level_time
 from bench.verify import load_expected, verdict_table, verify
 from estimators import estimator_descriptions, estimator_names
+from estimators.base import ESTIMATORS
 from formulations import formulation_descriptions, formulation_names, solver_descriptions
 from formulations.elasticity import order_descriptions
+from formulations.registry import FORMULATIONS
 from formulations.solvers.backends import check_backend
+from formulations.solvers.backends.base import REGISTRY as BACKENDS
+from formulations.solvers.registry import SOLVERS, SYSTEM_SOLVERS
 from scenes import scene_descriptions, scene_names
+from scenes.registry import BUILT_IN, SCENES
 
 SUMMARY_COLUMNS = ["level", "ndofs", "energy", "contact_force", "active_constraints", "eta",
                    "eta_0", "eta_geometric", "eta_complementarity", "energy_error",
@@ -63,15 +70,15 @@ def summary(table: pd.DataFrame) -> str:
 
 
 def list_command(args) -> int:
-    for title, items in (("scenes", scene_descriptions()),
-                         ("formulations", formulation_descriptions()),
-                         ("solvers", solver_descriptions()),
-                         ("estimators", estimator_descriptions()),
-                         ("orders (--order)", order_descriptions()),
-                         ("hard cases", hard_case_descriptions())):
+    """Every registered unit with its origin (built-in, a scene file, a plugin), then any
+    plugin that failed to load."""
+    for title, items, origin in LISTINGS:
         print(f"{title}:")
-        for name, text in items.items():
-            print(f"  {name:14s} {text}")
+        for name, text in items().items():
+            print(f"  {name:16s} [{origin(name)}] {text}")
+    for failure in FAILURES:
+        print(f"plugin {failure.distribution!r} skipped (entry point {failure.name!r} in "
+              f"{failure.group}): {failure.reason}")
     return 0
 
 
@@ -221,6 +228,22 @@ def sequence_command(args) -> int:
     return 0
 
 
+def _solver_origin(name: str) -> str:
+    return (SOLVERS if name in SOLVERS.names() else SYSTEM_SOLVERS).origin(name)
+
+
+def _hard_origin(name: str) -> str:
+    return (HARD_CASES if name in HARD_CASES.names() else SCENES).origin(name)
+
+
+LISTINGS = (("scenes", scene_descriptions, SCENES.origin),
+            ("formulations", formulation_descriptions, FORMULATIONS.origin),
+            ("solvers", solver_descriptions, _solver_origin),
+            ("sparse back-ends (--backend)", BACKENDS.descriptions, BACKENDS.origin),
+            ("estimators", estimator_descriptions, ESTIMATORS.origin),
+            ("orders (--order)", order_descriptions, lambda name: BUILT_IN),
+            ("hard cases", hard_case_descriptions, _hard_origin))
+
 COMMANDS = {"run": run_command, "compare": compare_command, "report": report_command,
             "export": export_command,
             "verify": verify_command, "hard": hard_command, "scaling": scaling_command,
@@ -229,6 +252,7 @@ COMMANDS = {"run": run_command, "compare": compare_command, "report": report_com
 
 def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
+    load_plugins()  # before the parser too: its lists include the plugins' units
     try:  # before the parser: its lists of valid scenes include the files' scenes
         load_scene_files(scene_files_in(argv))
     except ValueError as error:

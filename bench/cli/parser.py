@@ -248,7 +248,11 @@ def build_parser() -> argparse.ArgumentParser:
     from bench.cli.study import add_study_parser  # the study's own module (it uses these types)
 
     add_study_parser(sub)
-    sub.add_parser("list", help="list registered scenes, formulations, solvers, estimators "
-                   "and hard cases",
-                   description="List everything registered, with one line of description.")
+    listing = sub.add_parser(
+        "list", help="list registered scenes, formulations, solvers, back-ends, estimators and "
+        "hard cases, with where each came from",
+        description="List everything registered, with its origin (built-in, a scene file or "
+        "an installed plugin) and one line of description; then any plugin that failed to "
+        "load.")
+    _scene_file_option(listing)
     return parser

@@ -14,6 +14,7 @@ from dataclasses import replace
 from pathlib import Path
 from urllib.parse import urlsplit
 
+from bench.matrix.plugins import load_plugins
 from bench.matrix.scene_files import load_scene_files
 from bench.matrix.spec import SequenceSpec
 from bench.matrix.store import ResultStore, SequenceWriter
@@ -63,9 +64,10 @@ def check_scheduler(address: str, timeout: float = SCHEDULER_TIMEOUT) -> None:
 def sequence_task(spec: SequenceSpec, out: str, run: dict, cache: str | None,
                   max_memory_gib: float | None, scene_files: tuple[str, ...] = ()) -> Outcome:
     """One sequence on a worker: its rows go to its own partition as they finish (the user's
-    scene files imported first, as in the driver)."""
+    plugins and scene files imported first, as in the driver)."""
     if cache is not None:
         os.environ["SIGNORINI_BENCH_CACHE"] = cache
+    load_plugins()
     load_scene_files(scene_files)
     writer = SequenceWriter(Path(out) / "sequences" / f"{spec.key}.parquet")
     rows = []

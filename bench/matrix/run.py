@@ -18,6 +18,7 @@ import pandas as pd
 
 from bench.matrix.distributed import SchedulerError, check_scheduler, scheduler_endpoint
 from bench.matrix.harness import new_run_identity, run_specs, truth_name, write_truth_summary
+from bench.matrix.plugins import load_plugins
 from bench.matrix.rates import write_rates
 from bench.matrix.scene_files import load_scene_files, source_digest
 from bench.matrix.spec import (
@@ -78,6 +79,7 @@ class RunConfig:
 
     def __post_init__(self):
         object.__setattr__(self, "scene_files", tuple(str(f) for f in self.scene_files))
+        load_plugins()
         load_scene_files(self.scene_files)  # their scenes are valid names from here on
         for name, valid in NAME_LISTS.items():
             items = tuple(getattr(self, name))

@@ -13,6 +13,7 @@ from pathlib import Path
 
 from scenes.base import SceneError
 from scenes.declarative import register_toml_scene
+from scenes.registry import registering_as
 
 _LOADED: dict[str, str] = {}  # resolved path -> module name, per process
 
@@ -30,7 +31,8 @@ def load_scene_files(paths) -> list[str]:
         key = str(file.resolve())
         if key not in _LOADED and file.suffix == ".toml":
             try:
-                _LOADED[key] = register_toml_scene(file)
+                with registering_as(f"file {file}"):
+                    _LOADED[key] = register_toml_scene(file)
             except (SceneError, ValueError) as error:
                 raise ValueError(f"{flag}: {error}") from None
         elif key not in _LOADED:
@@ -39,7 +41,8 @@ def load_scene_files(paths) -> list[str]:
             module = importlib.util.module_from_spec(spec)
             sys.modules[name] = module
             try:
-                spec.loader.exec_module(module)
+                with registering_as(f"file {file}"):
+                    spec.loader.exec_module(module)
             except Exception as error:  # the user's code: name the file and the error
                 del sys.modules[name]
                 raise ValueError(f"{flag} failed to import: {type(error).__name__}: "

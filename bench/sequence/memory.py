@@ -5,20 +5,12 @@ The model is linear in the number of unknowns N, per solver route:
 
     peak [GiB] = base + per_dof * N.
 
-Coefficients are fitted to ``python -m bench scaling`` (peak resident memory of a whole level:
-assembly, factorisation, contact solve, estimator; paper scene, mixed method, uniform meshes)
-on the 2-core reference machine:
-
-* ``pardiso`` (active-set): 0.23 / 0.52 / 2.58 GiB at 10 512 / 100 800 / 992 640 DOFs; the
-  line through the first and the last gives base 0.20 GiB and 2.39e-6 GiB per DOF (2.6 kB),
-  0.86 x the middle point (P2 at 992 640 DOFs: 3.25 GiB measured, 3.53 predicted);
-* ``cholmod`` (active-set): 0.218 / 0.650 / 4.893 GiB at 10 512 / 100 800 / 992 640 DOFs; the
-  line through the last two gives base 0.17 GiB and 4.76e-6 GiB per DOF (5.1 kB), within 5 %
-  of all three points;
-* ``splu`` (active-set): 0.244 / 0.953 GiB at 10 512 / 100 800 DOFs, the line through them
-  (7.85e-6 GiB per DOF); beyond 1e5 unmeasured, so SuperLU's superlinear fill may exceed it;
-* ``reference`` (Clarabel): running after the cholmod route in the same process it never raised
-  the peak at 1e5 or 1e6, so the cholmod line is used as its bound.
+Each sparse back-end carries its line (``Backend.memory_gib``, with the measurements beside it
+in its own module), fitted to ``python -m bench scaling`` (peak resident memory of a whole
+level: assembly, factorisation, contact solve, estimator; paper scene, mixed method, uniform
+meshes) on the 2-core reference machine. ``reference`` (Clarabel), running after the cholmod
+route in the same process, never raised the peak at 1e5 or 1e6, so the cholmod line
+(REFERENCE) bounds it. A back-end without a line gets the steepest measured one.
 
 Formulations differ by a few slack unknowns per contact point, which the model ignores.
 
@@ -33,6 +25,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+from formulations.solvers.backends.base import REGISTRY as BACKENDS
+
 MARGIN = 0.1  # keep this fraction of the available memory (at least MIN_MARGIN_GIB) free
 MIN_MARGIN_GIB = 1.0
 
@@ -46,10 +40,19 @@ class MemoryLine:
         return self.base_gib + self.per_dof_gib * ndofs
 
 
-CHOLMOD = MemoryLine(0.1713, 4.754e-6)
-MODEL = {"pardiso": MemoryLine(0.2048, 2.393e-6), "cholmod": CHOLMOD,
-         "splu": MemoryLine(0.1612, 7.851e-6), "reference": CHOLMOD}
+REFERENCE = MemoryLine(0.1713, 4.754e-6)  # the cholmod route's line (docstring)
 ORDER_FACTOR = {1: 1.0, 2: 1.4, 3: 1.7}  # per-DOF memory of P_p relative to P1 (docstring)
+
+
+def memory_line(route_name: str) -> MemoryLine:
+    """The measured line of a route (``reference`` or a back-end's name); the steepest measured
+    line for a back-end without one (a bound, not a fit)."""
+    if route_name == "reference":
+        return REFERENCE
+    lines = {name: MemoryLine(*BACKENDS.get(name).memory_gib) for name in BACKENDS.names()
+             if BACKENDS.get(name).memory_gib is not None}
+    steepest = max([REFERENCE, *lines.values()], key=lambda line: line.per_dof_gib)
+    return lines.get(route_name, steepest)
 
 
 def route(solver: str, backend: str) -> str:
@@ -59,8 +62,7 @@ def route(solver: str, backend: str) -> str:
 def predict_peak_gib(ndofs: int, solver: str, backend: str, order: int = 1) -> float:
     """The predicted peak memory of a level with ``ndofs`` unknowns of order ``order`` (GiB);
     a back-end without a measured line gets the steepest one (a bound, not a fit)."""
-    steepest = max(MODEL.values(), key=lambda line: line.per_dof_gib)
-    line = MODEL.get(route(solver, backend), steepest)
+    line = memory_line(route(solver, backend))
     return line.base_gib + ORDER_FACTOR[order] * line.per_dof_gib * ndofs
 
 

@@ -18,7 +18,7 @@ from bench.cli import main
 from bench.matrix.artifacts import file_stem
 from bench.report import write_report
 from bench.sequence.loop import LoopConfig, run_sequence
-from bench.sequence.memory import MODEL, available_gib, predict_peak_gib
+from bench.sequence.memory import available_gib, memory_line, predict_peak_gib
 from bench.truth import cache
 from conftest import square_scene
 from formulations.solvers import backends
@@ -67,7 +67,7 @@ def test_a_level_that_would_not_fit_in_memory_is_refused_before_it_is_built(monk
 def test_memory_model_matches_the_scaling_table_within_1_5():
     table = pd.read_csv(os.path.join(ROOT, "reports", "scaling.csv"))
     for _, row in table.iterrows():
-        predicted = MODEL[row["backend"]].peak_gib(row["ndofs"])
+        predicted = memory_line(row["backend"]).peak_gib(row["ndofs"])
         assert 1 / 1.5 <= predicted / row["peak_gib_without_reference"] <= 1.5, row["ndofs"]
     assert 0 < available_gib() < float("inf")
 
@@ -266,7 +266,7 @@ def test_a_uniform_run_to_twice_the_machine_stops_at_the_last_level_that_fits(tm
     # measured on a 24 GiB machine: levels to 2 099 200 DOFs (peak 11.2 GiB), then level 9
     # (8 392 704 DOFs, ~40 GiB predicted) refused; takes about 3 minutes
     backend = backends.check_backend(None)
-    line = MODEL[backend]
+    line = memory_line(backend)
     capacity = int((available_gib() - line.base_gib) / line.per_dof_gib)
     out = tmp_path / "r"
     assert main(["run", "--strategy", "uniform", "--solver", "active-set", "--max-dofs",

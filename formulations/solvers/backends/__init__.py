@@ -44,14 +44,14 @@ __all__ = ["BACKENDS", "Backend", "BackendError", "CondensedFactor", "Factorisat
 
 def backend_names() -> tuple[str, ...]:
     """Every registered back-end, the preferred first."""
-    return tuple(sorted(REGISTRY, key=lambda name: REGISTRY[name].rank))
+    return tuple(sorted(REGISTRY.names(), key=lambda name: REGISTRY.get(name).rank))
 
 
 BACKENDS = backend_names()  # the built-in ones
 
 
 def available_backends() -> tuple[str, ...]:
-    return tuple(name for name in backend_names() if not REGISTRY[name].missing)
+    return tuple(name for name in backend_names() if not REGISTRY.get(name).missing)
 
 
 def default_backend() -> str:
@@ -62,28 +62,28 @@ def check_backend(backend: str | None) -> str:
     """The back-end to use for ``backend`` (None means the default), or a clear error."""
     if backend is None:
         return default_backend()
-    if backend not in REGISTRY:
+    if backend not in REGISTRY.names():
         raise BackendError(f"backend={backend!r} is not one of {', '.join(backend_names())}")
     if backend not in available_backends():
-        raise BackendError(f"backend={backend!r} is not available: {REGISTRY[backend].missing}")
+        raise BackendError(f"backend={backend!r} is not available: {REGISTRY.get(backend).missing}")
     return backend
 
 
 def condenses(backend: str | None) -> bool:
     """Whether ``backend`` gives the Schur complement (the condensed active-set route)."""
-    return REGISTRY[check_backend(backend)].condense is not None
+    return REGISTRY.get(check_backend(backend)).condense is not None
 
 
 def factorise(K: sparse.spmatrix, backend: str | None = None) -> Solve:
     """A plain factorisation of K: the linear-solve floor every contact solve is measured
     against (same back-end, same ordering options as ``factorise_condensed``)."""
-    return REGISTRY[check_backend(backend)].factorise(sparse.csc_matrix(K))
+    return REGISTRY.get(check_backend(backend)).factorise(sparse.csc_matrix(K))
 
 
 def factorise_condensed(K: sparse.spmatrix, contact: np.ndarray,
                         backend: str | None = None) -> CondensedFactor:
     backend = check_backend(backend)
-    condense = REGISTRY[backend].condense
+    condense = REGISTRY.get(backend).condense
     if condense is None:
         raise BackendError(f"backend={backend!r} gives no cheap Schur complement; "
                            f"{', '.join(b for b in available_backends() if condenses(b))} "

@@ -9,6 +9,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import linalg, sparse
 
+from scenes.registry import Registry
+
 Solve = Callable[[np.ndarray], np.ndarray]
 
 
@@ -41,24 +43,25 @@ class CondensedFactor:
 class Backend:
     """``factorise(K) -> solve``; ``condense(K, interior, contact) -> CondensedFactor`` or None
     when the back-end has no cheap Schur complement; ``rank``: the default is the available
-    back-end of lowest rank; ``missing``: why it cannot be used here ('' when it can)."""
+    back-end of lowest rank; ``missing``: why it cannot be used here ('' when it can);
+    ``memory_gib``: the measured peak memory of a whole P1 level on this route, (base GiB, GiB
+    per DOF) (bench.sequence.memory; None: not measured, the steepest measured line is used)."""
 
     name: str
     rank: int
     factorise: Callable[[sparse.csc_matrix], Solve]
     condense: Callable[[sparse.csc_matrix, np.ndarray, np.ndarray], CondensedFactor] | None
     missing: str = ""
+    description: str = ""
+    memory_gib: tuple[float, float] | None = None
 
 
-REGISTRY: dict[str, Backend] = {}
+REGISTRY = Registry("back-end")
 
 
 def register_backend(backend: Backend) -> Backend:
-    if backend.name in REGISTRY:
-        raise ValueError(f"back-end {backend.name!r} is registered twice")
-    REGISTRY[backend.name] = backend
-    return backend
+    return REGISTRY.register(backend.name, backend.description)(backend)
 
 
 def unregister_backend(name: str) -> None:
-    del REGISTRY[name]
+    REGISTRY.unregister(name)

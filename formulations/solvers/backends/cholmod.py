@@ -52,4 +52,8 @@ def condense(K, interior, contact) -> CondensedFactor:
 register_backend(Backend(
     "cholmod", rank=1, factorise=factorise, condense=condense,
     missing="" if cholmod is not None else "install scikit-sparse (needs SuiteSparse headers, "
-    "e.g. apt-get install libsuitesparse-dev)"))
+    "e.g. apt-get install libsuitesparse-dev)",
+    description="CHOLMOD supernodal Cholesky (scikit-sparse); S_C as the factor's last block",
+    # peak 0.218 / 0.650 / 4.893 GiB at 10 512 / 100 800 / 992 640 DOFs (bench scaling): the
+    # line through the last two, within 5 % of all three
+    memory_gib=(0.1713, 4.754e-6)))
