@@ -184,8 +184,11 @@ def export_command(args) -> int:
     if not (Path(args.results) / "artifacts").is_dir():
         raise InputError(f"--results={args.results!r} holds no artifacts/ (written by run and "
                          "compare); give a results folder")
-    written = export_results(args.results, args.out, args.format)
-    print(f"wrote {len(written)} files ({len(written) // 2} combinations) to {args.out}")
+    try:
+        written = export_results(args.results, args.out, args.format, args.levels)
+    except ValueError as error:
+        raise InputError(f"--{error}") from None
+    print(f"wrote {len(written)} files to {args.out}")
     return 0
 
 

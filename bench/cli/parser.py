@@ -16,7 +16,7 @@ from bench.cli.option_types import (
     sequence_budgets,
     theta_value,
 )
-from bench.export import FORMATS
+from bench.export import FORMATS, LEVELS
 from bench.hard import hard_case_names
 from bench.matrix.run import COMPARE_REFERENCE_DOFS
 from bench.perf.scaling import SIZES
@@ -137,8 +137,8 @@ def _report_parser(sub) -> None:
 
 
 def _export_parser(sub) -> None:
-    export = sub.add_parser("export", help="write each combination's last-level fields for "
-                            "ParaView (meshio)",
+    export = sub.add_parser("export", help="write each combination's fields (last level or "
+                            "every level) for ParaView (meshio)",
                             description="Write, per combination of RESULTS, the mesh with the "
                             "displacement, stress tensor, von Mises stress, estimator "
                             "indicators and (exact truth) error density, and Gamma_C with "
@@ -147,6 +147,11 @@ def _export_parser(sub) -> None:
                         help="results folder with artifacts/ (default: results)")
     export.add_argument("--format", choices=list(FORMATS), default="vtu",
                         help="file format (default: vtu)")
+    export.add_argument("--levels", choices=list(LEVELS), default="last",
+                        help="last: each combination's last level; all: every level, plus one "
+                             "series per combination that ParaView opens as one dataset "
+                             "(.pvd for vtu, a temporal .xdmf collection for xdmf) "
+                             "(default: last)")
     export.add_argument("--out", default=None,
                         help="folder for the files (default: RESULTS/fields)")
 

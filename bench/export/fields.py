@@ -1,4 +1,5 @@
-"""The fields of each combination's last level, written through meshio: the mesh with the
+"""The fields of each combination's last level, or of every level as a series, written through
+meshio: the mesh with the
 displacement, the stress tensor, von Mises stress, the estimator's element indicators and,
 where a truth is exact, the element error density; and the contact boundary with lambda_h and
 the gap. Read from ``DIR/artifacts/*.npz`` (``bench.matrix.artifacts``): nothing is
@@ -10,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
+from bench.export.series import write_pvd, write_xdmf_collection
 from bench.matrix.artifacts import load_artifact
 
 FORMATS = {"vtu": ".vtu", "xdmf": ".xdmf"}
@@ -52,23 +54,56 @@ def contact_mesh(data: dict):
     return meshio.Mesh(points, [("line", lines)], point_data=point_data)
 
 
-def export_results(results: str | Path, out: str | Path, fmt: str = "vtu") -> list[Path]:
-    """Write ``<combination>{ext}`` and ``<combination>-contact{ext}`` per artifact of the
-    results folder into ``out``; returns the files written."""
-    import meshio
+LEVELS = ("last", "all")
 
+
+def export_results(results: str | Path, out: str | Path, fmt: str = "vtu",
+                   levels: str = "last") -> list[Path]:
+    """Write ``<combination>{ext}`` and ``<combination>-contact{ext}`` per artifact of the
+    results folder into ``out`` (``levels="last"``), or with ``levels="all"`` every level into
+    ``<combination>/level-NNN{ext}`` plus one series per combination and part
+    (``<combination>[-contact].pvd`` for vtu, a temporal ``.xdmf`` collection for xdmf) that
+    ParaView opens as one dataset; returns the files written."""
     if fmt not in FORMATS:
         raise ValueError(f"format={fmt!r} is not one of {', '.join(FORMATS)}")
-    artifacts = sorted((Path(results) / "artifacts").glob("*.npz"))
+    if levels not in LEVELS:
+        raise ValueError(f"levels={levels!r} is not one of {', '.join(LEVELS)}")
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
+    if levels == "last":
+        return [file for path in sorted((Path(results) / "artifacts").glob("*.npz"))
+                for file in _write_level(path, out / path.stem, fmt)]
+    folders = sorted(p for p in (Path(results) / "artifacts" / "levels").glob("*") if p.is_dir())
+    if not folders:
+        raise ValueError(f"levels='all': {results} holds no per-level fields (artifacts/levels/ "
+                         "is written by runs of this version; rerun, or export levels='last')")
     written = []
-    for path in artifacts:
-        data = load_artifact(path)
-        if data is None or "stress" not in data:  # written by a version without fields
-            continue
-        for suffix, mesh in (("", body_mesh(data)), ("-contact", contact_mesh(data))):
-            target = out / f"{path.stem}{suffix}{FORMATS[fmt]}"
-            meshio.write(target, mesh)
-            written.append(target)
+    for folder in folders:
+        parts = {"": [], "-contact": []}
+        for path in sorted(folder.glob("level-*.npz")):
+            files = _write_level(path, out / folder.name / path.stem, fmt)
+            level = int(path.stem.split("-")[1])
+            for suffix, file in zip(parts, files, strict=False):
+                parts[suffix].append((level, file))
+            written += files
+        series = write_pvd if fmt == "vtu" else write_xdmf_collection
+        written += [series(out / f"{folder.name}{suffix}.{'pvd' if fmt == 'vtu' else 'xdmf'}",
+                           entries) for suffix, entries in parts.items() if entries]
+    return written
+
+
+def _write_level(path: Path, stem: Path, fmt: str) -> list[Path]:
+    """The body and the contact boundary of one artifact, as ``stem{ext}`` and
+    ``stem-contact{ext}`` ([] for an artifact of a version without fields)."""
+    import meshio
+
+    data = load_artifact(path)
+    if data is None or "stress" not in data:
+        return []
+    stem.parent.mkdir(parents=True, exist_ok=True)
+    written = []
+    for suffix, mesh in (("", body_mesh(data)), ("-contact", contact_mesh(data))):
+        target = stem.parent / f"{stem.name}{suffix}{FORMATS[fmt]}"
+        meshio.write(target, mesh)
+        written.append(target)
     return written

@@ -1,5 +1,7 @@
-"""Per-combination artifacts of the last level (mesh, displacement, stress, contact pressure),
-stored next to the results so that reports can draw meshes and fields without recomputing."""
+"""Per-combination artifacts (mesh, displacement, stress, contact pressure): the last level in
+``artifacts/<combination>.npz``, every level in ``artifacts/levels/<combination>/level-NNN.npz``,
+stored next to the results so that reports and ``export`` draw meshes and fields without
+recomputing."""
 
 from __future__ import annotations
 
@@ -29,7 +31,12 @@ def artifact_path(out: str | Path, row) -> Path:
     return Path(out) / "artifacts" / f"{file_stem(*(getattr(row, k) for k in KEYS))}.npz"
 
 
-def save_artifact(out: str | Path, result, scene=None) -> Path | None:
+def level_artifact_path(out: str | Path, row) -> Path:
+    return (Path(out) / "artifacts" / "levels" / file_stem(*(getattr(row, k) for k in KEYS))
+            / f"level-{row.level:03d}.npz")
+
+
+def save_artifact(out: str | Path, result, scene=None, path: Path | None = None) -> Path | None:
     """Write the last level of a sequence (``bench.sequence.loop.LevelResult``); None if it has no
     solution. Fields per element: the centroid stress (s11, s22, s12), von Mises, the
     estimator's squared indicators and, where ``scene`` has an exact solution, the squared
@@ -47,7 +54,7 @@ def save_artifact(out: str | Path, result, scene=None) -> Path | None:
     ends = sol.pressure(np.array([0.0, 1.0]))  # (n_facets, 2)
     gap = (np.asarray(scene.gap(mesh.p[:, sol.trace.vertices].reshape(2, -1)), dtype=float)
            .reshape(2, -1) if scene is not None else np.full(sol.trace.vertices.shape, np.nan))
-    path = artifact_path(out, result.row)
+    path = artifact_path(out, result.row) if path is None else path
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_suffix(".tmp.npz")
     np.savez_compressed(

@@ -7,7 +7,7 @@ import traceback
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from bench.matrix.artifacts import save_artifact
+from bench.matrix.artifacts import level_artifact_path, save_artifact
 from bench.matrix.spec import SequenceSpec, build_scene, check_formulation_options
 from bench.sequence.loop import LevelResult, run_sequence
 from bench.sequence.rows import ResultRow, identity_columns
@@ -66,7 +66,8 @@ def drain(sequence, record: Callable[[LevelResult], None]) -> tuple[str, LevelRe
 def run_spec(spec: SequenceSpec, run: dict, out, truth_of: Callable[[Scene], object],
              record: Callable[[LevelResult], None], max_memory_gib: float | None = None) -> str:
     """Run ``spec`` (``run``: the run's identity columns; ``truth_of(scene)``: its truth);
-    every level goes to ``record``; the last solved level is saved as an artifact. An
+    every level goes to ``record`` and its fields to a level artifact; the last solved level
+    is also saved as the combination's artifact. An
     impossible combination is one ``skipped`` row, an exception one ``failed`` row (level -1)
     with its type and message. Returns why the sequence ended."""
     names = sequence_identity(spec, run)
@@ -78,11 +79,16 @@ def run_spec(spec: SequenceSpec, run: dict, out, truth_of: Callable[[Scene], obj
         if reason is not None:
             record(whole_sequence_row(names, STATUS_SKIPPED, reason))
             return STATUS_SKIPPED  # also its end reason
+        def record_level(result: LevelResult) -> None:
+            record(result)
+            if result.solution is not None:
+                save_artifact(out, result, scene, level_artifact_path(out, result.row))
+
         end, last = drain(run_sequence(
             scene, spec.formulation, spec.solver, spec.estimator,
             spec.loop_config(max_memory_gib), run_columns(spec, run),
             truth=truth_of(scene), crosscheck_dofs=spec.crosscheck_dofs,
-            formulation_options=dict(spec.formulation_options)), record)
+            formulation_options=dict(spec.formulation_options)), record_level)
         if last is not None:
             save_artifact(out, last, scene)
         return end

@@ -72,3 +72,37 @@ def test_the_console_command_runs_the_same_commands():
                            "print([e.value for e in entry_points(group='console_scripts')"
                            " if e.name == 'signorini-bench'])"], capture_output=True, text=True)
     assert "bench.cli:main" in done.stdout, done.stdout + done.stderr
+
+
+@pytest.mark.parametrize("fmt", ["vtu", "xdmf"])
+def test_every_level_is_written_and_collected_in_one_series(results, tmp_path, fmt):
+    import xml.etree.ElementTree as ET
+
+    assert main(["export", "--results", str(results), "--format", fmt, "--levels", "all",
+                 "--out", str(tmp_path)]) == 0
+    stem = "free-boundary-mixed-active-set-residual-uniform-1"
+    sequence = list(run_sequence(get_scene("free-boundary"), "mixed", "active-set", "residual",
+                                 LoopConfig(strategy="uniform", max_dofs=600)))
+    files = sorted((tmp_path / stem).glob(f"level-*[0-9].{fmt}"))
+    assert len(files) == len(sequence) >= 3
+    for file, level in zip(files, sequence, strict=True):
+        mesh = level.solution.elasticity.mesh
+        body = meshio.read(file)
+        assert body.points.shape[0] == mesh.p.shape[1]  # each level its own mesh
+        u = level.solution.elasticity.nodal(level.solution.u).T
+        # the same deterministic solve, written as float64: round-off of the solve
+        assert np.allclose(body.point_data["displacement"][:, :2], u, rtol=1e-10,
+                           atol=1e-12 * np.abs(u).max())
+    series = tmp_path / f"{stem}.{'pvd' if fmt == 'vtu' else 'xdmf'}"
+    root = ET.parse(series).getroot()
+    if fmt == "vtu":
+        entries = root.findall("Collection/DataSet")
+        assert [e.get("timestep") for e in entries] == [str(k) for k in range(len(files))]
+        assert all((tmp_path / e.get("file")).is_file() for e in entries)
+    else:
+        grids = root.findall("Domain/Grid/Grid")
+        assert [g.find("Time").get("Value") for g in grids] == [str(k)
+                                                                for k in range(len(files))]
+        for item in root.iter("DataItem"):  # every heavy-data path resolves from the series
+            assert (tmp_path / item.text.strip().split(":")[0]).is_file()
+    assert (tmp_path / f"{stem}-contact{series.suffix}").is_file()
