@@ -1,4 +1,6 @@
-"""Provenance columns: commit, package versions, machine."""
+"""Provenance: the columns of every row (commit, package versions, machine) and the numerical
+stack of a run (``numerics``: versions and thread settings, recorded in run.json and the
+report's appendix)."""
 
 from __future__ import annotations
 
@@ -10,6 +12,28 @@ from importlib import metadata
 from pathlib import Path
 
 PACKAGES = ("numpy", "scipy", "scikit-fem", "cvxpy", "clarabel", "pandas")
+NUMERICAL_STACK = ("numpy", "scipy", "scikit-fem", "mkl", "pypardiso", "scikit-sparse",
+                   "clarabel", "cvxpy", "meshio")
+THREAD_VARIABLES = ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS")
+
+
+def _version(name: str) -> str:
+    try:
+        return metadata.version(name)
+    except metadata.PackageNotFoundError:
+        return "missing"
+
+
+def numerics() -> dict[str, str]:
+    """The versions of the numerical stack (MKL and PARDISO's wrapper included) and the thread
+    settings a run used: results must not depend on them, but times do."""
+    import numpy as np
+
+    blas = np.show_config(mode="dicts").get("Build Dependencies", {}).get("blas", {})
+    return {"numerical stack": " ".join(f"{n}={_version(n)}" for n in NUMERICAL_STACK),
+            "threads": " ".join(f"{v}={os.environ.get(v, 'unset')}" for v in THREAD_VARIABLES)
+            + f" cores={os.cpu_count() or '?'}",
+            "numpy BLAS": f"{blas.get('name', '?')} {blas.get('version', '')}".strip()}
 
 
 @functools.cache
@@ -23,12 +47,7 @@ def provenance() -> dict[str, str]:
         commit = (commit + ("+dirty" if dirty.strip() else "")) if commit else "unknown"
     except (OSError, subprocess.SubprocessError):
         commit = "unknown"
-    versions = []
-    for name in PACKAGES:
-        try:
-            versions.append(f"{name}={metadata.version(name)}")
-        except metadata.PackageNotFoundError:
-            versions.append(f"{name}=missing")
+    versions = [f"{name}={_version(name)}" for name in PACKAGES]
     cores = os.cpu_count() or "?"
     return {
         "commit": commit,

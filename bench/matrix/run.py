@@ -19,6 +19,7 @@ import pandas as pd
 from bench.matrix.distributed import SchedulerError, check_scheduler, scheduler_endpoint
 from bench.matrix.harness import new_run_identity, run_specs, truth_name, write_truth_summary
 from bench.matrix.plugins import load_plugins
+from bench.matrix.provenance import numerics
 from bench.matrix.rates import write_rates
 from bench.matrix.scene_files import load_scene_files, source_digest
 from bench.matrix.spec import (
@@ -210,7 +211,8 @@ def run(config: RunConfig, on_level: Callable[[LevelResult], None] | None = None
     truths = prepare_truths(specs, store.out, config.reference_crosscheck)
     (store.out / "run.json").write_text(json.dumps(
         {"command": config.command, "configuration": config.record(),
-         "run_id": identity["run_id"], "reused": list(reused)}, indent=1, default=str))
+         "run_id": identity["run_id"], "reused": list(reused), "numerics": numerics()},
+        indent=1, default=str))
     if config.workers or config.scheduler:
         from bench.matrix.distributed import run_on_dask
 

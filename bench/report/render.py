@@ -10,13 +10,15 @@ from pathlib import Path
 import jinja2
 import pandas as pd
 
-from bench.hard import LOSS_TOLERANCE, PRESSURE_TOLERANCE, hard_display
+from bench.hard import LOSS_TOLERANCE, PRESSURE_TOLERANCE, check_expected, hard_display
 from bench.matrix.rates import RATE_LEVELS, judged_levels, rates_table
 from bench.report import figures, hard_figures
 from bench.report.estimator_figures import ESTIMATOR_CAPTION, estimator_effectivity
 from bench.report.hard_figures import NITSCHE_CAPTION
+from bench.report.interactive import plotly_js
 from bench.report.orders import order_section
 from bench.report.sections import Figures, scene_section
+from bench.report.summary import first_screen
 from bench.report.tables import (
     accuracy_table,
     agreement_table,
@@ -27,6 +29,7 @@ from bench.report.tables import (
     timing_table,
 )
 from bench.sequence.rows import COLUMNS, INTERRUPTED, KEYS, with_labels
+from bench.verify import load_expected
 
 TEMPLATES = Path(__file__).with_name("templates")
 HARD_CAPTION = ("Hard cases: the mixed method's inf-sup constant beta_h against ndofs for "
@@ -105,6 +108,7 @@ def write_report(table: pd.DataFrame, out: str | Path, results: str | Path | Non
     figs = Figures(out)
     hard, hard_figures = _hard_section(results, figs)
     head = everything.iloc[0] if len(everything) else pd.Series(dtype=object)
+    tables = _tables(everything, rows, hard)
     return _render({
         "command": command or run_info.get("command", "(not recorded)"),
         "configuration": run_info.get("configuration", {}),
@@ -114,7 +118,11 @@ def write_report(table: pd.DataFrame, out: str | Path, results: str | Path | Non
         "pressure_tolerance": PRESSURE_TOLERANCE, "missing_columns": missing,
         "scenes": [scene_section(name, group, results, figs, truth)
                    for name, group in rows.groupby("scene", sort=True)],
-        "tables": _tables(everything, rows, hard),
+        "tables": tables,
+        "summary": first_screen(everything, rows, tables["rates"]),
+        "hard_verdicts": hard_verdicts(results),
+        "numerics": run_info.get("numerics", {}),
+        "plotly_js": plotly_js(),
         "estimator_figure": figs.add(estimator_effectivity(judged_levels(rows))
                                      if len(rows) else None, "estimators", ESTIMATOR_CAPTION),
         "orders": order_section(rows, figs),
@@ -123,6 +131,17 @@ def write_report(table: pd.DataFrame, out: str | Path, results: str | Path | Non
                                                         .fillna(False).astype(bool).sum()),
         **_provenance_of_rows(everything, run_info),
     }, out)
+
+
+def hard_verdicts(results: Path | None) -> str:
+    """'k of n hard verdicts as expected' and the unexpected ones ('' when not run)."""
+    if results is None or not (results / "hard.csv").exists():
+        return ""
+    checks = check_expected(pd.read_csv(results / "hard.csv"), load_expected().get("hard", []))
+    wrong = [f"{c['case']}/{c['formulation']}/{c['solver']}/{c['variant']}: {c['verdict']}, "
+             f"expected {c['expected']}" for c in checks if not c["passed"]]
+    return (f"{len(checks) - len(wrong)} of {len(checks)} hard verdicts as expected"
+            + (f"; unexpected: {'; '.join(wrong)}" if wrong else ""))
 
 
 def _provenance_of_rows(everything: pd.DataFrame, run_info: dict) -> dict:

@@ -11,6 +11,7 @@ import pandas as pd
 
 from bench.matrix.artifacts import artifact_path, file_stem, load_artifact
 from bench.report import figures
+from bench.report.interactive import interactive_figures
 from bench.sequence.rows import KEYS
 from scenes import get_scene
 
@@ -23,7 +24,8 @@ class Figures:
         self.out.mkdir(parents=True, exist_ok=True)
         self.items: list[dict] = []
 
-    def add(self, figure, name: str, caption: str) -> dict | None:
+    def add(self, figure, name: str, caption: str, interactive: str | None = None) -> dict | None:
+        """``interactive``: an HTML fragment the HTML report shows instead of the PNG."""
         if figure is None:
             return None
         buffer = io.BytesIO()
@@ -31,7 +33,7 @@ class Figures:
         data = buffer.getvalue()
         (self.out / f"{name}.png").write_bytes(data)
         item = {"file": f"figures/{name}.png", "caption": caption,
-                "data": base64.b64encode(data).decode("ascii")}
+                "data": base64.b64encode(data).decode("ascii"), "html": interactive}
         self.items.append(item)
         return item
 
@@ -82,6 +84,7 @@ def scene_section(name: str, group: pd.DataFrame, results: Path | None, figs: Fi
     artifacts = _artifacts(results, group)
     section = {"name": name, "truth": truth.get(name, {"kind": "unknown"}), "figures": []}
     preferred = _first_adaptive(artifacts)
+    live = interactive_figures(group, name)
     for figure, suffix, caption in (
             (figures.scene_picture(scene) if scene is not None else None, "scene",
              "Geometry (initial mesh), boundary parts and the obstacle."),
@@ -103,7 +106,7 @@ def scene_section(name: str, group: pd.DataFrame, results: Path | None, figs: Fi
             (figures.pressures(artifacts, _pressure_curve(scene, artifacts)), "pressure",
              "Contact pressure lambda_h along Gamma_C (adaptive, last level) per formulation; "
              "dotted lines are the contact-zone end points.")):
-        item = figs.add(figure, file_stem(name, suffix), caption)
+        item = figs.add(figure, file_stem(name, suffix), caption, live.get(suffix))
         if item is not None:
             section["figures"].append(item)
     if scene is None:

@@ -11,21 +11,19 @@ import pandas as pd
 import pytest
 
 from bench.hard import run_hard, write_hard
-from bench.matrix.harness import run_matrix
-from bench.matrix.store import ResultStore
+from bench.matrix import RunConfig, run
 from bench.report import write_report
-from bench.sequence.loop import LoopConfig
 from formulations import formulation_names, solver_names
 
-SECTIONS = ["contents", "what-was-run", "scenes", "results-per-scene", "summary-across-scenes",
-            "failures-and-skips", "hard-cases", "known-limitations"]
+SECTIONS = ["summary", "contents", "what-was-run", "scenes", "results-per-scene",
+            "summary-across-scenes", "failures-and-skips", "hard-cases", "known-limitations"]
 PNG = b"\x89PNG\r\n\x1a\n"
 
 
 class Collector(HTMLParser):
     def __init__(self):
         super().__init__()
-        self.ids, self.images, self.external = [], [], []
+        self.ids, self.images, self.external, self.interactive = [], [], [], []
 
     def handle_starttag(self, tag, attrs):
         attrs = dict(attrs)
@@ -33,17 +31,19 @@ class Collector(HTMLParser):
             self.ids.append(attrs["id"])
         if tag == "img":
             self.images.append(attrs.get("src", ""))
-        if tag in ("script", "link") or (tag == "img" and not attrs.get("src", "")
-                                         .startswith("data:")):
+        if (tag == "script" and "src" in attrs) or tag == "link" or (
+                tag == "img" and not attrs.get("src", "").startswith("data:")):
             self.external.append(tag)
+        if tag == "div" and "plotly-graph-div" in attrs.get("class", ""):
+            self.interactive.append(attrs["id"])
 
 
 @pytest.fixture(scope="module")
 def results(tmp_path_factory):
     out = tmp_path_factory.mktemp("results")
-    store = ResultStore(out)
-    run_matrix(["paper", "free-boundary"], ["mixed", "vi"], ["active-set"], ["residual"],
-               ["uniform", "adaptive"], store, LoopConfig(max_dofs=600), crosscheck_dofs=600)
+    run(RunConfig(scenes=("paper", "free-boundary"), formulations=("mixed", "vi"),
+                  solvers=("active-set",), strategies=("uniform", "adaptive"), max_dofs=600,
+                  crosscheck_dofs=600, out=str(out)))
     write_hard(run_hard(["no-contact", "penalty-eps", "invalid"]), out)
     return out
 
@@ -60,11 +60,16 @@ def test_html_is_self_contained_with_every_section_and_figure(report):
     parser = Collector()
     parser.feed(html)
     assert [s for s in SECTIONS if s not in parser.ids] == []
-    assert parser.external == []  # no scripts, stylesheets or linked images
-    # 2 scenes x (scene, convergence, effectivity, work-precision, meshes, deformed, pressure),
-    # less the paper's effectivity: without --reference-dofs it has no error to divide by;
-    # plus the hard cases' figure and the estimators' effectivity across scenes
-    assert len(parser.images) == 15
+    assert parser.external == []  # no linked scripts, stylesheets or images
+    assert html.count("<script") >= 1 + len(parser.interactive)  # plotly inlined, then figures
+    # interactive: 2 scenes x (convergence, effectivity, work-precision), less the paper's
+    # effectivity: without --reference-dofs it has no error to divide by
+    assert sorted(parser.interactive) == [
+        "free-boundary-convergence", "free-boundary-effectivity", "free-boundary-work-precision",
+        "paper-convergence", "paper-work-precision"]
+    # PNG: 2 scenes x (scene, meshes, deformed, pressure), the hard cases' figure and the
+    # estimators' effectivity across scenes
+    assert len(parser.images) == 10
     for src in parser.images:
         assert src.startswith("data:image/png;base64,")
         data = base64.b64decode(src.split(",", 1)[1])
@@ -73,7 +78,8 @@ def test_html_is_self_contained_with_every_section_and_figure(report):
 
 def test_markdown_links_every_figure_file(report):
     text = (report / "README.md").read_text()
-    for title in ("## Contents", "## What was run", "## Scenes", "## Results per scene",
+    for title in ("## Summary", "## Contents", "## Appendix: what was run", "## Scenes",
+                  "## Results per scene",
                   "## Summary across scenes", "## Failures and skips", "## Hard cases",
                   "## Known limitations"):
         assert title in text
@@ -87,6 +93,12 @@ def test_markdown_links_every_figure_file(report):
     for name in figures:
         assert f"figures/{name}" in text
     assert "test command" in text and "agrees" in text  # rates verdicts against the claims
+    summary = text.split("## Summary", 1)[1].split("## Contents", 1)[0]
+    assert "| free-boundary | mixed/active-set/residual/" in summary or \
+        "| free-boundary | vi/active-set/residual/" in summary  # the fastest, with its time
+    assert "| paper " in summary and " s (" in summary and "slopes agree" in summary
+    assert text.index("## Summary") < text.index("## Appendix: what was run")
+    assert "numerical stack" in text and "threads" in text  # the appendix's versions
 
 
 def test_strings_from_results_are_escaped_and_missing_columns_reported(results, tmp_path):
@@ -96,7 +108,7 @@ def test_strings_from_results_are_escaped_and_missing_columns_reported(results, 
     table = table.drop(columns=["effectivity_index", "t_refine"])
     write_report(table, tmp_path, None)
     html = (tmp_path / "index.html").read_text()
-    assert "<script>" not in html
+    assert "<script>alert" not in html
     assert "&lt;script&gt;alert(&#39;x&#39;)&lt;/script&gt; &amp; co" in html
     assert "effectivity_index" in html and "t_refine" in html  # listed as missing
     assert "Missing columns" in (tmp_path / "README.md").read_text()
@@ -133,3 +145,45 @@ def test_html_renders_in_headless_chromium(report, tmp_path):
 
     pixels = imread(shot)
     assert pixels.shape[0] > 1000 and float(np.std(pixels[..., :3])) > 0.05  # not blank
+
+
+LAYOUT_PROBE = """<script>
+window.addEventListener('load', () => {
+  const summary = document.getElementById('summary').getBoundingClientRect();
+  const cut = [...document.querySelectorAll('table')].filter(
+    t => !t.parentElement.classList.contains('table-scroll')
+         && t.scrollWidth > t.parentElement.clientWidth).length;
+  document.body.setAttribute('data-layout', JSON.stringify({
+    summaryTop: summary.top, viewport: window.innerHeight, cut: cut,
+    pageOverflow: document.documentElement.scrollWidth - window.innerWidth,
+    rows: document.querySelectorAll('#summary tbody tr').length}));
+});
+</script>"""
+
+
+@pytest.mark.skipif(CHROMIUM is None, reason="Debian's chromium is not installed "
+                                             "(.ci/run installs it)")
+def test_first_screen_shows_the_summary_and_no_table_overflows(report, tmp_path):
+    import json
+    import re
+
+    probe = tmp_path / "probe.html"  # the report plus a measuring script (test side only)
+    probe.write_text((report / "index.html").read_text().replace("</body>",
+                                                                 LAYOUT_PROBE + "</body>"))
+    browser = [CHROMIUM, "--headless", "--no-sandbox", "--disable-gpu", "--no-first-run",
+               "--disable-background-networking", "--disable-component-update",
+               f"--user-data-dir={tmp_path / 'profile'}", "--window-size=1280,900",
+               "--virtual-time-budget=10000"]
+    dom = subprocess.run([*browser, "--dump-dom", probe.as_uri()], capture_output=True,
+                         text=True, timeout=120).stdout
+    layout = json.loads(re.search(r"data-layout=\"([^\"]*)\"", dom).group(1)
+                        .replace("&quot;", '"'))
+    assert 0 <= layout["summaryTop"] < layout["viewport"] / 2  # on the first screen
+    assert layout["rows"] == 2  # one row per scene
+    assert layout["cut"] == 0 and layout["pageOverflow"] <= 0  # wide tables scroll in a box
+    shot = tmp_path / "first-screen.png"
+    subprocess.run([*browser, f"--screenshot={shot}", (report / "index.html").as_uri()],
+                   capture_output=True, timeout=120)
+    from matplotlib.image import imread
+
+    assert float(np.std(imread(shot)[..., :3])) > 0.05  # the first screen is not blank
