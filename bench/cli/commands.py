@@ -44,7 +44,7 @@ from formulations.elasticity import order_descriptions
 from formulations.registry import FORMULATIONS
 from formulations.solvers.backends import check_backend
 from formulations.solvers.backends.base import REGISTRY as BACKENDS
-from formulations.solvers.registry import SOLVERS, SYSTEM_SOLVERS
+from formulations.solvers.registry import FAST_SOLVER, SOLVERS, SYSTEM_SOLVERS
 from scenes import scene_descriptions, scene_names
 from scenes.registry import BUILT_IN, SCENES
 
@@ -145,7 +145,7 @@ def compare_command(args) -> int:
     same folder, then the report."""
     config = configured(
         scenes=[n for n in scene_names() if n not in hard_scene_names()],
-        formulations=formulation_names(), solvers=("active-set",),
+        formulations=formulation_names(), solvers=(FAST_SOLVER,),
         estimators=estimator_names(), strategies=("uniform", "adaptive"),
         max_dofs=args.max_dofs, reference_dofs=args.reference_dofs,
         crosscheck_dofs=args.crosscheck_dofs, max_memory_gib=args.max_memory, out=args.out,

@@ -27,6 +27,7 @@ from estimators import estimator_names
 from formulations import formulation_names, solver_names
 from formulations.elasticity import ORDERS
 from formulations.solvers.backends import backend_names
+from formulations.solvers.registry import REFERENCE_SOLVER
 from scenes import scene_names
 
 
@@ -74,8 +75,10 @@ def _run_parser(sub) -> None:
                      default=["mixed"], help="formulation(s): "
                      f"{', '.join(formulation_names())} (default: mixed); options as for "
                      "--scene, e.g. mixed:h_over_H=0.5|0.25")
-    run.add_argument("--solver", type=name_list("solver", solver_names()), default=["reference"],
-                     help=f"solver(s): {', '.join(solver_names())} (default: reference)")
+    run.add_argument("--solver", type=name_list("solver", solver_names()),
+                     default=[REFERENCE_SOLVER],
+                     help=f"solver(s): {', '.join(solver_names())} "
+                          f"(default: {REFERENCE_SOLVER})")
     run.add_argument("--estimator", type=name_list("estimator", estimator_names()),
                      default=["residual"],
                      help=f"estimator(s): {', '.join(estimator_names())} (default: residual)")

@@ -5,12 +5,35 @@ and ``@hard_case(name, description)`` registers any other (one file in ``bench/h
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from dataclasses import dataclass
+
 from scenes import get_scene, scene_descriptions, scene_names
 from scenes.registry import Registry
 
 HARD_CASES = Registry("hard case")
 hard_case = HARD_CASES.register
 HARD_TAG = "hard"
+
+
+@dataclass(frozen=True)
+class CaseFigure:
+    """A hard case's own figure: ``draw(rows)`` gets the case's rows of the hard table and
+    returns a matplotlib Figure, or None when they hold nothing to draw."""
+
+    draw: Callable
+    caption: str
+
+
+CASE_FIGURES: dict[str, CaseFigure] = {}
+
+
+def case_figure(case: str, caption: str):
+    """Register ``draw`` as the figure of ``case`` (the report shows it with ``caption``)."""
+    def decorate(draw: Callable) -> Callable:
+        CASE_FIGURES[case] = CaseFigure(draw, caption)
+        return draw
+    return decorate
 
 
 def hard_scene_names() -> list[str]:

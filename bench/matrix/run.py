@@ -17,7 +17,7 @@ from dataclasses import dataclass, fields
 import pandas as pd
 
 from bench.matrix.distributed import SchedulerError, check_scheduler, scheduler_endpoint
-from bench.matrix.harness import new_run_identity, run_specs, truth_name, write_truth_summary
+from bench.matrix.local import new_run_identity, run_specs, truth_name, write_truth_summary
 from bench.matrix.plugins import load_plugins
 from bench.matrix.provenance import numerics
 from bench.matrix.rates import write_rates
@@ -30,13 +30,14 @@ from bench.matrix.spec import (
     parse_item,
 )
 from bench.matrix.store import ResultStore
-from bench.sequence.loop import STRATEGIES, LevelResult
+from bench.sequence.loop import STRATEGIES, LevelResult, LoopConfig
 from bench.sequence.rows import COLUMNS, ResultRow
 from bench.truth import truth_for
 from estimators import estimator_names, guaranteed_estimators
 from formulations import STATUS_FAILED, formulation_names, solver_names
 from formulations.elasticity import ORDERS, check_order
 from formulations.solvers.backends import check_backend
+from formulations.solvers.registry import REFERENCE_SOLVER
 from scenes import scene_names
 from scenes.base import is_integer
 
@@ -55,7 +56,7 @@ class RunConfig:
 
     scenes: tuple[str, ...] = ("paper",)
     formulations: tuple[str, ...] = ("mixed",)
-    solvers: tuple[str, ...] = ("reference",)
+    solvers: tuple[str, ...] = (REFERENCE_SOLVER,)
     estimators: tuple[str, ...] = ("residual",)
     strategies: tuple[str, ...] = ("adaptive",)
     orders: tuple[int, ...] = (1,)  # polynomial orders of the displacements, a matrix dimension
@@ -116,17 +117,23 @@ class RunConfig:
             raise ValueError(f"target_error={self.target_error!r} needs estimators whose eta is "
                              f"a guaranteed bound ({', '.join(guaranteed_estimators())}); "
                              f"{', '.join(unsafe)} bound the error only up to a constant")
-        self.specs()[0].loop_config(self.max_memory_gib)  # validates the loop's options
+        self.loop()  # validates the loop's options
 
     def specs(self) -> list[SequenceSpec]:
         return cross_product(
             [s for item in self.scenes for s in parse_item(item, "scenes")],
             [f for item in self.formulations for f in parse_item(item, "formulations")],
-            self.solvers, self.estimators, self.strategies, self.orders, max_dofs=self.max_dofs,
-            max_levels=self.max_levels, marking=self.marking, theta=self.theta,
-            nested=self.nested, backend=self.backend, reference_dofs=self.reference_dofs,
-            crosscheck_dofs=self.crosscheck_dofs, scene_source=source_digest(self.scene_files),
-            target_error=self.target_error)
+            self.solvers, self.estimators, self.strategies, self.orders, self.loop(),
+            reference_dofs=self.reference_dofs, crosscheck_dofs=self.crosscheck_dofs,
+            scene_source=source_digest(self.scene_files))
+
+    def loop(self) -> LoopConfig:
+        """The loop settings every sequence shares (LoopConfig validates them)."""
+        return LoopConfig(strategy=self.strategies[0], order=self.orders[0],
+                          max_dofs=self.max_dofs, max_levels=self.max_levels,
+                          marking=self.marking, theta=self.theta, nested=self.nested,
+                          target_error=self.target_error, max_memory_gib=self.max_memory_gib,
+                          solver_options={"backend": self.backend} if self.backend else {})
 
     def record(self) -> dict:
         """The configuration as written to run.json."""

@@ -9,7 +9,7 @@ import hashlib
 import inspect
 import itertools
 import json
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass, replace
 
 from bench.sequence.loop import LoopConfig
 from formulations import get_formulation
@@ -19,42 +19,49 @@ from scenes.registry import SCENES
 SPEC_VERSION = 3  # bump when the rows of an unchanged spec would change (3: P3 references)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class SequenceSpec:
+    """A sequence: what it combines (scene, formulation, solver, estimator, with their sweep
+    parameters), how its loop runs (``loop``: strategy, order, budgets, marking, back-end,
+    target error) and what its errors are measured against."""
+
     scene: str
     formulation: str
     solver: str
     estimator: str
-    strategy: str
-    order: int = 1
+    loop: LoopConfig
     scene_parameters: tuple[tuple[str, object], ...] = ()
     formulation_options: tuple[tuple[str, object], ...] = ()
-    max_dofs: int = 20000
-    max_levels: int = 40
-    marking: str = "doerfler"
-    theta: float = 0.5
-    nested: bool = True
-    backend: str | None = None
     reference_dofs: int | None = None
     crosscheck_dofs: int = 0
     scene_source: str = ""  # digest of the --scene-file files ('' without)
-    target_error: float | None = None  # --target-error (None without)
+
+    strategy = property(lambda self: self.loop.strategy)
+    order = property(lambda self: self.loop.order)
+    max_dofs = property(lambda self: self.loop.max_dofs)
+    backend = property(lambda self: self.loop.solver_options.get("backend"))
 
     @property
     def key(self) -> str:
-        fields = asdict(self)
-        for name in ("scene_source", "target_error"):  # keys without them stay as they were
-            if not fields[name]:
-                del fields[name]
+        """A hash of every field that determines the rows (the same flat fields, and so the
+        same keys, as before the loop settings moved into ``loop``)."""
+        loop = self.loop
+        fields = {"scene": self.scene, "formulation": self.formulation, "solver": self.solver,
+                  "estimator": self.estimator, "strategy": loop.strategy, "order": loop.order,
+                  "scene_parameters": self.scene_parameters,
+                  "formulation_options": self.formulation_options, "max_dofs": loop.max_dofs,
+                  "max_levels": loop.max_levels, "marking": loop.marking, "theta": loop.theta,
+                  "nested": loop.nested, "backend": self.backend,
+                  "reference_dofs": self.reference_dofs, "crosscheck_dofs": self.crosscheck_dofs}
+        if self.scene_source:  # keys without them stay as they were
+            fields["scene_source"] = self.scene_source
+        if loop.target_error:
+            fields["target_error"] = loop.target_error
         text = json.dumps({**fields, "version": SPEC_VERSION}, sort_keys=True, default=str)
         return hashlib.sha256(text.encode()).hexdigest()[:20]
 
     def loop_config(self, max_memory_gib: float | None = None) -> LoopConfig:
-        return LoopConfig(strategy=self.strategy, order=self.order, max_dofs=self.max_dofs,
-                          max_levels=self.max_levels, marking=self.marking, theta=self.theta,
-                          nested=self.nested, max_memory_gib=max_memory_gib,
-                          target_error=self.target_error,
-                          solver_options={"backend": self.backend} if self.backend else {})
+        return replace(self.loop, max_memory_gib=max_memory_gib)
 
     @property
     def labels(self) -> dict[str, str]:
@@ -63,12 +70,13 @@ class SequenceSpec:
                 "formulation_options": label(self.formulation_options)}
 
 
-def cross_product(scenes, formulations, solvers, estimators, strategies, orders=(1,),
+def cross_product(scenes, formulations, solvers, estimators, strategies, orders, loop: LoopConfig,
                   **settings) -> list[SequenceSpec]:
     """Every combination as a spec; ``scenes`` and ``formulations`` are (name, parameter
-    pairs) as ``parse_item`` gives them, ``settings`` the remaining fields."""
+    pairs) as ``parse_item`` gives them, ``loop`` the loop settings every spec shares (its
+    strategy and order replaced per spec), ``settings`` the remaining fields."""
     return [SequenceSpec(scene=scene, formulation=formulation, solver=solver,
-                         estimator=estimator, strategy=strategy, order=order,
+                         estimator=estimator, loop=replace(loop, strategy=strategy, order=order),
                          scene_parameters=tuple(sorted(parameters)),
                          formulation_options=tuple(sorted(options)), **settings)
             for (scene, parameters), (formulation, options), solver, estimator, strategy, order

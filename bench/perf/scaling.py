@@ -21,6 +21,7 @@ import numpy as np
 import pandas as pd
 
 from bench.perf.system_scaling import measure_systems, system_table, warm_up_systems
+from formulations.solvers.registry import FAST_SOLVER, REFERENCE_SOLVER
 
 # (initial_divisions, uniform refinements) of the paper scene for ~10^4, 10^5, 10^6 DOFs
 SIZES = {"1e4": (9, 3), "1e5": (14, 4), "1e6": (11, 6)}
@@ -79,7 +80,7 @@ def measure(size: str, backend: str | None = None, reference: bool = True,
     start = time.perf_counter()
     factorise(disc.qp.K, backend)(linear_rhs(disc.qp))
     row["t_linear_solve"] = time.perf_counter() - start
-    fast = solve(disc, "active-set", backend=backend)
+    fast = solve(disc, FAST_SOLVER, backend=backend)
     row.update(t_fast_solve=fast.solve_time, fast_iterations=fast.iterations,
                fast_status=fast.status, fast_max_residual=max(vars(fast.residuals).values()))
     row.update({phase_column(name): seconds for name, seconds in fast.diagnostics.phases})
@@ -93,7 +94,7 @@ def measure(size: str, backend: str | None = None, reference: bool = True,
     if reference:
         from bench.measure.difference import solution_difference
 
-        reference = solve(disc, "reference")
+        reference = solve(disc, REFERENCE_SOLVER)
         energy, pressure = solution_difference(disc, fast, reference)
         row.update(t_reference_solve=reference.solve_time,
                    reference_iterations=reference.iterations,

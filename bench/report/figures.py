@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import textwrap
 
-import matplotlib.ticker
 import numpy as np
 import pandas as pd
 from matplotlib.collections import LineCollection
@@ -258,41 +257,3 @@ def scene_picture(scene):
     ax.set_title(textwrap.fill(scene.description, 60), fontsize=8)
     fig.tight_layout()
     return fig
-
-
-def hard_stability(hard: pd.DataFrame, pressure_bar: float):
-    """The hard cases' numbers: the mixed method's inf-sup constant against ndofs per h/H, and
-    the penalty's penetration, conditioning and pressure loss against eps_0."""
-    ratio = hard[(hard["case"] == "mixed-h/H") & (hard["solver"] == "active-set")]
-    sweep = hard[hard["case"] == "penalty-eps"]
-    if ratio.empty and sweep.empty:
-        return None
-    fig = Figure(figsize=(13, 4))
-    axes = fig.subplots(1, 3)
-    for variant, group in ratio.groupby("variant", sort=False):
-        axes[0].loglog(group["ndofs"], group["inf_sup"], marker="o", label=variant)
-    axes[0].set(xlabel="ndofs", title="mixed: discrete inf-sup constant beta_h")
-    for axis in (axes[0].xaxis, axes[0].yaxis):
-        axis.set_minor_formatter(matplotlib.ticker.NullFormatter())
-    fast = sweep[sweep["solver"] == "active-set"]
-    eps = fast["variant"].str.split("=").str[1].astype(float)
-    axes[1].loglog(eps, fast["penetration"], marker="o", label="max penetration")
-    axes[1].loglog(eps, fast["condition_estimate"], marker="s", label="condition estimate")
-    axes[1].set(xlabel="eps_0", title="penalty (active-set): penetration, conditioning")
-    for solver, group in sweep.groupby("solver"):
-        values = group["pressure_loss"].clip(lower=1e-17)
-        axes[2].loglog(group["variant"].str.split("=").str[1].astype(float), values,
-                       marker="o", label=solver)
-    axes[2].axhline(pressure_bar, color="k", linewidth=0.7, linestyle="--",
-                    label="bar for 'accurate'")
-    axes[2].set(xlabel="eps_0", title="penalty: pressure loss")
-    for ax in axes:
-        ax.grid(True, which="both", alpha=0.3)
-        if ax.get_legend_handles_labels()[0]:
-            ax.legend(fontsize=7)
-        ax.title.set_fontsize(10)
-    for ax in axes[1:]:
-        ax.invert_xaxis()
-    fig.tight_layout()
-    return fig
-

@@ -11,10 +11,10 @@ import jinja2
 import pandas as pd
 
 from bench.hard import LOSS_TOLERANCE, PRESSURE_TOLERANCE, check_expected, hard_display
+from bench.hard.registry import CASE_FIGURES
+from bench.matrix.artifacts import file_stem
 from bench.matrix.rates import RATE_LEVELS, judged_levels, rates_table
-from bench.report import figures, hard_figures
 from bench.report.estimator_figures import ESTIMATOR_CAPTION, estimator_effectivity
-from bench.report.hard_figures import NITSCHE_CAPTION
 from bench.report.interactive import plotly_js
 from bench.report.orders import order_section
 from bench.report.sections import Figures, scene_section
@@ -32,10 +32,6 @@ from bench.sequence.rows import COLUMNS, INTERRUPTED, KEYS, with_labels
 from bench.verify import load_expected
 
 TEMPLATES = Path(__file__).with_name("templates")
-HARD_CAPTION = ("Hard cases: the mixed method's inf-sup constant beta_h against ndofs for "
-                "h/H = 1, 1/2, 1/4 (bounded below only for h/H <= 1/2); the penalty's "
-                "penetration and condition estimate against eps_0; and each solver's pressure "
-                "loss against eps_0, with the bar for 'accurate'.")
 
 
 def cut_short(table: pd.DataFrame) -> pd.Series:
@@ -65,9 +61,9 @@ def _hard_section(results: Path | None, figs: Figures) -> tuple[pd.DataFrame | N
     if results is None or not (results / "hard.csv").exists():
         return None, []
     raw = pd.read_csv(results / "hard.csv")
-    items = [figs.add(figures.hard_stability(raw, PRESSURE_TOLERANCE), "hard-stability",
-                      HARD_CAPTION),
-             figs.add(hard_figures.nitsche_parameters(raw), "hard-nitsche", NITSCHE_CAPTION)]
+    items = [figs.add(figure.draw(raw[raw["case"] == case]), file_stem("hard", case),
+                      figure.caption)
+             for case, figure in CASE_FIGURES.items() if (raw["case"] == case).any()]
     return hard_display(raw), [item for item in items if item is not None]
 
 

@@ -10,6 +10,7 @@ from bench.measure.difference import solution_difference
 from formulations import STATUS_FAILED, STATUS_SKIPPED, SolverDiagnostics, solve
 from formulations.diagnostics import inf_sup_constant, pressure_oscillation
 from formulations.discretisation import why_unsolvable
+from formulations.solvers.registry import REFERENCE_SOLVER
 
 
 def error_columns(truth, solution, estimate) -> dict:
@@ -49,10 +50,10 @@ def diagnostic_columns(disc, sol, inf_sup: bool, backend: str | None) -> dict:
 def crosscheck_columns(disc, sol) -> dict:
     """Solve the same discrete problem with the reference solver and compare: relative
     energy-norm difference of u_h and max pressure difference relative to max lambda_h."""
-    why = why_unsolvable(disc, "reference")
+    why = why_unsolvable(disc, REFERENCE_SOLVER)
     if why is not None:  # no form the reference can solve (a nonsymmetric Nitsche variant)
         return {"crosscheck_status": STATUS_SKIPPED}
-    reference = solve(disc, "reference")
+    reference = solve(disc, REFERENCE_SOLVER)
     out = {"crosscheck_status": reference.status}
     if reference.status == STATUS_FAILED:
         return out

@@ -28,6 +28,7 @@ from formulations.elasticity import (
     predict_uniform_free_dofs,
 )
 from formulations.solvers.backends import check_backend
+from formulations.solvers.registry import REFERENCE_SOLVER
 from scenes import Scene
 from scenes.base import is_integer, is_number
 
@@ -168,7 +169,7 @@ def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
                            eta_complementarity=est.eta_complementarity)
             if truth is not None:
                 numbers.update(error_columns(truth, sol, est))
-            if solver != "reference" and disc.ndofs <= crosscheck_dofs:
+            if solver != REFERENCE_SOLVER and disc.ndofs <= crosscheck_dofs:
                 numbers.update(crosscheck_columns(disc, sol))
         reached = (not failed and config.target_error is not None and est.guaranteed
                    and est.eta <= config.target_error)

@@ -26,6 +26,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from formulations.solvers.backends.base import REGISTRY as BACKENDS
+from formulations.solvers.registry import REFERENCE_SOLVER
 
 MARGIN = 0.1  # keep this fraction of the available memory (at least MIN_MARGIN_GIB) free
 MIN_MARGIN_GIB = 1.0
@@ -47,7 +48,7 @@ ORDER_FACTOR = {1: 1.0, 2: 1.4, 3: 1.7}  # per-DOF memory of P_p relative to P1 
 def memory_line(route_name: str) -> MemoryLine:
     """The measured line of a route (``reference`` or a back-end's name); the steepest measured
     line for a back-end without one (a bound, not a fit)."""
-    if route_name == "reference":
+    if route_name == REFERENCE_SOLVER:
         return REFERENCE
     lines = {name: MemoryLine(*BACKENDS.get(name).memory_gib) for name in BACKENDS.names()
              if BACKENDS.get(name).memory_gib is not None}
@@ -56,7 +57,7 @@ def memory_line(route_name: str) -> MemoryLine:
 
 
 def route(solver: str, backend: str) -> str:
-    return "reference" if solver == "reference" else backend
+    return REFERENCE_SOLVER if solver == REFERENCE_SOLVER else backend
 
 
 def predict_peak_gib(ndofs: int, solver: str, backend: str, order: int = 1) -> float:

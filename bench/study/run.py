@@ -17,6 +17,7 @@ from bench.study.report import write_study_report
 from bench.verify import load_expected
 from estimators import estimator_names
 from formulations import formulation_names
+from formulations.solvers.registry import FAST_SOLVER
 
 
 @dataclass(frozen=True)
@@ -40,7 +41,7 @@ class StudyConfig:
     def run_configs(self) -> list[RunConfig]:
         """Adaptive first (in parallel, about 5 GiB each at 1e6 DOFs), then uniform in this
         process (a 2.1e6-DOF level needs about 11 GiB, half of a 24 GiB machine)."""
-        common = dict(scenes=self.scenes, solvers=("active-set",),
+        common = dict(scenes=self.scenes, solvers=(FAST_SOLVER,),
                       estimators=tuple(estimator_names()), orders=self.orders,
                       reference_dofs=self.reference_dofs, reference_crosscheck=self.crosscheck,
                       out=self.out, command=self.command)

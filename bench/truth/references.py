@@ -33,6 +33,7 @@ from bench.measure.nonnested import energy_difference
 from bench.sequence.loop import LoopConfig, run_sequence
 from bench.truth.error_bar import error_bar
 from formulations import STATUS_OK, DiscreteSolution
+from formulations.solvers.registry import FAST_SOLVER
 
 ASSEMBLY_VERSION = 3  # 3: P_p references, error bar with a fitted rate
 
@@ -44,7 +45,7 @@ class Recipe:
     name: str
     formulation: str
     order: int
-    solver: str = "active-set"
+    solver: str = FAST_SOLVER
     estimator: str = "residual"
     marking: str = "doerfler"
     theta: float = 0.5

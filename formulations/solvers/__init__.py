@@ -2,6 +2,8 @@
 
 from formulations.solvers import active_set, reference, semismooth_newton  # noqa: F401
 from formulations.solvers.registry import (
+    FAST_SOLVER,
+    REFERENCE_SOLVER,
     get_solver,
     get_system_solver,
     register_solver,
@@ -10,5 +12,5 @@ from formulations.solvers.registry import (
     solver_names,
 )
 
-__all__ = ["get_solver", "get_system_solver", "register_solver", "register_system_solver",
-           "solver_descriptions", "solver_names"]
+__all__ = ["FAST_SOLVER", "REFERENCE_SOLVER", "get_solver", "get_system_solver",
+           "register_solver", "register_system_solver", "solver_descriptions", "solver_names"]

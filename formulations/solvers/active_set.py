@@ -46,7 +46,7 @@ from formulations.solvers.augmented import initial_active_set, solve_augmented
 from formulations.solvers.backends import check_backend, condenses, factorise_condensed
 from formulations.solvers.lcp import CYCLING_EXAMPLE, condition_1, least_index_pivoting, pdas
 from formulations.solvers.reference import solve_reference
-from formulations.solvers.registry import register_solver
+from formulations.solvers.registry import FAST_SOLVER, register_solver
 
 
 def _fallback(qp: ContactQP, why: str, diagnostics: SolverDiagnostics,
@@ -56,12 +56,12 @@ def _fallback(qp: ContactQP, why: str, diagnostics: SolverDiagnostics,
     reason = f"{why}; answered by the reference solver (safeguard)"
     if answer.reason:
         reason += f": {answer.reason}"
-    return replace(answer, solver="active-set", reason=reason,
+    return replace(answer, solver=FAST_SOLVER, reason=reason,
                    solve_time=time.perf_counter() - start,
                    diagnostics=replace(diagnostics, safeguard="reference fallback"))
 
 
-@register_solver("active-set", "primal-dual active set (semismooth Newton): condensed "
+@register_solver(FAST_SOLVER, "primal-dual active set (semismooth Newton): condensed "
                                "B K^-1 B' from one factorisation (pardiso, cholmod) or the "
                                "augmented saddle-point system (splu); nested iteration")
 def solve_active_set(qp: ContactQP, warm_start: np.ndarray | None = None,
@@ -80,7 +80,7 @@ def solve_active_set(qp: ContactQP, warm_start: np.ndarray | None = None,
             return _fallback(qp, f"plain active set failed ({reason})", diagnostics, start)
         return QPSolution(u=u, multipliers=lam, status=status, reason=reason,
                           iterations=iterations, solve_time=time.perf_counter() - start,
-                          solver="active-set", backend=backend, diagnostics=diagnostics)
+                          solver=FAST_SOLVER, backend=backend, diagnostics=diagnostics)
     factor = factorise_condensed(qp.K, np.unique(qp.B.indices), backend)
     clock = time.perf_counter()
     u0 = factor.solve(qp.F)
@@ -116,7 +116,7 @@ def solve_active_set(qp: ContactQP, warm_start: np.ndarray | None = None,
                           phases=tuple(phases))
     return QPSolution(u=u, multipliers=result.lam, status=STATUS_OK, reason=reason,
                       iterations=iterations, solve_time=time.perf_counter() - start,
-                      solver="active-set", backend=factor.backend, diagnostics=diagnostics)
+                      solver=FAST_SOLVER, backend=factor.backend, diagnostics=diagnostics)
 
 
 def cycling_qp() -> ContactQP:

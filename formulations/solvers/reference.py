@@ -18,7 +18,7 @@ import numpy as np
 from scipy import sparse
 
 from formulations.base import STATUS_FAILED, STATUS_INACCURATE, STATUS_OK, ContactQP, QPSolution
-from formulations.solvers.registry import register_solver
+from formulations.solvers.registry import REFERENCE_SOLVER, register_solver
 
 # Clarabel's defaults are 1e-8. Measured on the paper scene (2e3..3e4 DOFs) against the exact
 # active-set solution: tolerances 1e-9 leave relative differences of ~3e-7 (energy norm) and
@@ -28,7 +28,7 @@ CLARABEL_TOLERANCES = {"tol_gap_abs": 1e-10, "tol_gap_rel": 1e-10, "tol_feas": 1
                        "tol_ktratio": 1e-8}
 
 
-@register_solver("reference", "CVXPY + Clarabel interior point (the judge of correctness)")
+@register_solver(REFERENCE_SOLVER, "CVXPY + Clarabel interior point (the judge of correctness)")
 def solve_reference(qp: ContactQP, warm_start=None, backend=None,
                     **clarabel_options) -> QPSolution:
     """Solve ``qp`` with Clarabel; ``warm_start`` and ``backend`` are accepted for the common
@@ -52,13 +52,13 @@ def solve_reference(qp: ContactQP, warm_start=None, backend=None,
             problem.solve(solver=cp.CLARABEL, **settings)
     except cp.SolverError as error:
         return QPSolution(None, None, STATUS_FAILED, f"Clarabel failed: {error}", 0,
-                          time.perf_counter() - start, "reference", "clarabel")
+                          time.perf_counter() - start, REFERENCE_SOLVER, "clarabel")
     elapsed = time.perf_counter() - start
     stats = problem.solver_stats
     iterations = int(stats.num_iters or 0) if stats is not None else 0
     if problem.status not in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE) or u.value is None:
         return QPSolution(None, None, STATUS_FAILED, f"Clarabel status {problem.status!r}",
-                          iterations, elapsed, "reference", "clarabel")
+                          iterations, elapsed, REFERENCE_SOLVER, "clarabel")
     mu = np.asarray(constraint.dual_value if qp.m else np.zeros(0), dtype=float).ravel()
     status, reason = STATUS_OK, ""
     if problem.status == cp.OPTIMAL_INACCURATE:
@@ -67,4 +67,4 @@ def solve_reference(qp: ContactQP, warm_start=None, backend=None,
     return QPSolution(u=d * np.asarray(u.value, dtype=float),
                       multipliers=qp.objective_scale * d * mu / qp.row_scale,
                       status=status, reason=reason, iterations=iterations, solve_time=elapsed,
-                      solver="reference", backend="clarabel")
+                      solver=REFERENCE_SOLVER, backend="clarabel")

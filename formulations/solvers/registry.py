@@ -12,6 +12,11 @@ no method for what a formulation offers is a ``skipped`` combination (``why_unso
 
 from scenes.registry import Registry
 
+# the two roles the suite gives solvers: the judge of correctness, and the fast solver every
+# sequence, scaling run and hard case times (their names, used wherever a role is meant)
+REFERENCE_SOLVER = "reference"
+FAST_SOLVER = "active-set"
+
 SOLVERS = Registry("solver")
 SYSTEM_SOLVERS = Registry("solver")
 register_solver = SOLVERS.register

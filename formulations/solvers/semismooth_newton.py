@@ -38,7 +38,7 @@ from scipy.sparse.linalg import splu
 from formulations.base import STATUS_FAILED, STATUS_OK, QPSolution, SolverDiagnostics
 from formulations.semismooth import SemismoothSystem
 from formulations.solvers.backends import check_backend, condenses, factorise_condensed
-from formulations.solvers.registry import register_system_solver
+from formulations.solvers.registry import FAST_SOLVER, register_system_solver
 
 # relative nonlinear residual at which iterative refinement stops (one step reaches 1e-13 ..
 # 3e-12 from the ~1e-9 the partial factorisation leaves, measured to 5e5 DOFs)
@@ -205,7 +205,7 @@ def damped(problem: Linearised, x: np.ndarray, done: int, changes: tuple[int, ..
                         "damped Newton", condition)
 
 
-@register_system_solver("active-set", "semismooth Newton (primal-dual active set) on the "
+@register_system_solver(FAST_SOLVER, "semismooth Newton (primal-dual active set) on the "
                                       "contact values, condensed from one factorisation")
 def solve_semismooth(system: SemismoothSystem, warm_start: np.ndarray | None = None,
                      max_iter: int = 50, backend: str | None = None) -> QPSolution:
@@ -242,7 +242,7 @@ def solve_semismooth(system: SemismoothSystem, warm_start: np.ndarray | None = N
                                     condition_estimate=result.condition, phases=tuple(phases))
     return QPSolution(u=u if ok else None, multipliers=system.pressure(u) if ok else None,
                       status=result.status, reason=result.reason, iterations=result.iterations,
-                      solve_time=time.perf_counter() - start, solver="active-set",
+                      solve_time=time.perf_counter() - start, solver=FAST_SOLVER,
                       backend=backend, diagnostics=diagnostics)
 
 

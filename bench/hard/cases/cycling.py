@@ -11,14 +11,15 @@ from formulations.solvers import get_solver
 from formulations.solvers.active_set import cycling_qp
 from formulations.solvers.backends import available_backends
 from formulations.solvers.lcp import CYCLING_EXAMPLE
+from formulations.solvers.registry import FAST_SOLVER, REFERENCE_SOLVER
 
 
 @hard_case("cycling", "a contact QP on which the plain active-set iteration cycles "
                       "(formulations.solvers.lcp.CYCLING_EXAMPLE): the safeguard answers")
 def cycling() -> list[dict]:
     qp, (_, _, start) = cycling_qp(), CYCLING_EXAMPLE
-    runs = [("active-set", backend, {"warm_start": start.astype(float), "backend": backend})
-            for backend in available_backends()] + [("reference", "clarabel", {})]
+    runs = [(FAST_SOLVER, backend, {"warm_start": start.astype(float), "backend": backend})
+            for backend in available_backends()] + [(REFERENCE_SOLVER, "clarabel", {})]
     records = []
     for solver, variant, options in runs:
         answer = get_solver(solver)(qp, **options)
@@ -35,5 +36,5 @@ def cycling() -> list[dict]:
             condition_estimate=diag.condition_estimate, verdict=verdict(status, loss),
             finding=(f"plain iteration cycled: {diag.cycled}; changes per "
                      f"iteration {','.join(map(str, diag.active_set_changes))}"
-                     if solver == "active-set" else "interior point: no active sets")))
+                     if solver == FAST_SOLVER else "interior point: no active sets")))
     return records

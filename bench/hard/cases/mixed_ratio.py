@@ -3,11 +3,14 @@ oscillation under refinement (docs/theory.md, section 8)."""
 
 from __future__ import annotations
 
+import matplotlib.ticker
 import numpy as np
 import pandas as pd
+from matplotlib.figure import Figure
 
-from bench.hard.registry import hard_case
+from bench.hard.registry import case_figure, hard_case
 from bench.hard.verdicts import solve_both
+from formulations.solvers.registry import FAST_SOLVER
 from scenes import get_scene
 
 
@@ -23,7 +26,7 @@ def mixed_ratio() -> list[dict]:
             records += rows
     frame = pd.DataFrame(records)
     for ratio in (1.0, 0.5, 0.25):
-        part = frame[(frame["variant"] == f"h/H={ratio:g}") & (frame["solver"] == "active-set")]
+        part = frame[(frame["variant"] == f"h/H={ratio:g}") & (frame["solver"] == FAST_SOLVER)]
         # h ~ ndofs^(-1/2): the slope of log beta against log h
         slope = -2 * np.polyfit(np.log(part["ndofs"]), np.log(part["inf_sup"]), 1)[0]
         text = (f"beta_h {part['inf_sup'].iloc[0]:.3g} -> {part['inf_sup'].iloc[-1]:.3g} "
@@ -32,3 +35,22 @@ def mixed_ratio() -> list[dict]:
             if record["variant"] == f"h/H={ratio:g}":
                 record["finding"] = text
     return records
+
+
+@case_figure("mixed-h/H", "The mixed method's discrete inf-sup constant beta_h against ndofs for "
+                          "h/H = 1, 1/2, 1/4: bounded below only for h/H <= 1/2.")
+def inf_sup_figure(rows: pd.DataFrame):
+    fast = rows[rows["solver"] == FAST_SOLVER]
+    if fast.empty:
+        return None
+    fig = Figure(figsize=(5.5, 4))
+    ax = fig.subplots()
+    for variant, group in fast.groupby("variant", sort=False):
+        ax.loglog(group["ndofs"], group["inf_sup"], marker="o", label=variant)
+    ax.set(xlabel="ndofs", title="mixed: discrete inf-sup constant beta_h")
+    for axis in (ax.xaxis, ax.yaxis):
+        axis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    return fig

@@ -6,12 +6,15 @@ the penetration, the pressure error and the energy error against the exact solut
 from __future__ import annotations
 
 import numpy as np
+import pandas as pd
+from matplotlib.figure import Figure
 
-from bench.hard.registry import hard_case
+from bench.hard.registry import case_figure, hard_case
 from bench.hard.verdicts import solve_both
 from bench.measure.contact import penetration
 from bench.truth.kinds import ExactTruth
 from formulations import STATUS_FAILED
+from formulations.solvers.registry import FAST_SOLVER
 from scenes import get_scene
 
 GAMMAS_0 = tuple(10.0 ** k for k in range(-4, 5))
@@ -44,3 +47,31 @@ def nitsche_sweep() -> list[dict]:
                                   f"{errors.pressure_error:.2e}, {sol.iterations} iterations")
             records += rows
     return records
+
+
+@case_figure("nitsche-gamma", "Nitsche's method on free-boundary (2112 DOFs) against gamma_0 for "
+                              "theta = 1, 0, -1 (semismooth Newton): penetration, energy error "
+                              "and pressure error against the exact solution; a missing point "
+                              "is a failed solve (the symmetric variant below its coercivity "
+                              "bound).")
+def nitsche_figure(rows: pd.DataFrame):
+    """Three panels against gamma_0, one line per theta."""
+    sweep = rows[rows["solver"] == FAST_SOLVER]
+    if sweep.empty or "gamma_0" not in sweep:
+        return None
+    fig = Figure(figsize=(13, 4))
+    axes = fig.subplots(1, 3)
+    for theta, group in sweep.groupby("theta", sort=False):
+        ok = group[group["verdict"] != "failed"]
+        for ax, column in zip(axes, ("penetration", "energy_error", "pressure_error"),
+                              strict=True):
+            ax.loglog(ok["gamma_0"], ok[column].clip(lower=1e-17), marker="o",
+                      label=f"theta = {theta:g}")
+    for ax, title in zip(axes, ("max penetration", "energy error (exact)",
+                                "pressure error (exact)"), strict=True):
+        ax.set(xlabel="gamma_0", title=f"nitsche: {title}")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=7)
+        ax.title.set_fontsize(10)
+    fig.tight_layout()
+    return fig

@@ -10,6 +10,7 @@ from bench.hard.verdicts import solve_both
 from bench.measure.contact import contact_zone
 from formulations import STATUS_FAILED, get_formulation, solve
 from formulations.registry import FORMULATIONS
+from formulations.solvers.registry import FAST_SOLVER
 from scenes import get_scene
 
 HARD_SCENE_LEVEL = 3  # refinements of each hard scene's initial mesh (544..4752 DOFs)
@@ -40,7 +41,7 @@ def scene_finding(row: dict, solution) -> str:
 def force_change(scene, formulation: str, fine: float) -> float:
     """Relative change of the contact force from one uniform level coarser."""
     coarse = solve(get_formulation(formulation)(scene, scene.mesh.refined(
-        HARD_SCENE_LEVEL - 1)), "active-set").contact_force()
+        HARD_SCENE_LEVEL - 1)), FAST_SOLVER).contact_force()
     return abs(fine - coarse) / max(abs(fine), abs(coarse)) if fine or coarse else 0.0
 
 

@@ -4,7 +4,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from bench.matrix.harness import run_matrix
+from bench.matrix import RunConfig, run
 from bench.matrix.store import ResultStore
 from bench.sequence.loop import LoopConfig, run_sequence
 from bench.sequence.rows import COLUMNS
@@ -65,12 +65,12 @@ def test_store_keeps_finished_rows_when_a_run_breaks(tmp_path, monkeypatch):
         return real(disc, solver, **options)
 
     monkeypatch.setattr(loop_module, "solve", flaky)
-    store = ResultStore(tmp_path / "out")
-    rows = run_matrix(["paper"], ["mixed"], ["reference"], ["residual"], ["uniform"], store,
-                      LoopConfig(max_dofs=5000))
+    out = tmp_path / "out"
+    rows = run(RunConfig(solvers=("reference",), strategies=("uniform",), max_dofs=5000,
+                         out=str(out))).rows
     assert [r.status for r in rows] == ["ok", "ok", "failed"]
     assert "simulated crash" in rows[-1].reason
-    for frame in (pd.read_parquet(store.parquet), pd.read_csv(store.csv)):
+    for frame in (pd.read_parquet(out / "results.parquet"), pd.read_csv(out / "results.csv")):
         assert list(frame["status"]) == ["ok", "ok", "failed"]
         assert set(REQUIRED) <= set(frame.columns)
 

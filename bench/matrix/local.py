@@ -1,5 +1,6 @@
-"""The matrix harness: every (scene, formulation, solver, estimator, strategy) sequence of a
-run, in this process (``run_specs``); ``bench.matrix.distributed`` runs the same specs on Dask."""
+"""A run's sequences in this process (``run_specs``), one after another; ``bench.matrix.
+distributed`` runs the same specs on Dask. ``bench.matrix.run`` is the one entry point to
+both."""
 
 from __future__ import annotations
 
@@ -10,10 +11,10 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from bench.matrix.provenance import provenance
-from bench.matrix.spec import SequenceSpec, cross_product
+from bench.matrix.spec import SequenceSpec
 from bench.matrix.store import ResultStore
 from bench.matrix.task import run_spec
-from bench.sequence.loop import LevelResult, LoopConfig
+from bench.sequence.loop import LevelResult
 from bench.sequence.rows import INTERRUPTED, ResultRow
 from bench.truth import truth_for
 
@@ -43,20 +44,6 @@ def write_truth_summary(out, name: str, truth) -> None:
     path.write_text(json.dumps(summary, indent=1, default=float))
 
 
-def specs_for(scenes: Sequence[str], formulations: Sequence[str], solvers: Sequence[str],
-              estimators: Sequence[str], strategies: Sequence[str], config: LoopConfig,
-              reference_dofs: int | None = None, crosscheck_dofs: int = 0,
-              scene_parameters: dict | None = None) -> list[SequenceSpec]:
-    """The cross product as specs (``config`` gives the loop settings)."""
-    parameters = tuple((scene_parameters or {}).items())
-    return cross_product([(s, parameters) for s in scenes], [(f, ()) for f in formulations],
-                         solvers, estimators, strategies, max_dofs=config.max_dofs,
-                         max_levels=config.max_levels, marking=config.marking,
-                         theta=config.theta, nested=config.nested,
-                         backend=config.solver_options.get("backend"),
-                         reference_dofs=reference_dofs, crosscheck_dofs=crosscheck_dofs)
-
-
 def run_specs(specs: Sequence[SequenceSpec], store: ResultStore, run: dict,
               on_level: Callable[[LevelResult], None] | None = None,
               truths: dict | None = None, max_memory_gib: float | None = None,
@@ -76,7 +63,7 @@ def run_specs(specs: Sequence[SequenceSpec], store: ResultStore, run: dict,
         name = truth_name(spec)
 
         def truth_of(scene, name=name, spec=spec):
-            if name not in truths:  # run() prepares them; run_matrix builds them here
+            if name not in truths:  # run() prepares them; built here when missing
                 truths[name] = truth_for(scene, spec.reference_dofs, spec.max_dofs,
                                          spec.order)
                 write_truth_summary(store.out, name, truths[name])
@@ -90,18 +77,3 @@ def run_specs(specs: Sequence[SequenceSpec], store: ResultStore, run: dict,
         if on_sequence is not None:
             on_sequence(spec, end)
     return rows
-
-
-def run_matrix(scenes: Sequence[str], formulations: Sequence[str], solvers: Sequence[str],
-               estimators: Sequence[str], strategies: Sequence[str], store: ResultStore,
-               config: LoopConfig, on_level: Callable[[LevelResult], None] | None = None,
-               scene_parameters: dict | None = None, reference_dofs: int | None = None,
-               crosscheck_dofs: int = 0) -> list[ResultRow]:
-    """Run the cross product in this process (see ``run_specs``): errors against each
-    scene's exact solution or an overkill reference of ``reference_dofs`` DOFs; levels with at
-    most ``crosscheck_dofs`` DOFs also solved by the reference solver; the last level of each
-    sequence saved as an artifact (``bench.matrix.artifacts``)."""
-    specs = specs_for(scenes, formulations, solvers, estimators, strategies, config,
-                      reference_dofs, crosscheck_dofs, scene_parameters)
-    return run_specs(specs, store, new_run_identity(), on_level,
-                     max_memory_gib=config.max_memory_gib)

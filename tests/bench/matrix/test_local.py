@@ -2,17 +2,17 @@
 
 import pytest
 
-from bench.matrix.harness import run_matrix
-from bench.matrix.store import ResultStore
-from bench.sequence.loop import LoopConfig
+from bench.matrix import RunConfig, run
 from estimators import estimator_names
 from estimators.base import ESTIMATORS, register_estimator
 from formulations import formulation_names
 
 
 def test_full_matrix_on_the_paper_scene_has_no_failed_rows(tmp_path):
-    rows = run_matrix(["paper"], formulation_names(), ["reference"], estimator_names(),
-                      ["uniform", "adaptive"], ResultStore(tmp_path), LoopConfig(max_dofs=2500))
+    rows = run(RunConfig(formulations=tuple(formulation_names()), solvers=("reference",),
+                         estimators=tuple(estimator_names()),
+                         strategies=("uniform", "adaptive"), max_dofs=2500,
+                         out=str(tmp_path))).rows
     combos = {(r.formulation, r.estimator, r.strategy) for r in rows}
     assert len(combos) == 2 * len(formulation_names()) * len(estimator_names())
     # a combination a registration declares impossible is one skipped row with its reason
@@ -45,9 +45,10 @@ def picky_estimator():
 
 
 def test_impossible_combination_becomes_one_skipped_row(tmp_path, picky_estimator):
-    store = ResultStore(tmp_path)
-    rows = run_matrix(["paper"], ["penalty", "mixed"], ["active-set"], [picky_estimator],
-                      ["uniform"], store, LoopConfig(max_dofs=200))
+    result = run(RunConfig(formulations=("penalty", "mixed"), solvers=("active-set",),
+                           estimators=(picky_estimator,), strategies=("uniform",),
+                           max_dofs=200, out=str(tmp_path)))
+    rows, store = result.rows, result.store
     skipped = [r for r in rows if r.status == "skipped"]
     assert len(skipped) == 1 and skipped[0].formulation == "penalty"
     assert skipped[0].reason == "needs a multiplier" and skipped[0].level == -1
