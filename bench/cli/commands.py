@@ -193,7 +193,7 @@ def export_command(args) -> int:
 
 
 def verify_command(args) -> int:
-    verdicts, _, closed_form = verify(args.out, on_level=progress)
+    verdicts, _, closed_form = verify(args.out, on_level=progress, workers=args.workers)
     print("\n" + closed_form.to_markdown(index=False, floatfmt=".4g") + "\n")
     print(verdict_table(verdicts))
     failed = [v for v in verdicts if not v.passed]

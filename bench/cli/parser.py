@@ -226,6 +226,9 @@ def _verify_parser(sub) -> None:
                             "fails.")
     verify.add_argument("--out", default="results-verify",
                         help="folder for the gate runs' results (default: results-verify)")
+    verify.add_argument("--workers", type=non_negative_int("workers"), default=0,
+                        help="run the gate sequences on a local Dask cluster of this many "
+                             "processes (default: 0, in this process)")
 
 
 def _hard_parser(sub) -> None:

@@ -5,6 +5,7 @@ folder (results.parquet, plus artifacts/, truth.json, run.json and hard.csv when
 from __future__ import annotations
 
 import json
+import sys
 from pathlib import Path
 
 import jinja2
@@ -14,6 +15,7 @@ from bench.hard import LOSS_TOLERANCE, PRESSURE_TOLERANCE, check_expected, hard_
 from bench.hard.registry import CASE_FIGURES
 from bench.matrix.artifacts import file_stem
 from bench.matrix.rates import RATE_LEVELS, judged_levels, rates_table
+from bench.matrix.scene_files import load_scene_files
 from bench.report.estimator_figures import ESTIMATOR_CAPTION, estimator_effectivity
 from bench.report.interactive import plotly_js
 from bench.report.orders import order_section
@@ -101,6 +103,7 @@ def write_report(table: pd.DataFrame, out: str | Path, results: str | Path | Non
     everything = latest_run(table) if len(table) else table
     rows = everything[everything["level"] >= 0]
     run_info, truth = _read_json(results, "run.json"), _read_json(results, "truth.json")
+    _load_scene_files(run_info)
     figs = Figures(out)
     hard, hard_figures = _hard_section(results, figs)
     head = everything.iloc[0] if len(everything) else pd.Series(dtype=object)
@@ -138,6 +141,16 @@ def hard_verdicts(results: Path | None) -> str:
              f"expected {c['expected']}" for c in checks if not c["passed"]]
     return (f"{len(checks) - len(wrong)} of {len(checks)} hard verdicts as expected"
             + (f"; unexpected: {'; '.join(wrong)}" if wrong else ""))
+
+
+def _load_scene_files(run_info: dict) -> None:
+    """The run's scene files, so that its scenes get their pictures; a file that is gone or no
+    longer loads only costs the picture (the section says so)."""
+    for file in run_info.get("configuration", {}).get("scene_files", []):
+        try:
+            load_scene_files([file])
+        except ValueError as error:
+            print(f"note: {error}; its scenes are drawn without a picture", file=sys.stderr)
 
 
 def _provenance_of_rows(everything: pd.DataFrame, run_info: dict) -> dict:

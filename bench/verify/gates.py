@@ -34,8 +34,10 @@ class Verdict:
     expected: str = ""  # a verdict gate's expected verdict (instead of a [low, high] band)
 
 
-def run_gate_matrices(expected: dict, out: str | Path, on_level=None) -> pd.DataFrame:
-    """The result rows of every ``[[run]]`` of expected.toml (stored together in ``out``)."""
+def run_gate_matrices(expected: dict, out: str | Path, on_level=None,
+                      workers: int = 0) -> pd.DataFrame:
+    """The result rows of every ``[[run]]`` of expected.toml (stored together in ``out``);
+    ``workers`` > 0 runs each on a local Dask cluster of that many processes."""
     tables = []
     for k, entry in enumerate(expected["run"]):
         config = RunConfig(scenes=(entry["scene"],), formulations=entry["formulations"],
@@ -43,7 +45,8 @@ def run_gate_matrices(expected: dict, out: str | Path, on_level=None) -> pd.Data
                            strategies=entry["strategies"], orders=entry.get("orders", (1,)),
                            max_dofs=entry["max_dofs"],
                            reference_dofs=entry.get("reference_dofs"), out=str(out),
-                           overwrite=k == 0, command="python -m bench verify")
+                           overwrite=k == 0, workers=workers,
+                           command="python -m bench verify")
         tables.append(run(config, on_level=on_level).table)
     return pd.concat(tables, ignore_index=True)
 
@@ -93,13 +96,14 @@ def hard_verdicts(expected: dict, hard: pd.DataFrame) -> list[Verdict]:
 
 
 def verify(out: str | Path = "results-verify", expected_path: str | Path = EXPECTED,
-           on_level=None, hard: bool = True, quick: bool = False,
+           on_level=None, hard: bool = True, quick: bool = False, workers: int = 0,
            ) -> tuple[list[Verdict], pd.DataFrame, pd.DataFrame]:
     """Every gate; with ``hard`` also the hard cases' verdicts (written to out/hard.csv);
     ``quick``: the reduced truth checks of ``[truth.quick]`` and no ``full`` gates. Returns
-    the verdicts, the rates table and the closed-form comparison."""
+    the verdicts, the rates table and the closed-form comparison (``workers``: as in
+    ``run_gate_matrices``; the results do not depend on it)."""
     expected = load_expected(expected_path)
-    rows = run_gate_matrices(expected, out, on_level)
+    rows = run_gate_matrices(expected, out, on_level, workers)
     rates = rates_table(rows)
     closed_form = closed_form_table(expected["closed_form"])
     truth = truth_table(expected["truth"], quick)

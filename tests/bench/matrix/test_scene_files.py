@@ -24,11 +24,15 @@ def test_the_example_scene_file_runs_from_the_command_line(tmp_path):
     assert record["scene_files"] == [str(EXAMPLE)]
 
 
-def test_a_scene_file_reaches_the_dask_workers(tmp_path):
-    result = run(RunConfig(scenes=("wide-block",), solvers=("active-set",),
+def test_python_and_toml_scene_files_reach_the_dask_workers(tmp_path):
+    toml = EXAMPLE.with_name("pressed_block.toml")
+    result = run(RunConfig(scenes=("wide-block", "pressed-block"), solvers=("active-set",),
                            strategies=("uniform",), max_dofs=600, workers=1,
-                           scene_files=(str(EXAMPLE),), out=str(tmp_path)))
-    assert len(result.rows) == 2 and all(r.status == "ok" for r in result.rows)  # 136, 528 DOFs
+                           scene_files=(str(EXAMPLE), str(toml)), out=str(tmp_path)))
+    assert all(r.status == "ok" for r in result.rows)
+    # free DOFs, 2 per node off the clamped top: wide-block 17 x 5 and 33 x 9 nodes less 17
+    # and 33, pressed-block 9 x 5 and 17 x 9 less 9 and 17
+    assert sorted(r.ndofs for r in result.rows) == [72, 136, 272, 528]
 
 
 def test_a_broken_scene_file_is_refused_in_one_line(tmp_path, capsys):

@@ -16,7 +16,9 @@ FULL = sorted(set(gate_names(load_expected())) - set(GATES))
 def verdicts(tmp_path_factory):
     # the hard cases' verdicts are asserted by tests/bench/test_hard.py; the truth's gates
     # run in their reduced version ([truth.quick]); the full ones in test_full_truth_gates
-    verdicts, _, _ = verify(tmp_path_factory.mktemp("verify"), hard=False, quick=True)
+    # on two worker processes (the CI machine's cores); the rows do not depend on it
+    verdicts, _, _ = verify(tmp_path_factory.mktemp("verify"), hard=False, quick=True,
+                            workers=2)
     return verdicts
 
 
