@@ -26,6 +26,7 @@ from skfem.helpers import dot
 from skfem.models.elasticity import linear_elasticity
 
 from formulations.load import body_load
+from formulations.p1_stiffness import p1_stiffness
 from scenes import Scene
 from scenes.base import is_integer
 
@@ -123,12 +124,11 @@ def assemble_elasticity(scene: Scene, mesh: MeshTri, order: int = 1) -> Elastici
     order = check_order(order)
     basis = Basis(mesh, vector_element(order))  # loads: scikit-fem's rule of order 2p
     lam, mu = scene.material.lame
-    if order == 1:  # P1 strains are constant per element: the centroid rule is exact, 3x cheaper
-        stiffness_basis = Basis(mesh, basis.elem,
-                                quadrature=(np.full((2, 1), 1.0 / 3.0), np.array([0.5])))
+    if order == 1:  # constant strains: the closed-form local matrices (formulations.p1_stiffness)
+        K = p1_stiffness(mesh, lam, mu, basis.element_dofs, basis.N)
     else:  # strain products have degree 2(p - 1): a rule of that order is exact
         stiffness_basis = Basis(mesh, basis.elem, intorder=2 * (order - 1))
-    K = asm(linear_elasticity(lam, mu), stiffness_basis).tocsr()
+        K = asm(linear_elasticity(lam, mu), stiffness_basis).tocsr()
     F = np.zeros(basis.N)
     if scene.body_force is not None:
         F += body_load(scene.body_force, basis)
@@ -140,8 +140,9 @@ def assemble_elasticity(scene: Scene, mesh: MeshTri, order: int = 1) -> Elastici
 
         F += asm(surface, FacetBasis(mesh, basis.elem, facets=neumann,
                                      intorder=max(4, 2 * order)))
-    clamped = basis.get_dofs(scene.dirichlet_facets(mesh)).all()
-    free = np.setdiff1d(np.arange(basis.N), clamped)
+    is_free = np.ones(basis.N, dtype=bool)  # a mask, not a sorted set difference: O(N)
+    is_free[basis.get_dofs(scene.dirichlet_facets(mesh)).all()] = False
+    free = np.flatnonzero(is_free)
     return Elasticity(mesh=mesh, basis=basis, lame=(lam, mu), K=K, F=F, free=free, order=order)
 
 

@@ -1,0 +1,34 @@
+"""The closed-form P1 stiffness equals scikit-fem's generic assembly of the same bilinear form
+(an independent implementation: quadrature on reference elements) to round-off."""
+
+import numpy as np
+import pytest
+from skfem import Basis, MeshTri, asm
+from skfem.models.elasticity import linear_elasticity
+
+from formulations.elasticity import vector_element
+from formulations.p1_stiffness import p1_stiffness
+from scenes import get_scene
+
+
+def meshes():
+    paper = get_scene("paper").mesh.refined(2)
+    graded = get_scene("graded").mesh  # aspect ratios up to ~130
+    clockwise = MeshTri(paper.p, paper.t[[0, 2, 1]])  # negative Jacobians
+    jittered = MeshTri(paper.p + 0.02 * np.random.default_rng(1).standard_normal(paper.p.shape)
+                       * (np.abs(paper.p) < 1), paper.t)  # interior nodes moved
+    return {"paper": paper, "graded": graded, "clockwise": clockwise, "jittered": jittered}
+
+
+@pytest.mark.parametrize("name", list(meshes()))
+@pytest.mark.parametrize("lam, mu", [(1.0, 0.5), (5.3e4, 2.6e4), (1e6, 1.0)])
+def test_closed_form_equals_scikit_fem(name, lam, mu):
+    mesh = meshes()[name]
+    basis = Basis(mesh, vector_element(1))
+    mine = p1_stiffness(mesh, lam, mu, basis.element_dofs, basis.N)
+    theirs = asm(linear_elasticity(lam, mu), Basis(mesh, basis.elem, intorder=0)).tocsr()
+    # a sum of a few products per entry, in another order: round-off of max |K| (1e-14)
+    assert abs(mine - theirs).max() <= 1e-14 * abs(theirs).max()
+    # symmetric local matrices; the sparse sum of an entry and of its mirror may add the
+    # same element contributions in another order: round-off only
+    assert mine.shape == theirs.shape and abs(mine - mine.T).max() <= 1e-15 * abs(mine).max()
