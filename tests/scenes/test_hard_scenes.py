@@ -87,12 +87,15 @@ def test_full_contact_activates_every_constraint(formulation):
 def test_young_modulus_scales_out(formulation, solver):
     # the paper scene is driven by the obstacle alone: u does not depend on E and the pressure
     # is proportional to it. Both solvers scale by E internally; measured <= 3.4e-14 for u and
-    # <= 4.7e-11 for the force (the penalty's force through the reference), so 1e-10 it is.
+    # <= 4.4e-11 for the force, except the penalty's force: the penetration over eps, so u's
+    # round-off is amplified by |u_n| / penetration (~1e4 at eps_0 = 1e-3), measured 8.6e-11
+    # (active set) and 1.4e-10 (reference); hence 1e-10, and 1e-9 for the penalty's force
     soft, stiff = (get_scene("paper", young_modulus=e) for e in (1.0, 70000.0))
     a, b = (solve(get_formulation(formulation)(s, s.mesh.refined(3)), solver)
             for s in (soft, stiff))
     assert np.abs(a.u - b.u).max() <= 1e-10 * np.abs(b.u).max()
-    assert 70000.0 * a.contact_force() == pytest.approx(b.contact_force(), rel=1e-10)
+    force_bound = 1e-9 if formulation == "penalty" else 1e-10
+    assert 70000.0 * a.contact_force() == pytest.approx(b.contact_force(), rel=force_bound)
 
 
 EPSILONS = [1e-1, 1e-2, 1e-4, 1e-6, 1e-8, 1e-10, 1e-12]

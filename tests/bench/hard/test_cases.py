@@ -104,8 +104,12 @@ def test_penalty_penetration_and_conditioning_scale_like_eps(hard):
 
 
 def test_young_modulus_scales_out_to_1e_10(hard):
-    # measured <= 5.7e-14 except the penalty through the reference (force, 4.7e-11)
-    assert (rows(hard, "scale")["scale_difference"] <= 1e-10).all()
+    # measured <= 2.4e-14 for mixed and vi, 4.4e-11 for nitsche; the penalty's force is the
+    # penetration over eps, so u's round-off is amplified by |u_n| / penetration (~1e4 at
+    # eps_0 = 1e-3): measured 8.6e-11 (active set) and 1.4e-10 (reference), hence 1e-9 there
+    scale = rows(hard, "scale")
+    bound = np.where(scale["formulation"] == "penalty", 1e-9, 1e-10)
+    assert (scale["scale_difference"] <= bound).all()
 
 
 @pytest.mark.parametrize("variant, message", [

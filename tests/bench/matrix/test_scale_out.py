@@ -29,9 +29,12 @@ def same_rows(a: pd.DataFrame, b: pd.DataFrame) -> None:
             "formulation_options", "level"]
     a, b = (t.sort_values(keys).reset_index(drop=True) for t in (a, b))
     assert a[keys].equals(b[keys])
+    # the Dask workers factorise with one thread, this process with the machine's: PARDISO's
+    # parallel factorisation rounds differently (measured up to 1.7e-12 relative in eta at
+    # 140 000 DOFs), so 1e-10, far below any effect of a lost or duplicated level
     for column in NUMBERS:
         np.testing.assert_allclose(a[column].astype(float), b[column].astype(float),
-                                   rtol=1e-12, atol=0)
+                                   rtol=1e-10, atol=0)
 
 
 def test_two_runs_into_one_folder_at_once_lose_nothing(tmp_path):
