@@ -26,12 +26,11 @@ from estimators.contact_terms import contact_terms
 from formulations import DiscreteSolution
 from formulations.elasticity import ELEMENTS, stress_from_gradient
 from formulations.evaluation import gradients_at_reference
+from formulations.p1_stiffness import barycentric_gradients
 
 
 def element_areas(mesh) -> np.ndarray:
-    p = mesh.p[:, mesh.t]
-    a, b = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
-    return 0.5 * np.abs(a[0] * b[1] - a[1] * b[0])
+    return barycentric_gradients(mesh)[1]
 
 
 def averaged_stress(solution: DiscreteSolution, scalar: Basis) -> np.ndarray:

@@ -18,8 +18,8 @@ from scipy import sparse
 from scipy.sparse.linalg import spsolve
 
 from estimators.averaging import element_areas
-from estimators.patch_data import hat_gradients
 from formulations.contact import gauss_legendre
+from formulations.p1_stiffness import barycentric_gradients
 
 SAMPLES = 33        # points per contact facet at which w is sampled for min_e w (ends included)
 QUADRATURE = 10     # Gauss points per contact facet for the kinked integrands
@@ -128,7 +128,8 @@ def _gap_minus_displacement(scene, solution, t: np.ndarray) -> np.ndarray:
 def _p1_energy(mesh, nodal: np.ndarray, lame: tuple[float, float]) -> np.ndarray:
     """a(d, d) per element for the P1 field with vertex values ``nodal`` (2, n_vertices)."""
     lam, mu = lame
-    grad = np.einsum("iae,ake->ike", nodal[:, mesh.t], hat_gradients(mesh))  # du_i/dx_k
+    gradients = barycentric_gradients(mesh)[0]
+    grad = np.einsum("iae,ake->ike", nodal[:, mesh.t], gradients)  # du_i/dx_k
     eps = 0.5 * (grad + grad.transpose(1, 0, 2))
     density = 2 * mu * (eps**2).sum(axis=(0, 1)) + lam * (eps[0, 0] + eps[1, 1]) ** 2
     return element_areas(mesh) * density

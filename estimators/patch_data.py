@@ -18,6 +18,7 @@ from estimators.averaging import element_areas
 from estimators.raviart_thomas import ElementTriRTk
 from formulations.elasticity import ELEMENTS
 from formulations.load import body_load
+from formulations.p1_stiffness import barycentric_gradients
 
 # scalar Lagrange triangles by degree (P0 for the multipliers of weak symmetry at k = 1)
 SCALARS = {0: ElementTriP0, **ELEMENTS, 4: ElementTriP4}
@@ -51,7 +52,7 @@ def interior_data(mesh, sigma_h, body_force, k: int, intorder: int) -> Interior:
     hats = np.array([np.asarray(b[0]) for b in Basis(mesh, ElementTriP1(),
                                                quadrature=rt.quadrature).basis])
     stress = sigma_h(rt)
-    rhs, data = patch_rhs(rt, dg, hats, stress, hat_gradients(mesh))
+    rhs, data = patch_rhs(rt, dg, hats, stress, barycentric_gradients(mesh)[0])
     if body_force is not None:
         data = data - load_moments(mesh, body_force, k)
     total = np.array([np.bincount(mesh.t.T.ravel(), data[:, :, r].sum(axis=-1).ravel(),
@@ -159,12 +160,3 @@ def skew_data(interior: Interior, data: np.ndarray, turning: np.ndarray,
                      for g in range(scalar.doflocs.shape[0])])
     return (rotation[mesh.t.T.ravel()] * share)[:, None] * mean[None, :]
 
-
-def hat_gradients(mesh) -> np.ndarray:
-    """Gradients of the three barycentric coordinates of every triangle, (3, 2, n_el)."""
-    p = mesh.p[:, mesh.t]                                    # (2, 3, n_el)
-    d1, d2 = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
-    det = d1[0] * d2[1] - d1[1] * d2[0]
-    g1 = np.array([d2[1], -d2[0]]) / det
-    g2 = np.array([-d1[1], d1[0]]) / det
-    return np.array([-g1 - g2, g1, g2])

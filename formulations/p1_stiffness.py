@@ -34,8 +34,9 @@ def element_stiffness(mesh: MeshTri, lam: float, mu: float) -> np.ndarray:
     """Local 6 x 6 matrices, shape (6, 6, n_elements)."""
     g, area = barycentric_gradients(mesh)
     gx, gy = g[:, 0], g[:, 1]  # (3, n)
-    xx, yy = gx[:, None] * gx[None], gy[:, None] * gy[None]  # outer products first: each
-    grad_dot = xx + yy  # g_i . g_j          # block is then exactly symmetric in (i, j)
+    # outer products first, so that each block is exactly symmetric in (i, j)
+    xx, yy = gx[:, None] * gx[None], gy[:, None] * gy[None]
+    grad_dot = xx + yy  # g_i . g_j
     blocks = np.empty((3, 2, 3, 2, area.size))
     blocks[:, 0, :, 0] = (lam + mu) * xx + mu * grad_dot
     blocks[:, 1, :, 1] = (lam + mu) * yy + mu * grad_dot

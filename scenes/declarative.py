@@ -6,6 +6,7 @@ scene; every error is one line naming the file, the key and what is allowed."""
 from __future__ import annotations
 
 import hashlib
+import inspect
 import tomllib
 from pathlib import Path
 
@@ -81,8 +82,8 @@ def _parameters(path: Path, table: dict) -> dict[str, float]:
     return {key: float(value) for key, value in table.items()}
 
 
-def _signature(defaults: dict[str, float]):
-    import inspect
+def _signature(defaults: dict[str, float]) -> inspect.Signature:
+    """The factory's keyword parameters, so that sweeps check names as for built-in scenes."""
     return inspect.Signature([inspect.Parameter(k, inspect.Parameter.KEYWORD_ONLY, default=v)
                               for k, v in defaults.items()])
 

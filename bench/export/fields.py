@@ -1,9 +1,8 @@
 """The fields of each combination's last level, or of every level as a series, written through
-meshio: the mesh with the
-displacement, the stress tensor, von Mises stress, the estimator's element indicators and,
-where a truth is exact, the element error density; and the contact boundary with lambda_h and
-the gap. Read from ``DIR/artifacts/*.npz`` (``bench.matrix.artifacts``): nothing is
-recomputed."""
+meshio: the mesh with the displacement, the stress tensor, von Mises stress, the estimator's
+element indicators and, where a truth is exact, the element error density; and the contact
+boundary with lambda_h and the gap. Read from ``DIR/artifacts/`` (``bench.matrix.artifacts``):
+nothing is recomputed."""
 
 from __future__ import annotations
 

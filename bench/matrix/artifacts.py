@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import os
 import re
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -36,10 +37,11 @@ def level_artifact_path(out: str | Path, row) -> Path:
             / f"level-{row.level:03d}.npz")
 
 
-def save_artifact(out: str | Path, result, scene=None, path: Path | None = None) -> Path | None:
-    """Write the last level of a sequence (``bench.sequence.loop.LevelResult``); None if it has no
-    solution. Fields per element: the centroid stress (s11, s22, s12), von Mises, the
-    estimator's squared indicators and, where ``scene`` has an exact solution, the squared
+def save_artifact(path: Path, result, scene=None) -> Path | None:
+    """Write a level of a sequence (``bench.sequence.loop.LevelResult``) to ``path`` (its
+    ``level_artifact_path``); None if it has no solution. Fields per element: the centroid
+    stress (s11, s22, s12), von Mises, the estimator's squared indicators and, where ``scene``
+    has an exact solution, the squared
     energy-norm error per element; on Gamma_C: the facets' vertices, lambda_h and the gap at
     the facet ends (the fields ``python -m bench export`` writes)."""
     sol = result.solution
@@ -54,7 +56,6 @@ def save_artifact(out: str | Path, result, scene=None, path: Path | None = None)
     ends = sol.pressure(np.array([0.0, 1.0]))  # (n_facets, 2)
     gap = (np.asarray(scene.gap(mesh.p[:, sol.trace.vertices].reshape(2, -1)), dtype=float)
            .reshape(2, -1) if scene is not None else np.full(sol.trace.vertices.shape, np.nan))
-    path = artifact_path(out, result.row) if path is None else path
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_suffix(".tmp.npz")
     np.savez_compressed(
@@ -67,6 +68,19 @@ def save_artifact(out: str | Path, result, scene=None, path: Path | None = None)
         ndofs=sol.elasticity.ndofs, level=result.row.level)
     os.replace(tmp, path)
     return path
+
+
+def publish_last_level(out: str | Path, row) -> Path | None:
+    """Copy the level artifact of ``row`` (the sequence's last solved level) to the
+    combination's artifact, atomically; None if that level wrote none."""
+    source, target = level_artifact_path(out, row), artifact_path(out, row)
+    if not source.exists():
+        return None
+    tmp = target.with_suffix(".tmp.npz")
+    target.parent.mkdir(parents=True, exist_ok=True)
+    shutil.copyfile(source, tmp)
+    os.replace(tmp, target)
+    return target
 
 
 def element_error_density(scene, sol, n_elements: int) -> np.ndarray:

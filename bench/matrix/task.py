@@ -7,7 +7,7 @@ import traceback
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from bench.matrix.artifacts import level_artifact_path, save_artifact
+from bench.matrix.artifacts import level_artifact_path, publish_last_level, save_artifact
 from bench.matrix.spec import SequenceSpec, build_scene, check_formulation_options
 from bench.sequence.loop import LevelResult, run_sequence
 from bench.sequence.rows import ResultRow, identity_columns
@@ -79,18 +79,19 @@ def run_spec(spec: SequenceSpec, run: dict, out, truth_of: Callable[[Scene], obj
         if reason is not None:
             record(whole_sequence_row(names, STATUS_SKIPPED, reason))
             return STATUS_SKIPPED  # also its end reason
+
         def record_level(result: LevelResult) -> None:
             record(result)
             if result.solution is not None:
-                save_artifact(out, result, scene, level_artifact_path(out, result.row))
+                save_artifact(level_artifact_path(out, result.row), result, scene)
 
         end, last = drain(run_sequence(
             scene, spec.formulation, spec.solver, spec.estimator,
             spec.loop_config(max_memory_gib), run_columns(spec, run),
             truth=truth_of(scene), crosscheck_dofs=spec.crosscheck_dofs,
             formulation_options=dict(spec.formulation_options)), record_level)
-        if last is not None:
-            save_artifact(out, last, scene)
+        if last is not None:  # its fields are already written: copied, not computed again
+            publish_last_level(out, last.row)
         return end
     except Exception as error:  # recorded, never silent: the row carries type and message
         record(whole_sequence_row(names, STATUS_FAILED, f"{type(error).__name__}: {error}"))

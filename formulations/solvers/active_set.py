@@ -62,8 +62,8 @@ def _fallback(qp: ContactQP, why: str, diagnostics: SolverDiagnostics,
 
 
 @register_solver(FAST_SOLVER, "primal-dual active set (semismooth Newton): condensed "
-                               "B K^-1 B' from one factorisation (pardiso, cholmod) or the "
-                               "augmented saddle-point system (splu); nested iteration")
+                              "B K^-1 B' from one factorisation (pardiso, cholmod) or the "
+                              "augmented saddle-point system (splu); nested iteration")
 def solve_active_set(qp: ContactQP, warm_start: np.ndarray | None = None,
                      max_iter: int = 100, backend: str | None = None) -> QPSolution:
     """``backend``: 'pardiso' or 'cholmod' (condensed iteration) or 'splu' (augmented
