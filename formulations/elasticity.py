@@ -7,6 +7,7 @@ Everything is vectorised over elements by scikit-fem's assembly.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -29,9 +30,11 @@ from formulations.load import body_load
 from formulations.p1_stiffness import p1_stiffness
 from scenes import Scene
 from scenes.base import is_integer
+from scenes.topology import ensure_topology
 
 ELEMENTS = {1: ElementTriP1, 2: ElementTriP2, 3: ElementTriP3}
 ORDERS = tuple(ELEMENTS)
+CENTROID_RULE = (np.full((2, 1), 1.0 / 3.0), np.array([0.5]))  # reference triangle, weight = area
 
 
 def order_descriptions() -> dict[str, str]:
@@ -70,8 +73,9 @@ class Elasticity:
         """Number of unknowns (free DOFs)."""
         return int(self.free.size)
 
-    @property
+    @functools.cached_property
     def K_free(self) -> sparse.csr_matrix:
+        """K on the free DOFs (built once)."""
         return self.K[self.free][:, self.free].tocsr()
 
     def expand(self, u_free: np.ndarray) -> np.ndarray:
@@ -90,11 +94,16 @@ class Elasticity:
         return u[self.basis.nodal_dofs]
 
     def element_stress(self, u: np.ndarray) -> np.ndarray:
-        """Stress (s11, s22, s12) per element at its centroid; shape (3, n_elements) (P1: the
-        constant stress of the element)."""
-        centroid = Basis(self.mesh, self.basis.elem,
-                         quadrature=(np.full((2, 1), 1.0 / 3.0), np.array([0.5])))
-        return stress_from_gradient(centroid.interpolate(u).grad[:, :, :, 0], *self.lame)
+        """Stress (s11, s22, s12) per element at its centroid (the basis's rule); shape
+        (3, n_elements) (P1: the constant stress of the element)."""
+        return stress_from_gradient(self.basis.interpolate(u).grad[:, :, :, 0], *self.lame)
+
+
+def dof_basis(mesh: MeshTri, order: int = 1) -> Basis:
+    """The displacement basis an ``Elasticity`` carries: its DOF numbering, element maps and
+    element, on the one-point centroid rule (nothing integrates with it: each integral builds
+    the basis of its own rule, and the quadrature data of a default basis cost more than K)."""
+    return Basis(mesh, vector_element(order), quadrature=CENTROID_RULE)
 
 
 def element_diameters(mesh: MeshTri) -> np.ndarray:
@@ -122,16 +131,17 @@ def assemble_elasticity(scene: Scene, mesh: MeshTri, order: int = 1) -> Elastici
     """Stiffness K, load F = (f, v) + (q, v)_{Gamma_N}, and the free DOFs for ``mesh`` with
     P_order displacements."""
     order = check_order(order)
-    basis = Basis(mesh, vector_element(order))  # loads: scikit-fem's rule of order 2p
+    ensure_topology(mesh)
+    basis = dof_basis(mesh, order)
     lam, mu = scene.material.lame
     if order == 1:  # constant strains: the closed-form local matrices (formulations.p1_stiffness)
-        K = p1_stiffness(mesh, lam, mu, basis.element_dofs, basis.N)
+        K = p1_stiffness(mesh, lam, mu)
     else:  # strain products have degree 2(p - 1): a rule of that order is exact
         stiffness_basis = Basis(mesh, basis.elem, intorder=2 * (order - 1))
         K = asm(linear_elasticity(lam, mu), stiffness_basis).tocsr()
     F = np.zeros(basis.N)
-    if scene.body_force is not None:
-        F += body_load(scene.body_force, basis)
+    if scene.body_force is not None:  # scikit-fem's default rule, of order 2p
+        F += body_load(scene.body_force, Basis(mesh, basis.elem))
     neumann = scene.neumann_facets(mesh)
     if scene.traction is not None and neumann.size:
         @LinearForm

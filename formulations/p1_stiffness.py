@@ -17,6 +17,8 @@ import numpy as np
 from scipy import sparse
 from skfem import MeshTri
 
+from scenes.topology import TRIANGLE_EDGES, ensure_topology
+
 
 def barycentric_gradients(mesh: MeshTri) -> tuple[np.ndarray, np.ndarray]:
     """The gradients g (3 vertices, 2 components, n_elements) and the areas (n_elements)."""
@@ -30,26 +32,72 @@ def barycentric_gradients(mesh: MeshTri) -> tuple[np.ndarray, np.ndarray]:
     return g, 0.5 * np.abs(det)
 
 
-def element_stiffness(mesh: MeshTri, lam: float, mu: float) -> np.ndarray:
-    """Local 6 x 6 matrices, shape (6, 6, n_elements)."""
+def local_block(g: np.ndarray, i: int, j: int, c: int, d: int, lam: float,
+                mu: float) -> np.ndarray:
+    """a(phi_j e_d, phi_i e_c) / A for every triangle: lam (g_i)_c (g_j)_d + mu (g_i)_d (g_j)_c
+    + mu delta_cd g_i . g_j. Swapping (i, c) and (j, d) only commutes the products, so the
+    local matrices are exactly symmetric."""
+    value = lam * (g[i, c] * g[j, d]) + mu * (g[i, d] * g[j, c])
+    if c == d:
+        value += mu * (g[i, 0] * g[j, 0] + g[i, 1] * g[j, 1])
+    return value
+
+
+def vertex_pattern(mesh: MeshTri) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The vertex graph of the mesh in CSR form (every vertex with itself and with the other
+    ends of its edges, columns sorted): (indptr, indices, source), where ``source`` gives, for
+    each entry, its place in [diagonal (n_vertices), edges a -> b (n_edges), edges b -> a]."""
+    nv, (a, b) = mesh.p.shape[1], ensure_topology(mesh).facets
+    rows = np.concatenate((np.arange(nv), a, b))
+    cols = np.concatenate((np.arange(nv), b, a))
+    # entry ids as data: one CSR conversion and an in-row sort carry them to their places
+    graph = sparse.csr_matrix((np.arange(1.0, rows.size + 1), (rows, cols)), shape=(nv, nv))
+    graph.sort_indices()
+    return graph.indptr, graph.indices, graph.data.astype(np.int64) - 1
+
+
+def block_values(mesh: MeshTri, lam: float, mu: float) -> np.ndarray:
+    """The 2 x 2 vertex blocks of K in ``vertex_pattern``'s source order, shape (2, 2, n):
+    each triangle's local blocks summed onto its vertices and its edges, one component at a
+    time (no array of all 36 local entries is ever held)."""
     g, area = barycentric_gradients(mesh)
-    gx, gy = g[:, 0], g[:, 1]  # (3, n)
-    # outer products first, so that each block is exactly symmetric in (i, j)
-    xx, yy = gx[:, None] * gx[None], gy[:, None] * gy[None]
-    grad_dot = xx + yy  # g_i . g_j
-    blocks = np.empty((3, 2, 3, 2, area.size))
-    blocks[:, 0, :, 0] = (lam + mu) * xx + mu * grad_dot
-    blocks[:, 1, :, 1] = (lam + mu) * yy + mu * grad_dot
-    xy = gx[:, None] * gy[None]
-    blocks[:, 0, :, 1] = lam * xy + mu * xy.transpose(1, 0, 2)
-    blocks[:, 1, :, 0] = blocks[:, 0, :, 1].transpose(1, 0, 2)  # K symmetric to the last bit
-    return blocks.reshape(6, 6, -1) * area
+    t, t2f, (a, _) = mesh.t, mesh.t2f, mesh.facets
+    nv, ne = mesh.p.shape[1], a.size
+    forward = [t[i] == a[t2f[k]] for k, (i, _) in enumerate(TRIANGLE_EDGES)]
+    blocks = np.empty((2, 2, nv + 2 * ne))
+    for c, d in ((0, 0), (0, 1), (1, 0), (1, 1)):
+        blocks[c, d, :nv] = sum(np.bincount(t[i], area * local_block(g, i, i, c, d, lam, mu),
+                                            nv) for i in range(3))
+        upper = np.zeros(ne)
+        for k, (i, j) in enumerate(TRIANGLE_EDGES):
+            # K_ab, a < b the edge's first vertex: the local (i, j) block or its transpose
+            value = np.where(forward[k], local_block(g, i, j, c, d, lam, mu),
+                             local_block(g, j, i, c, d, lam, mu))
+            upper += np.bincount(t2f[k], area * value, ne)
+        blocks[c, d, nv:nv + ne] = upper
+    blocks[:, :, nv + ne:] = blocks[:, :, nv:nv + ne].transpose(1, 0, 2)  # K_ba = K_ab^T
+    return blocks
 
 
-def p1_stiffness(mesh: MeshTri, lam: float, mu: float, element_dofs: np.ndarray,
-                 n_dofs: int) -> sparse.csr_matrix:
-    """K assembled from the local matrices into the global DOFs ``element_dofs`` (6, n)."""
-    local = element_stiffness(mesh, lam, mu)
-    rows = np.broadcast_to(element_dofs[:, None, :], local.shape).ravel()
-    cols = np.broadcast_to(element_dofs[None, :, :], local.shape).ravel()
-    return sparse.csr_matrix((local.ravel(), (rows, cols)), shape=(n_dofs, n_dofs))
+def p1_stiffness(mesh: MeshTri, lam: float, mu: float) -> sparse.csr_matrix:
+    """K on the DOFs of scikit-fem's ``ElementVector(ElementTriP1)`` (DOF 2 v + c: vertex v,
+    component c), written straight into CSR: the pattern is the vertex graph with each entry
+    a 2 x 2 block, so no list of 36 entries per triangle is sorted."""
+    indptr, indices, source = vertex_pattern(mesh)
+    blocks = block_values(mesh, lam, mu)[:, :, source]
+    degree = np.diff(indptr)
+    row = np.repeat(np.arange(degree.size), degree)
+    within = np.arange(indices.size) - indptr[row]  # place of the entry in its vertex row
+    base = 4 * indptr[row] + 2 * within
+    data = np.empty(4 * indices.size)
+    columns = np.empty(4 * indices.size, dtype=np.int32)
+    for c in range(2):  # DOF row 2 v + c holds [2 w, 2 w + 1 for w in the row's vertices]
+        for d in range(2):
+            place = base + 2 * c * degree[row] + d
+            data[place] = blocks[c, d]
+            columns[place] = 2 * indices + d
+    dof_indptr = np.empty(2 * degree.size + 1, dtype=np.int64)
+    dof_indptr[0] = 0
+    dof_indptr[1:] = np.cumsum(np.repeat(2 * degree, 2))
+    n = 2 * degree.size
+    return sparse.csr_matrix((data, columns, dof_indptr), shape=(n, n))

@@ -12,6 +12,7 @@ from pathlib import Path
 import pandas as pd
 
 from bench.cli.compare_block import check_readme, write_compare_block
+from bench.cli.diff import diff_command
 from bench.cli.guards import InputError, check_output_folders
 from bench.cli.parser import build_parser
 from bench.cli.progress import Progress
@@ -250,7 +251,8 @@ LISTINGS = (("scenes", scene_descriptions, SCENES.origin),
 COMMANDS = {"run": run_command, "compare": compare_command, "report": report_command,
             "export": export_command,
             "verify": verify_command, "hard": hard_command, "scaling": scaling_command,
-            "list": list_command, "study": study_command}
+            "list": list_command, "study": study_command,
+            "diff": diff_command}
 
 
 def main(argv: list[str] | None = None) -> int:

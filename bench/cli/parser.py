@@ -259,6 +259,9 @@ def build_parser() -> argparse.ArgumentParser:
     from bench.cli.study import add_study_parser  # the study's own module (it uses these types)
 
     add_study_parser(sub)
+    from bench.cli.diff import add_diff_parser
+
+    add_diff_parser(sub)
     listing = sub.add_parser(
         "list", help="list registered scenes, formulations, solvers, back-ends, estimators and "
         "hard cases, with where each came from",

@@ -41,11 +41,6 @@ def energy_density(grad: np.ndarray, lam: float, mu: float) -> np.ndarray:
     return s11 * grad[0, 0] + s22 * grad[1, 1] + s12 * (grad[0, 1] + grad[1, 0])
 
 
-def element_gradients(solution: DiscreteSolution) -> np.ndarray:
-    """The constant P1 gradient per element, shape (2, 2, n_elements)."""
-    return solution.elasticity.basis.interpolate(solution.u).grad[:, :, :, 0]
-
-
 def pressure_error(solution: DiscreteSolution, true_pressure, trace=None) -> float:
     """||lambda - lambda_h||_{0,Gamma_C} on the facets of ``trace`` (the finer one; default
     u_h's), with ``true_pressure(s)`` a function of the contact coordinate."""

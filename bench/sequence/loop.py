@@ -31,6 +31,7 @@ from formulations.solvers.backends import check_backend
 from formulations.solvers.registry import REFERENCE_SOLVER
 from scenes import Scene
 from scenes.base import is_integer, is_number
+from scenes.topology import refined
 
 STRATEGIES = ("uniform", "adaptive")
 
@@ -99,13 +100,13 @@ def level_columns(disc, sol, mesh, options: dict) -> dict:
 def refine(mesh: MeshTri, sol, est, config: LoopConfig) -> MeshTri:
     """The next mesh: uniform refinement, or marking (plus the contact grading closure)."""
     if config.strategy == "uniform":
-        return mesh.refined()
+        return refined(mesh)
     marked = mark(est.indicators, config.marking, config.theta)
     if config.grade_contact:
         trace = sol.trace
         marked = grade_contact_trace(marked, trace.length, trace.element, trace.coordinate,
                                      mesh.t.shape[1])
-    return mesh.refined(marked)
+    return refined(mesh, marked)
 
 
 def memory_refusal(level: int, ndofs: int, solver: str, config: LoopConfig) -> str | None:
