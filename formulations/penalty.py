@@ -28,9 +28,12 @@ quadrature point:
 
     min 1/2 u'Ku - F'u + 1/2 sum_q D_q s_q^2   s.t.  u_n(x_q) - s_q <= g(x_q),  -s_q <= 0,
 
-with D_q = w_q h_e / eps_e = E w_q / eps_0 (Gauss weights w_q on [0, 1]). The primal-dual
-active set method on this QP is a semismooth Newton method for the penalised equation
-K u + P' D (P u - g)_+ = F (Hintermueller, Ito, Kunisch 2003).
+with D_q = w_q h_e / eps_e = E w_q / eps_0 (Gauss weights w_q on [0, 1]); the reference
+solver takes this QP. The fast solver takes the penalised equation itself,
+K u + P' D (P u - g)_+ = F, a ``SemismoothSystem`` without the sigma_nn term (gamma = 1/eps):
+semismooth Newton condensed onto the Gauss points, one unknown each instead of the QP's two
+rows and a slack (Hintermueller, Ito, Kunisch 2003: the same iteration as the primal-dual
+active set method on the QP).
 """
 
 from __future__ import annotations
@@ -38,6 +41,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy import sparse
 from skfem import MeshTri
 
 from formulations.base import (
@@ -58,6 +62,7 @@ from formulations.discretisation import Discretisation, discrete_solution
 from formulations.elasticity import assemble_elasticity, check_order
 from formulations.evaluation import normal_trace_matrix
 from formulations.registry import register_formulation
+from formulations.semismooth import SemismoothSystem
 from scenes import Scene
 from scenes.base import is_number
 
@@ -136,26 +141,31 @@ def discretise(scene: Scene, mesh: MeshTri, epsilon_0: float = DEFAULT_EPSILON_0
     ns = nf * nq
     gap_h = gap_interpolant(scene, trace, order)
     gap = gap_h(t)
-    P = normal_trace_matrix(elasticity.basis, trace, t)[:, elasticity.free]
+    P = normal_trace_matrix(elasticity.basis, trace, t)[:, elasticity.free].tocsr()
+    epsilon = epsilon_0 * trace.length / (order**2 * young)
+    # per Gauss point: eps, and Gauss weight x facet length (its share of Gamma_C)
+    row_epsilon, row_length = np.repeat(epsilon, nq), np.tile(w, nf) * np.repeat(trace.length, nq)
+    system = SemismoothSystem(K=elasticity.K_free, F=elasticity.F[elasticity.free],
+                              S=sparse.csr_matrix((0, n)), N=P, gap=gap.ravel(),
+                              weight=row_length, gamma=1.0 / row_epsilon, theta=0.0,
+                              objective_scale=young)
     # D_q = w_q h_e / eps_e = p^2 E w_q / eps_0
     qp = slack_qp(elasticity.K_free, elasticity.F[elasticity.free], P, gap.ravel(),
                   order**2 * young / epsilon_0 * np.tile(w, nf), young)
-    epsilon = epsilon_0 * trace.length / (order**2 * young)
     s_points = trace.coordinates_at(t)
-    # per slack row: eps, and Gauss weight x facet length (the row's share of Gamma_C)
-    row_epsilon, row_length = np.repeat(epsilon, nq), np.tile(w, nf) * np.repeat(trace.length, nq)
     pressure_floor = young * np.abs(gap).max(initial=0.0) / trace.length.sum()
-
-    def transfer(previous: DiscreteSolution) -> np.ndarray:
-        pressing = previous.pressure_at(s_points.ravel()) > 0  # u_n - s <= g active
-        return np.concatenate([pressing, ~pressing]).astype(float)  # else s >= 0 active
 
     def recover(answer: QPSolution, residuals: Residuals, status: str,
                 reason: str) -> DiscreteSolution:
         u_free = answer.u[:n]
         penetration_at_points = P @ u_free - gap.ravel()
-        mismatch = pressure_mismatch(penetration_at_points, row_epsilon,
-                                     answer.multipliers[:ns], row_length, pressure_floor)
+        if answer.u.size > n:  # the QP: u, then the slacks; multipliers per row
+            slacks, row_multipliers = answer.u[n:], answer.multipliers[:ns]
+        else:  # the system: u alone; its multipliers are the pressures at the Gauss points
+            slacks = np.maximum(penetration_at_points, 0.0)
+            row_multipliers = answer.multipliers * row_length
+        mismatch = pressure_mismatch(penetration_at_points, row_epsilon, row_multipliers,
+                                     row_length, pressure_floor)
         if status == STATUS_OK and mismatch > PRESSURE_CONSISTENCY:
             status, reason = STATUS_INACCURATE, (
                 f"penalty pressure (u_hn - g_h)_+/eps disagrees with the QP multipliers by "
@@ -169,8 +179,8 @@ def discretise(scene: Scene, mesh: MeshTri, epsilon_0: float = DEFAULT_EPSILON_0
                                                            trace.coordinate[1, -1]),
             active_constraints=penetrating,
             pressure_mismatch=mismatch,
-            details=PenaltyDetails(epsilon_0=epsilon_0, epsilon=epsilon, slacks=answer.u[n:]))
+            details=PenaltyDetails(epsilon_0=epsilon_0, epsilon=epsilon, slacks=slacks))
 
+    # warm starts: the previous pressure at the Gauss points (the system's unknowns)
     return Discretisation(formulation="penalty", elasticity=elasticity, trace=trace, qp=qp,
-                          recover=recover, row_coordinate=np.tile(s_points.ravel(), 2),
-                          transfer=transfer)
+                          recover=recover, row_coordinate=s_points.ravel(), system=system)

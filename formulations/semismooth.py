@@ -14,6 +14,10 @@ This is eq. (12.2) of docs/theory.md written on the contact values z only: the n
 lives in the few entries of z, which is what lets a solver condense onto them. The discrete
 pressure is lambda_q = -m_q >= 0.
 
+S may have no rows: then z = N u, P_q = gamma_q (g_q - v_q) and the equation is
+K u + N' W gamma (N u - g)_+ = F, the penalty method with eps = 1 / gamma (docs/theory.md,
+section 3).
+
 A solution checks itself: ``residuals`` computes the relative nonlinear residual from u alone
 (the pressure is a function of u, so a dual violation or a complementarity gap cannot occur).
 """
@@ -35,7 +39,7 @@ class SemismoothSystem:
 
     K: sparse.csr_matrix
     F: np.ndarray
-    S: sparse.csr_matrix  # sigma_nn at the quadrature points (nq x n)
+    S: sparse.csr_matrix  # sigma_nn at the quadrature points (nq x n; or 0 x n: no such term)
     N: sparse.csr_matrix  # u . n at the quadrature points (nq x n)
     gap: np.ndarray  # g at the quadrature points
     weight: np.ndarray  # quadrature weight x facet length
@@ -51,6 +55,11 @@ class SemismoothSystem:
     def nq(self) -> int:
         return int(self.gap.size)
 
+    @property
+    def ns(self) -> int:
+        """Rows of S: nq, or 0 for a system without the sigma_nn term (a penalty)."""
+        return int(self.S.shape[0])
+
     @cached_property
     def T(self) -> sparse.csr_matrix:
         """u -> z = (S u, N u) (built once)."""
@@ -58,22 +67,27 @@ class SemismoothSystem:
 
     def pressure_argument(self, z: np.ndarray) -> np.ndarray:
         """P = sigma_nn + gamma (g - u_n) at the quadrature points."""
-        s, v = z[: self.nq], z[self.nq:]
-        return s + self.gamma * (self.gap - v)
+        s, v = z[: self.ns], z[self.ns:]
+        return (s if self.ns else 0.0) + self.gamma * (self.gap - v)
 
     def phi(self, z: np.ndarray) -> np.ndarray:
         """(phi_S, phi_N) of the module docstring."""
-        return self.phi_of(z[: self.nq], np.minimum(self.pressure_argument(z), 0.0))
+        return self.phi_of(z[: self.ns], np.minimum(self.pressure_argument(z), 0.0))
 
     def phi_of(self, s: np.ndarray, m: np.ndarray) -> np.ndarray:
-        """(phi_S, phi_N) from sigma_nn = s and m = [P]_- at the quadrature points."""
+        """(phi_S, phi_N) from sigma_nn = s and m = [P]_- at the quadrature points (phi_N
+        alone without S)."""
         w = self.weight
+        if not self.ns:
+            return -w * m
         return np.concatenate([self.theta / self.gamma * w * (m - s), -w * m])
 
     def phi_affine(self, active: np.ndarray) -> tuple[sparse.csr_matrix, np.ndarray]:
         """phi(z) = D z + c where ``active`` (P < 0) is fixed: (D, c)."""
         chi = active.astype(float)
         w, gamma, theta = self.weight, self.gamma, self.theta
+        if not self.ns:
+            return sparse.diags(gamma * w * chi, format="csr"), -gamma * w * chi * self.gap
         D = sparse.bmat([[sparse.diags(theta / gamma * w * (chi - 1.0)),
                           sparse.diags(-theta * w * chi)],
                          [sparse.diags(-w * chi), sparse.diags(gamma * w * chi)]], format="csr")

@@ -33,11 +33,6 @@ class StudyConfig:
     report: str = "reports/study"
     command: str = "python -m bench study"
 
-    # formulations whose adaptive budget is capped lower: the penalty's graded contact
-    # boundary carries two rows per Gauss point (11 036 rows at 449 596 DOFs on paper), and
-    # the dense condensed iteration costs O(rows^3) per step (over 100 s a level there)
-    adaptive_caps: tuple[tuple[str, int], ...] = (("penalty", 300_000),)
-
     def run_configs(self) -> list[RunConfig]:
         """Adaptive first (in parallel, about 5 GiB each at 1e6 DOFs), then uniform in this
         process (a 2.1e6-DOF level needs about 11 GiB, half of a 24 GiB machine)."""
@@ -45,15 +40,11 @@ class StudyConfig:
                       estimators=tuple(estimator_names()), orders=self.orders,
                       reference_dofs=self.reference_dofs, reference_crosscheck=self.crosscheck,
                       out=self.out, command=self.command)
-        caps = dict(self.adaptive_caps)
-        budgets = {f: min(caps.get(f, self.adaptive_max_dofs), self.adaptive_max_dofs)
-                   for f in formulation_names()}
-        adaptive = [RunConfig(strategies=("adaptive",), max_dofs=budget, workers=self.workers,
-                              formulations=tuple(f for f in budgets if budgets[f] == budget),
-                              **common)
-                    for budget in sorted(set(budgets.values()), reverse=True)]
-        return adaptive + [RunConfig(strategies=("uniform",), max_dofs=self.uniform_max_dofs,
-                                     formulations=tuple(formulation_names()), **common)]
+        formulations = tuple(formulation_names())
+        return [RunConfig(strategies=("adaptive",), max_dofs=self.adaptive_max_dofs,
+                          workers=self.workers, formulations=formulations, **common),
+                RunConfig(strategies=("uniform",), max_dofs=self.uniform_max_dofs,
+                          formulations=formulations, **common)]
 
 
 # the default tests' version: the paper scene to a few thousand DOFs

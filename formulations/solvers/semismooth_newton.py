@@ -86,23 +86,29 @@ class ReducedPressure:
     P0 (and s for m = 0) for any right-hand side, ``phi(s_free, m)`` phi from m."""
 
     system: SemismoothSystem
-    L: tuple  # LU factors of I - M_SS Theta
+    L: tuple | None  # LU factors of I - M_SS Theta (None without S)
     LR: np.ndarray  # (I - M_SS Theta)^-1 (M_SN W - M_SS Theta)
     E: np.ndarray  # I - gamma M_NS Theta
     G: np.ndarray
 
     def free(self, z0: np.ndarray, gap: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        nq, gamma = self.system.nq, self.system.gamma
-        s_free = linalg.lu_solve(self.L, z0[:nq], check_finite=False)
-        return self.E @ s_free + gamma * (gap - z0[nq:]), s_free
+        ns, gamma = self.system.ns, self.system.gamma
+        if not ns:  # no sigma_nn term: P0 = gamma (g - v0)
+            return gamma * (gap - z0), np.zeros(0)
+        s_free = linalg.lu_solve(self.L, z0[:ns], check_finite=False)
+        return self.E @ s_free + gamma * (gap - z0[ns:]), s_free
 
     def phi(self, s_free: np.ndarray, m: np.ndarray) -> np.ndarray:
         return self.system.phi_of(s_free + self.LR @ m, m)
 
 
 def reduced_pressure(system: SemismoothSystem, M: np.ndarray) -> ReducedPressure:
-    """The matrices of ``ReducedPressure`` from M = T K^-1 T' (one nq x nq factorisation)."""
+    """The matrices of ``ReducedPressure`` from M = T K^-1 T' (one nq x nq factorisation;
+    none without S, where M = M_NN and G = gamma M_NN W)."""
     nq, w, gamma = system.nq, system.weight, system.gamma
+    if not system.ns:
+        return ReducedPressure(system, None, np.zeros((0, nq)), np.zeros((nq, 0)),
+                               gamma[:, None] * M * w[None, :])
     Mss, Msn, Mns, Mnn = M[:nq, :nq], M[:nq, nq:], M[nq:, :nq], M[nq:, nq:]
     Theta = system.theta * w / gamma
     L = linalg.lu_factor(np.eye(nq) - Mss * Theta[None, :], check_finite=False)
