@@ -152,10 +152,25 @@ class GradientField:
     def at(self, x: np.ndarray, cells: np.ndarray) -> np.ndarray:
         """grad u_h (2, 2, n) at points x (2, n) from the polynomials of ``cells`` (extended
         beyond the element for a point outside it)."""
+        if self.degree == 0:  # a constant per element (P1): nothing to evaluate
+            return self.coefficients[:, :, 0, cells]
         out = np.empty((2, 2, x.shape[1]))
         for start in range(0, x.shape[1], CHUNK):
             block = slice(start, start + CHUNK)
-            xi = self.locator.reference_coordinates(x[:, block], cells[block])
-            out[:, :, block] = np.einsum("ijmn,mn->ijn", self.coefficients[:, :, :, cells[block]],
-                                         _powers(xi, self.degree))
+            [out[:, :, block]] = self.at_each([x[:, block]], cells[block])
+        return out
+
+    def at_each(self, points: list[np.ndarray], cells: np.ndarray) -> list[np.ndarray]:
+        """``at(x, cells)`` for every x in ``points`` (each (2, n), the same cells): the cells'
+        polynomials and maps are gathered once for all of them."""
+        if self.degree == 0:
+            return [self.coefficients[:, :, 0, cells]] * len(points)
+        coefficients = self.coefficients[:, :, :, cells]
+        origin, inv = self.locator.origin[:, cells], self.locator.inverse[:, :, cells]
+        out = []
+        for x in points:
+            d = x - origin
+            xi = np.array([inv[0, 0] * d[0] + inv[0, 1] * d[1],
+                           inv[1, 0] * d[0] + inv[1, 1] * d[1]])
+            out.append(np.einsum("ijmn,mn->ijn", coefficients, _powers(xi, self.degree)))
         return out

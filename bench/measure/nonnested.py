@@ -37,11 +37,11 @@ def _cell_energy(first: GradientField, second: GradientField, lame, corners, are
     """sum over cells of the rule applied to sigma(e) : eps(e), e = u_first - u_second."""
     X, W = rule
     a, b = corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]
+    points = [corners[:, 0] + a * X[0, q] + b * X[1, q] for q in range(W.size)]
     total = 0.0
-    for q in range(W.size):
-        x = corners[:, 0] + a * X[0, q] + b * X[1, q]
-        difference = first.at(x, parent) - second.at(x, located)
-        total += 2.0 * W[q] * float((energy_density(difference, *lame) * area).sum())
+    for q, (mine, theirs) in enumerate(zip(first.at_each(points, parent),
+                                           second.at_each(points, located), strict=True)):
+        total += 2.0 * W[q] * float((energy_density(mine - theirs, *lame) * area).sum())
     return total
 
 
