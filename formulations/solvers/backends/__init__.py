@@ -90,5 +90,7 @@ def factorise_condensed(K: sparse.spmatrix, contact: np.ndarray,
                            "do (the augmented iteration is used instead)")
     K = sparse.csc_matrix(K)
     contact = np.unique(np.asarray(contact, dtype=np.int64))
-    interior = np.setdiff1d(np.arange(K.shape[0]), contact)
+    is_contact = np.zeros(K.shape[0], dtype=bool)  # a mask, not a sorted set difference
+    is_contact[contact] = True
+    interior = np.flatnonzero(~is_contact)
     return condense(K, interior, contact)
