@@ -16,6 +16,8 @@ import numpy as np
 from scipy import sparse
 from skfem import Basis, ElementH1, ElementVector
 
+from formulations.p1_stiffness import barycentric_gradients
+
 CHUNK = 200_000  # points per block when summing gradients (bounds the temporary arrays)
 
 
@@ -108,15 +110,38 @@ def normal_trace_matrix(basis: Basis, trace, t: np.ndarray) -> sparse.csr_matrix
 
 
 def gradients_at_reference(basis: Basis, u: np.ndarray, X: np.ndarray) -> np.ndarray:
-    """grad u_h at the same reference points X (2, nX) of every element, by scikit-fem's
-    vectorised interpolation; shape (2, 2, n_elements, nX), element-major."""
-    at = Basis(basis.mesh, basis.elem, quadrature=(X, np.ones(X.shape[1])))
-    return at.interpolate(u).grad
+    """grad u_h at the same reference points X (2, nX) of every element; shape
+    (2, 2, n_elements, nX), element-major. Vector Lagrange elements on affine meshes: the
+    reference gradients of the scalar functions (the same for every element) through each
+    element's inverse Jacobian (no basis object at the points); others: scikit-fem's
+    interpolation."""
+    inverse = getattr(basis.mapping, "invA", None)  # (2, 2, nE) for affine maps
+    if inverse is None or not (isinstance(basis.elem, ElementVector)
+                               and isinstance(basis.elem.elem, ElementH1)):
+        at = Basis(basis.mesh, basis.elem, quadrature=(X, np.ones(X.shape[1])))
+        return at.interpolate(u).grad
+    out = np.zeros((2, 2, inverse.shape[2], X.shape[1]))
+    for j in range(basis.Nbfun // 2):
+        _, reference = basis.elem.elem.lbasis(X, j)  # (2, nX)
+        gradient = np.einsum("rde,rq->deq", inverse, reference)  # of scalar function j
+        for c in range(2):  # vector function 2 j + c: scalar function j in component c
+            out[c] += u[basis.element_dofs[2 * j + c]][None, :, None] * gradient
+    return out
+
+
+def p1_gradients(basis: Basis, u: np.ndarray) -> np.ndarray:
+    """The constant grad u_h (2, 2, n_elements) of a vector P1 field: sum_i u_i g_i' with
+    the barycentric gradients g_i (scikit-fem's local DOF 2 i + c: node i, component c)."""
+    g, _ = barycentric_gradients(basis.mesh)  # (3, 2, nE)
+    nodal = u[basis.element_dofs].reshape(3, 2, -1)
+    return np.einsum("ice,ide->cde", nodal, g)
 
 
 def gradients_at(basis: Basis, u: np.ndarray, x: np.ndarray, cells: np.ndarray) -> np.ndarray:
     """grad u_h at many points (2, n) in elements ``cells``, in blocks of CHUNK points;
     shape (2, 2, n)."""
+    if basis.elem.maxdeg == 1 and isinstance(basis.elem, ElementVector):  # constant per element
+        return p1_gradients(basis, u)[:, :, cells]
     out = np.empty((2, 2, x.shape[1]))
     for start in range(0, x.shape[1], CHUNK):
         block = slice(start, start + CHUNK)

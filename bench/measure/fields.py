@@ -20,8 +20,7 @@ from scipy.spatial import cKDTree
 from skfem import Basis, MeshTri
 
 from formulations.elasticity import vector_element
-from formulations.evaluation import gradients_at_reference
-from formulations.p1_stiffness import barycentric_gradients
+from formulations.evaluation import gradients_at_reference, p1_gradients
 
 CHUNK = 250_000  # points per block when evaluating (bounds the temporary arrays)
 MAX_WALK = 64  # walk steps before the remaining points go to matplotlib's trapezoid finder
@@ -136,11 +135,8 @@ class GradientField:
     def from_solution(cls, basis: Basis, u: np.ndarray) -> GradientField:
         """The field of the DOF vector ``u`` of a vector P_p ``basis``."""
         degree = basis.elem.maxdeg - 1
-        if degree == 0:  # P1: grad u = sum_i u_i g_i' with the barycentric gradients g_i
-            g, _ = barycentric_gradients(basis.mesh)  # (3, 2, nE)
-            nodal = u[basis.element_dofs].reshape(3, 2, -1)  # local DOF 2 i + c
-            gradient = np.einsum("ice,ide->cde", nodal, g)
-            return cls(Locator.from_mesh(basis.mesh), 0, gradient[:, :, None, :])
+        if degree == 0:  # P1: the constant gradient of each element
+            return cls(Locator.from_mesh(basis.mesh), 0, p1_gradients(basis, u)[:, :, None, :])
         nodes = _lattice(degree)
         values = gradients_at_reference(basis, u, nodes)  # (2, 2, nE, n_nodes)
         solve = np.linalg.inv(_powers(nodes, degree).T)  # Vandermonde: coefficients <- values
