@@ -28,6 +28,7 @@ from skfem.models.elasticity import linear_elasticity
 
 from formulations.load import body_load
 from formulations.p1_stiffness import p1_stiffness
+from formulations.p2_stiffness import p2_stiffness
 from scenes import Scene
 from scenes.base import is_integer
 from scenes.topology import ensure_topology
@@ -136,6 +137,8 @@ def assemble_elasticity(scene: Scene, mesh: MeshTri, order: int = 1) -> Elastici
     lam, mu = scene.material.lame
     if order == 1:  # constant strains: the closed-form local matrices (formulations.p1_stiffness)
         K = p1_stiffness(mesh, lam, mu)
+    elif order == 2:  # the same straight into CSR (formulations.p2_stiffness)
+        K = p2_stiffness(mesh, lam, mu)
     else:  # strain products have degree 2(p - 1): a rule of that order is exact
         stiffness_basis = Basis(mesh, basis.elem, intorder=2 * (order - 1))
         K = asm(linear_elasticity(lam, mu), stiffness_basis).tocsr()

@@ -43,17 +43,24 @@ def local_block(g: np.ndarray, i: int, j: int, c: int, d: int, lam: float,
     return value
 
 
-def vertex_pattern(mesh: MeshTri) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The vertex graph of the mesh in CSR form (every vertex with itself and with the other
-    ends of its edges, columns sorted): (indptr, indices, source), where ``source`` gives, for
-    each entry, its place in [diagonal (n_vertices), edges a -> b (n_edges), edges b -> a]."""
-    nv, (a, b) = mesh.p.shape[1], ensure_topology(mesh).facets
-    rows = np.concatenate((np.arange(nv), a, b))
-    cols = np.concatenate((np.arange(nv), b, a))
+def node_pattern(n_nodes: int, rows: np.ndarray,
+                 cols: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The node graph given by its entries (rows, cols), each pair once, in CSR form with
+    sorted columns: (indptr, indices, source), ``source`` giving each CSR entry's place in the
+    given list."""
     # entry ids as data: one CSR conversion and an in-row sort carry them to their places
-    graph = sparse.csr_matrix((np.arange(1.0, rows.size + 1), (rows, cols)), shape=(nv, nv))
+    graph = sparse.csr_matrix((np.arange(1.0, rows.size + 1), (rows, cols)),
+                              shape=(n_nodes, n_nodes))
     graph.sort_indices()
     return graph.indptr, graph.indices, graph.data.astype(np.int64) - 1
+
+
+def vertex_pattern(mesh: MeshTri) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The vertex graph of the mesh (every vertex with itself and with the other ends of its
+    edges), ``source`` in [diagonal (n_vertices), edges a -> b (n_edges), edges b -> a]."""
+    nv, (a, b) = mesh.p.shape[1], ensure_topology(mesh).facets
+    return node_pattern(nv, np.concatenate((np.arange(nv), a, b)),
+                        np.concatenate((np.arange(nv), b, a)))
 
 
 def block_values(mesh: MeshTri, lam: float, mu: float) -> np.ndarray:
@@ -84,14 +91,19 @@ def p1_stiffness(mesh: MeshTri, lam: float, mu: float) -> sparse.csr_matrix:
     component c), written straight into CSR: the pattern is the vertex graph with each entry
     a 2 x 2 block, so no list of 36 entries per triangle is sorted."""
     indptr, indices, source = vertex_pattern(mesh)
-    blocks = block_values(mesh, lam, mu)[:, :, source]
+    return block_csr(indptr, indices, block_values(mesh, lam, mu)[:, :, source])
+
+
+def block_csr(indptr: np.ndarray, indices: np.ndarray, blocks: np.ndarray) -> sparse.csr_matrix:
+    """The CSR matrix on DOFs 2 n + c (node n, component c) of a node graph (indptr, indices)
+    whose entry k is the 2 x 2 block blocks[:, :, k]."""
     degree = np.diff(indptr)
     row = np.repeat(np.arange(degree.size), degree)
-    within = np.arange(indices.size) - indptr[row]  # place of the entry in its vertex row
+    within = np.arange(indices.size) - indptr[row]  # place of the entry in its node row
     base = 4 * indptr[row] + 2 * within
     data = np.empty(4 * indices.size)
     columns = np.empty(4 * indices.size, dtype=np.int32)
-    for c in range(2):  # DOF row 2 v + c holds [2 w, 2 w + 1 for w in the row's vertices]
+    for c in range(2):  # DOF row 2 n + c holds [2 w, 2 w + 1 for w in the row's nodes]
         for d in range(2):
             place = base + 2 * c * degree[row] + d
             data[place] = blocks[c, d]
