@@ -67,6 +67,13 @@ def slack_qp(K: sparse.spmatrix, F: np.ndarray, P: sparse.spmatrix, gap: np.ndar
                      objective_scale=objective_scale)
 
 
+def slack_warm_start(pressing: np.ndarray) -> np.ndarray:
+    """A warm start for ``slack_qp``: row q of P u - s <= g active where the point presses,
+    else its s_q >= 0."""
+    pressing = np.asarray(pressing, dtype=bool)
+    return np.concatenate([pressing, ~pressing]).astype(float)
+
+
 @dataclass(frozen=True, eq=False)
 class SolverDiagnostics:
     """What a solver reports about its own run (``formulations.solvers.active_set``); the

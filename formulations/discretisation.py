@@ -38,11 +38,18 @@ class Discretisation:
     multiplier_gram: np.ndarray | None = None
     system: SemismoothSystem | None = None
     no_qp: str = ""  # why qp is None
+    # the QP's own warm start where its rows are not the system's points (a slack QP)
+    qp_transfer: Callable[[DiscreteSolution], np.ndarray] | None = None
 
-    def warm_start(self, previous: DiscreteSolution) -> np.ndarray:
-        """Initial multipliers for this QP from a solution on another (coarser) mesh: the
-        previous lambda_h at each constraint row's place on Gamma_C (nested iteration), unless
-        the formulation's rows need their own ``transfer``."""
+    def warm_start(self, previous: DiscreteSolution, solver: str | None = None) -> np.ndarray:
+        """Initial multipliers for the problem ``solver`` solves (the system if it has a method
+        for it, else the QP) from a solution on another (coarser) mesh: the previous lambda_h
+        at each constraint row's place on Gamma_C (nested iteration), unless the formulation's
+        rows need their own ``transfer`` (``qp_transfer`` for the QP of a formulation that also
+        has a system)."""
+        if (solver is not None and self.qp_transfer is not None
+                and not uses_system(self, solver)):
+            return self.qp_transfer(previous)
         if self.transfer is not None:
             return self.transfer(previous)
         return previous.pressure_at(self.row_coordinate)

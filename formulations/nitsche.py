@@ -35,7 +35,14 @@ import numpy as np
 from scipy import sparse
 from skfem import MeshTri
 
-from formulations.base import ContactQP, DiscreteSolution, QPSolution, Residuals, slack_qp
+from formulations.base import (
+    ContactQP,
+    DiscreteSolution,
+    QPSolution,
+    Residuals,
+    slack_qp,
+    slack_warm_start,
+)
 from formulations.contact import contact_trace, gap_interpolant, gauss_legendre
 from formulations.discretisation import Discretisation, discrete_solution
 from formulations.elasticity import assemble_elasticity, check_order
@@ -146,5 +153,6 @@ def discretise(scene: Scene, mesh: MeshTri, theta: float = 1.0,
         formulation="nitsche", elasticity=elasticity, trace=trace,
         qp=convex_form(system) if symmetric else None, recover=recover,
         row_coordinate=s_points, transfer=transfer, system=system,
+        qp_transfer=lambda previous: slack_warm_start(transfer(previous) > 0),
         no_qp="" if symmetric else f"theta={theta:g} is not the optimality condition of a "
                                    "convex functional (only theta = 1 is)")

@@ -51,6 +51,7 @@ from formulations.base import (
     QPSolution,
     Residuals,
     slack_qp,
+    slack_warm_start,
 )
 from formulations.contact import (
     contact_trace,
@@ -181,6 +182,10 @@ def discretise(scene: Scene, mesh: MeshTri, epsilon_0: float = DEFAULT_EPSILON_0
             pressure_mismatch=mismatch,
             details=PenaltyDetails(epsilon_0=epsilon_0, epsilon=epsilon, slacks=slacks))
 
+    def qp_transfer(previous: DiscreteSolution) -> np.ndarray:
+        return slack_warm_start(previous.pressure_at(s_points.ravel()) > 0)
+
     # warm starts: the previous pressure at the Gauss points (the system's unknowns)
     return Discretisation(formulation="penalty", elasticity=elasticity, trace=trace, qp=qp,
-                          recover=recover, row_coordinate=s_points.ravel(), system=system)
+                          recover=recover, row_coordinate=s_points.ravel(), system=system,
+                          qp_transfer=qp_transfer)

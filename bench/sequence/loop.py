@@ -154,7 +154,7 @@ def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
         t_assemble = time.perf_counter() - start
         options = dict(config.solver_options)
         if config.nested and previous is not None and previous.ok:
-            options["warm_start"] = disc.warm_start(previous)  # nested iteration
+            options["warm_start"] = disc.warm_start(previous, solver)  # nested iteration
         sol = previous = solve(disc, solver, **options)
         failed = sol.status == STATUS_FAILED
         start = time.perf_counter()
