@@ -21,7 +21,19 @@ from scenes.topology import TRIANGLE_EDGES, ensure_topology
 
 
 def barycentric_gradients(mesh: MeshTri) -> tuple[np.ndarray, np.ndarray]:
-    """The gradients g (3 vertices, 2 components, n_elements) and the areas (n_elements)."""
+    """The gradients g (3 vertices, 2 components, n_elements) and the areas (n_elements),
+    computed once per mesh (assembly, estimators and errors all ask; a mesh's arrays are never
+    changed in place, so the read-only copies stored on it stay right)."""
+    cached = getattr(mesh, "_barycentric_gradients", None)
+    if cached is None:
+        cached = _barycentric_gradients(mesh)
+        for array in cached:
+            array.setflags(write=False)
+        mesh._barycentric_gradients = cached
+    return cached
+
+
+def _barycentric_gradients(mesh: MeshTri) -> tuple[np.ndarray, np.ndarray]:
     x = mesh.p[:, mesh.t]  # (2, 3, n)
     d1, d2 = x[:, 1] - x[:, 0], x[:, 2] - x[:, 0]
     det = d1[0] * d2[1] - d1[1] * d2[0]
