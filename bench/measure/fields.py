@@ -21,6 +21,7 @@ from skfem import Basis, MeshTri
 
 from formulations.elasticity import vector_element
 from formulations.evaluation import gradients_at_reference, p1_gradients
+from formulations.p1_stiffness import barycentric_gradients
 
 CHUNK = 250_000  # points per block when evaluating (bounds the temporary arrays)
 MAX_WALK = 64  # walk steps before the remaining points go to matplotlib's trapezoid finder
@@ -55,11 +56,10 @@ class Locator:
 
     @classmethod
     def from_mesh(cls, mesh: MeshTri) -> Locator:
-        p = mesh.p[:, mesh.t]  # (2, 3, nE)
-        a, b = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
-        det = a[0] * b[1] - a[1] * b[0]
-        inverse = np.array([[b[1], -b[0]], [-a[1], a[0]]]) / det
-        return cls(mesh, p[:, 0], inverse, 0.5 * np.abs(det))
+        # the rows of the inverse map are the gradients of the reference coordinates xi = the
+        # barycentric coordinate of vertex 1, eta = that of vertex 2 (computed once per mesh)
+        gradients, area = barycentric_gradients(mesh)
+        return cls(mesh, mesh.p[:, mesh.t[0]], gradients[1:], area)
 
     @functools.cached_property
     def neighbours(self) -> np.ndarray:
