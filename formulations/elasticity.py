@@ -26,6 +26,7 @@ from skfem import (
 from skfem.helpers import dot
 from skfem.models.elasticity import linear_elasticity
 
+from formulations.dof_basis import DofBasis
 from formulations.load import body_load
 from formulations.p1_stiffness import p1_stiffness
 from formulations.p2_stiffness import p2_stiffness
@@ -35,7 +36,6 @@ from scenes.topology import ensure_topology
 
 ELEMENTS = {1: ElementTriP1, 2: ElementTriP2, 3: ElementTriP3}
 ORDERS = tuple(ELEMENTS)
-CENTROID_RULE = (np.full((2, 1), 1.0 / 3.0), np.array([0.5]))  # reference triangle, weight = area
 
 
 def order_descriptions() -> dict[str, str]:
@@ -104,7 +104,7 @@ def dof_basis(mesh: MeshTri, order: int = 1) -> Basis:
     """The displacement basis an ``Elasticity`` carries: its DOF numbering, element maps and
     element, on the one-point centroid rule (nothing integrates with it: each integral builds
     the basis of its own rule, and the quadrature data of a default basis cost more than K)."""
-    return Basis(mesh, vector_element(order), quadrature=CENTROID_RULE)
+    return DofBasis(mesh, vector_element(order))
 
 
 def element_diameters(mesh: MeshTri) -> np.ndarray:
