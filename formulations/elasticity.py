@@ -32,7 +32,7 @@ from formulations.p1_stiffness import p1_stiffness
 from formulations.p2_stiffness import p2_stiffness
 from scenes import Scene
 from scenes.base import is_integer
-from scenes.topology import ensure_topology
+from scenes.topology import RefinementPlan, ensure_topology
 
 ELEMENTS = {1: ElementTriP1, 2: ElementTriP2, 3: ElementTriP3}
 ORDERS = tuple(ELEMENTS)
@@ -170,6 +170,27 @@ def count_free_dofs(scene: Scene, mesh: MeshTri, order: int = 1) -> int:
     dirichlet = scene.dirichlet_facets(mesh)
     clamped = np.unique(mesh.facets[:, dirichlet]).size + (order - 1) * dirichlet.size
     nodes = lagrange_dofs(mesh.p.shape[1], mesh.facets.shape[1], mesh.t.shape[1], order)
+    return int(2 * (nodes - clamped))
+
+
+def predict_refined_free_dofs(scene: Scene, plan: RefinementPlan, order: int = 1) -> int:
+    """``count_free_dofs`` of ``plan.refined`` without splitting a triangle: a red-green-blue
+    split adds one vertex per split facet, which becomes two facets (two clamped ones on
+    Gamma_D), and k triangles and k interior edges to a triangle with k split edges. A plan
+    that scikit-fem carries out itself is counted after refining (uniform ones by
+    ``predict_uniform_free_dofs``)."""
+    mesh = plan.mesh
+    if plan.split is None:
+        return (predict_uniform_free_dofs(scene, mesh, order) if plan.marked is None
+                else count_free_dofs(scene, plan.refined, order))
+    dirichlet = scene.dirichlet_facets(mesh)
+    new_vertices, more = plan.new_vertices(), int(plan.new_elements_per_element().sum())
+    split_clamped = int(np.count_nonzero(plan.split[dirichlet]))
+    clamped = (np.unique(mesh.facets[:, dirichlet]).size + split_clamped
+               + (order - 1) * (dirichlet.size + split_clamped))
+    nodes = lagrange_dofs(mesh.p.shape[1] + new_vertices,
+                          mesh.facets.shape[1] + new_vertices + more, mesh.t.shape[1] + more,
+                          order)
     return int(2 * (nodes - clamped))
 
 

@@ -11,7 +11,8 @@ the mesh, ours or scikit-fem's, finds them.
 
 from __future__ import annotations
 
-from dataclasses import replace
+import functools
+from dataclasses import dataclass, replace
 
 import numpy as np
 from skfem import MeshTri
@@ -81,18 +82,52 @@ def longest_edge_last(mesh: MeshTri) -> tuple[np.ndarray, np.ndarray]:
     return t, t2f
 
 
+@dataclass(frozen=True, eq=False)
+class RefinementPlan:
+    """What ``refined(mesh, marked)`` will split, known before any new element is made: the
+    mesh with each triangle's longest edge last and the facets to split (scikit-fem's closure
+    of the marked triangles), or ``split`` None where scikit-fem refines by itself (uniform
+    refinement, meshes with subdomains, other element types)."""
+
+    mesh: MeshTri
+    marked: np.ndarray | None
+    sorted_mesh: MeshTri | None = None
+    split: np.ndarray | None = None  # per facet of ``mesh``: 1 to split
+
+    def new_vertices(self) -> int:
+        return int(np.count_nonzero(self.split))
+
+    def new_elements_per_element(self) -> np.ndarray:
+        """How many more triangles each one becomes: one per split edge (green 1, blue 2,
+        red 3), which is also how many new interior edges it gets."""
+        return np.count_nonzero(self.split[self.sorted_mesh.t2f], axis=0)
+
+    @functools.cached_property
+    def refined(self) -> MeshTri:
+        mesh, marked = self.mesh, self.marked
+        if self.split is None:
+            return ensure_topology(mesh.refined() if marked is None else mesh.refined(marked))
+        p, t, _ = MeshTri._adaptive_split_elements(self.sorted_mesh, self.split, None)
+        return ensure_topology(replace(mesh, doflocs=p, t=t, _boundaries=None,
+                                       _subdomains=None))
+
+
+def refinement_plan(mesh: MeshTri, marked: np.ndarray | None = None) -> RefinementPlan:
+    """Plan ``refined(mesh, marked)``: the closure of the marked triangles without splitting."""
+    ensure_topology(mesh)
+    if marked is None or type(mesh) is not MeshTri or mesh._subdomains is not None:
+        return RefinementPlan(mesh, marked)
+    t, t2f = longest_edge_last(mesh)
+    sorted_mesh = _with_topology(replace(mesh, t=t, sort_t=False), mesh.facets, t2f)
+    split = MeshTri._adaptive_find_facets(sorted_mesh, np.asarray(marked))
+    return RefinementPlan(mesh, np.asarray(marked), sorted_mesh, split)
+
+
 def refined(mesh: MeshTri, marked: np.ndarray | None = None) -> MeshTri:
     """``mesh.refined()`` (uniform) or ``mesh.refined(marked)`` (scikit-fem's red-green-blue
     refinement of the marked triangles and its closure), the same mesh to the bit, with the
     topology of both meshes built here."""
-    ensure_topology(mesh)
-    if marked is None or type(mesh) is not MeshTri or mesh._subdomains is not None:
-        return ensure_topology(mesh.refined() if marked is None else mesh.refined(marked))
-    t, t2f = longest_edge_last(mesh)
-    sorted_mesh = _with_topology(replace(mesh, t=t, sort_t=False), mesh.facets, t2f)
-    split = MeshTri._adaptive_find_facets(sorted_mesh, np.asarray(marked))
-    p, t, _ = MeshTri._adaptive_split_elements(sorted_mesh, split, None)
-    return ensure_topology(replace(mesh, doflocs=p, t=t, _boundaries=None, _subdomains=None))
+    return refinement_plan(mesh, marked).refined
 
 
 def _with_topology(mesh: MeshTri, facets: np.ndarray, t2f: np.ndarray) -> MeshTri:

@@ -25,13 +25,13 @@ from formulations.elasticity import (
     check_order,
     count_free_dofs,
     element_diameters,
-    predict_uniform_free_dofs,
+    predict_refined_free_dofs,
 )
 from formulations.solvers.backends import check_backend
 from formulations.solvers.registry import REFERENCE_SOLVER
 from scenes import Scene
 from scenes.base import is_integer, is_number
-from scenes.topology import refined
+from scenes.topology import RefinementPlan, refinement_plan
 
 STRATEGIES = ("uniform", "adaptive")
 
@@ -97,16 +97,22 @@ def level_columns(disc, sol, mesh, options: dict) -> dict:
         reason=sol.reason, **vars(sol.residuals))
 
 
-def refine(mesh: MeshTri, sol, est, config: LoopConfig) -> MeshTri:
-    """The next mesh: uniform refinement, or marking (plus the contact grading closure)."""
+def refinement(mesh: MeshTri, sol, est, config: LoopConfig) -> RefinementPlan:
+    """The plan of the next mesh: uniform refinement, or marking (plus the contact grading
+    closure)."""
     if config.strategy == "uniform":
-        return refined(mesh)
+        return refinement_plan(mesh)
     marked = mark(est.indicators, config.marking, config.theta)
     if config.grade_contact:
         trace = sol.trace
         marked = grade_contact_trace(marked, trace.length, trace.element, trace.coordinate,
                                      mesh.t.shape[1])
-    return refined(mesh, marked)
+    return refinement_plan(mesh, marked)
+
+
+def refine(mesh: MeshTri, sol, est, config: LoopConfig) -> MeshTri:
+    """The next mesh (``refinement``'s plan carried out)."""
+    return refinement(mesh, sol, est, config).refined
 
 
 def memory_refusal(level: int, ndofs: int, solver: str, config: LoopConfig) -> str | None:
@@ -182,10 +188,11 @@ def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
             return "failed"
         if reached:
             return "target"
-        if config.strategy == "uniform" and predict_uniform_free_dofs(
-                scene, mesh, config.order) > config.max_dofs:
-            return "budget"
         start = time.perf_counter()
-        mesh = refine(mesh, sol, est, config)
+        plan = refinement(mesh, sol, est, config)
+        # the next level's size before its triangles are made: no refinement is wasted
+        if predict_refined_free_dofs(scene, plan, config.order) > config.max_dofs:
+            return "budget"
+        mesh = plan.refined
         t_refine = time.perf_counter() - start
     return "max_levels"

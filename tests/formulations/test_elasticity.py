@@ -3,8 +3,15 @@
 import numpy as np
 import pytest
 
-from formulations.elasticity import assemble_elasticity, stress_from_gradient, von_mises
+from formulations.elasticity import (
+    assemble_elasticity,
+    count_free_dofs,
+    predict_refined_free_dofs,
+    stress_from_gradient,
+    von_mises,
+)
 from scenes import get_scene
+from scenes.topology import refinement_plan
 
 
 @pytest.fixture(scope="module")
@@ -66,3 +73,20 @@ def test_von_mises_of_uniaxial_and_pure_shear():
     grad = np.zeros((2, 2, 1))
     grad[0, 1, 0] = 1.0
     assert stress_from_gradient(grad, 2.0, 3.0)[:, 0] == pytest.approx([0.0, 0.0, 3.0])
+
+
+@pytest.mark.parametrize("name", ["paper", "hertz", "free-boundary", "thin", "corner"])
+@pytest.mark.parametrize("order", [1, 2, 3])
+def test_the_next_levels_size_is_known_before_refining(name, order):
+    # the refinement loop stops on this prediction: it must be the count of the mesh that
+    # refining gives, exactly (an integer), for adaptive and uniform refinement
+    scene = get_scene(name)
+    rng = np.random.default_rng(11)
+    mesh = scene.mesh
+    for fraction in (0.05, 0.3, 1.0, None):
+        marked = (None if fraction is None else
+                  np.flatnonzero(rng.random(mesh.t.shape[1]) < fraction))
+        plan = refinement_plan(mesh, marked)
+        assert predict_refined_free_dofs(scene, plan, order) == count_free_dofs(
+            scene, plan.refined, order)
+        mesh = plan.refined
