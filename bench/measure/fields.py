@@ -23,7 +23,9 @@ from formulations.elasticity import vector_element
 from formulations.evaluation import gradients_at_reference, p1_gradients
 from formulations.p1_stiffness import barycentric_gradients
 
-CHUNK = 250_000  # points per block when evaluating (bounds the temporary arrays)
+CHUNK = 50_000  # points per block when evaluating: small temporaries are reused, not faulted in
+# afresh (measured at 10^6 DOFs against the P3 reference: 0.96-1.14 s against 1.14-1.30 s with
+# 250 000)
 MAX_WALK = 64  # walk steps before the remaining points go to matplotlib's trapezoid finder
 INSIDE = 1e-12  # barycentric tolerance for "inside"
 
