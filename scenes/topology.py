@@ -43,11 +43,12 @@ def build_f2t(t2f: np.ndarray, n_facets: int) -> np.ndarray:
     """(2, n_facets): the triangles on either side of each facet, -1 on the boundary, as
     scikit-fem's ``Mesh.build_inverse`` gives them (the first and the last triangle met in
     ``t2f`` read row by row)."""
-    position = np.arange(t2f.size)
-    first = np.full(n_facets, t2f.size)
-    last = np.full(n_facets, -1)
-    np.minimum.at(first, t2f.ravel(), position)
-    np.maximum.at(last, t2f.ravel(), position)
+    position, flat = np.arange(t2f.size), t2f.ravel()
+    # an assignment through repeated indices leaves the last value written (numpy's indexing
+    # rules): written backwards, the first occurrence; forwards, the last
+    first, last = np.empty(n_facets, dtype=np.int64), np.empty(n_facets, dtype=np.int64)
+    first[flat[::-1]] = position[::-1]
+    last[flat] = position
     n_elements = t2f.shape[1]
     f2t = np.vstack((first % n_elements, last % n_elements)).astype(np.int32)
     f2t[1, first == last] = -1
@@ -68,8 +69,10 @@ def longest_edge_last(mesh: MeshTri) -> tuple[np.ndarray, np.ndarray]:
     """scikit-fem's ``MeshTri1._adaptive_sort_mesh`` (vertices reordered so that (0, 2) is the
     longest edge) and the matching t2f, permuted from the mesh's own instead of rebuilt."""
     t, t2f = mesh.t, ensure_topology(mesh).t2f
-    length = [np.sqrt(np.sum((mesh.p[:, t[i]] - mesh.p[:, t[j]]) ** 2, axis=0))
-              for i, j in TRIANGLE_EDGES]  # l01, l12, l02
+    # each edge's length once, then per triangle (a - b and b - a square to the same numbers)
+    a, b = mesh.p[:, mesh.facets[0]], mesh.p[:, mesh.facets[1]]
+    edge_length = np.sqrt(np.sum((a - b) ** 2, axis=0))
+    length = [edge_length[t2f[k]] for k in range(len(TRIANGLE_EDGES))]  # l01, l12, l02
     swap12 = (length[0] > length[2]) & (length[0] > length[1])  # (0, 1) longest
     swap01 = (length[1] > length[0]) & (length[1] > length[2])  # (1, 2) longest
     t, t2f = t.copy(), t2f.copy()
