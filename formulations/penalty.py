@@ -182,10 +182,8 @@ def discretise(scene: Scene, mesh: MeshTri, epsilon_0: float = DEFAULT_EPSILON_0
             pressure_mismatch=mismatch,
             details=PenaltyDetails(epsilon_0=epsilon_0, epsilon=epsilon, slacks=slacks))
 
-    def qp_transfer(previous: DiscreteSolution) -> np.ndarray:
-        return slack_warm_start(previous.pressure_at(s_points.ravel()) > 0)
-
-    # warm starts: the previous pressure at the Gauss points (the system's unknowns)
+    # warm starts: the previous pressure at the Gauss points, or the slack QP's active rows
     return Discretisation(formulation="penalty", elasticity=elasticity, trace=trace, qp=qp,
                           recover=recover, row_coordinate=s_points.ravel(), system=system,
-                          qp_transfer=qp_transfer)
+                          qp_transfer=lambda previous: slack_warm_start(
+                              previous.pressure_at(s_points.ravel()) > 0))

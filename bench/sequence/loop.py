@@ -115,6 +115,14 @@ def refine(mesh: MeshTri, sol, est, config: LoopConfig) -> MeshTri:
     return refinement(mesh, sol, est, config).refined
 
 
+def target_reason(config: LoopConfig, est) -> str | None:
+    """Why the sequence ends at this level: its guaranteed bound reached
+    ``config.target_error``; None if it did not."""
+    if config.target_error is None or not est.guaranteed or est.eta > config.target_error:
+        return None
+    return f"target reached: guaranteed eta={est.eta:.4g} <= {config.target_error:g}"
+
+
 def memory_refusal(level: int, ndofs: int, solver: str, config: LoopConfig) -> str | None:
     """Why a level of ``ndofs`` unknowns must not be built (its predicted peak memory does not
     fit), or None."""
@@ -178,11 +186,9 @@ def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
                 numbers.update(error_columns(truth, sol, est))
             if solver != REFERENCE_SOLVER and disc.ndofs <= crosscheck_dofs:
                 numbers.update(crosscheck_columns(disc, sol))
-        reached = (not failed and config.target_error is not None and est.guaranteed
-                   and est.eta <= config.target_error)
+        reached = None if failed else target_reason(config, est)
         if reached:
-            numbers["reason"] = (f"{numbers['reason']}; " if numbers["reason"] else "") + (
-                f"target reached: guaranteed eta={est.eta:.4g} <= {config.target_error:g}")
+            numbers["reason"] = "; ".join(filter(None, (numbers["reason"], reached)))
         yield LevelResult(ResultRow(**ident, **numbers), sol, est)
         if failed:
             return "failed"
