@@ -28,7 +28,7 @@ class DofBasis(CellBasis):
 
     def __init__(self, mesh: MeshTri, elem: Element):
         super().__init__(mesh, elem, quadrature=_NO_POINTS)  # numbering and maps, no values
-        del self.basis  # the empty list scikit-fem made: the cached property below answers
+        self.__dict__.pop("basis", None)  # scikit-fem's empty list: the property below answers
         self.X, self.W = CENTROID_RULE
         self.dx = np.abs(self.mapping.detDF(self.X)) * np.broadcast_to(self.W, (self.nelems, 1))
 
