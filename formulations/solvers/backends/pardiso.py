@@ -51,26 +51,15 @@ def _pardiso():
     return function
 
 
-def upper_triangle(K: sparse.spmatrix) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The CSR arrays (data, indptr, indices; int32, sorted columns) of K's upper triangle,
-    by one mask over the entries (scipy's ``triu`` goes through COO: 0.35-0.47 s against
-    about 0.1 s at 10^6 DOFs)."""
-    csr = sparse.csr_matrix(K)
-    csr.sort_indices()
-    rows = np.repeat(np.arange(csr.shape[0], dtype=np.int32), np.diff(csr.indptr))
-    keep = csr.indices >= rows
-    kept = np.concatenate([[0], np.cumsum(keep, dtype=np.int64)])
-    return (np.ascontiguousarray(csr.data[keep], dtype=np.float64),
-            kept[csr.indptr].astype(np.int32), csr.indices[keep].astype(np.int32))
-
-
 class _Handle:
     """One PARDISO factorisation of an SPD K (its upper triangle); freed with the object."""
 
     def __init__(self, K: sparse.csc_matrix, schur: np.ndarray | None = None):
-        data, indptr, indices = upper_triangle(K)
+        upper = sparse.triu(K, format="csr")
+        upper.sort_indices()
         self.n = K.shape[0]
-        self.arrays = (data, indptr, indices,
+        self.arrays = (np.ascontiguousarray(upper.data, dtype=np.float64),
+                       upper.indptr.astype(np.int32), upper.indices.astype(np.int32),
                        np.zeros(64, dtype=np.int64), np.zeros(64, dtype=np.int32),
                        np.zeros(self.n, dtype=np.int32))
         iparm, perm = self.arrays[4], self.arrays[5]
