@@ -7,7 +7,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from formulations.base import STATUS_FAILED, ContactQP, DiscreteSolution, QPSolution, Residuals
+from formulations.base import (
+    STATUS_FAILED,
+    ContactQP,
+    DiscreteSolution,
+    QPSolution,
+    Residuals,
+    slack_warm_start,
+)
 from formulations.contact import ContactTrace
 from formulations.elasticity import Elasticity
 from formulations.kkt import final_status, qp_residuals
@@ -38,21 +45,21 @@ class Discretisation:
     multiplier_gram: np.ndarray | None = None
     system: SemismoothSystem | None = None
     no_qp: str = ""  # why qp is None
-    # the QP's own warm start where its rows are not the system's points (a slack QP)
-    qp_transfer: Callable[[DiscreteSolution], np.ndarray] | None = None
+    # the QP is the system's slack form (formulations.base.slack_qp): per point of the system,
+    # a row u_n - s <= g and a row s >= 0
+    qp_is_slack_form: bool = False
 
     def warm_start(self, previous: DiscreteSolution, solver: str | None = None) -> np.ndarray:
         """Initial multipliers for the problem ``solver`` solves (the system if it has a method
         for it, else the QP) from a solution on another (coarser) mesh: the previous lambda_h
         at each constraint row's place on Gamma_C (nested iteration), unless the formulation's
-        rows need their own ``transfer`` (``qp_transfer`` for the QP of a formulation that also
-        has a system)."""
-        if (solver is not None and self.qp_transfer is not None
-                and not uses_system(self, solver)):
-            return self.qp_transfer(previous)
-        if self.transfer is not None:
-            return self.transfer(previous)
-        return previous.pressure_at(self.row_coordinate)
+        rows need their own ``transfer``; for a slack-form QP, which of each point's two rows
+        is active."""
+        values = (self.transfer(previous) if self.transfer is not None
+                  else previous.pressure_at(self.row_coordinate))
+        if self.qp_is_slack_form and solver is not None and not uses_system(self, solver):
+            return slack_warm_start(values > 0)
+        return values
 
     @property
     def ndofs(self) -> int:

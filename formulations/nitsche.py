@@ -35,14 +35,7 @@ import numpy as np
 from scipy import sparse
 from skfem import MeshTri
 
-from formulations.base import (
-    ContactQP,
-    DiscreteSolution,
-    QPSolution,
-    Residuals,
-    slack_qp,
-    slack_warm_start,
-)
+from formulations.base import ContactQP, DiscreteSolution, QPSolution, Residuals, slack_qp
 from formulations.contact import contact_trace, gap_interpolant, gauss_legendre
 from formulations.discretisation import Discretisation, discrete_solution
 from formulations.elasticity import assemble_elasticity, check_order
@@ -153,6 +146,6 @@ def discretise(scene: Scene, mesh: MeshTri, theta: float = 1.0,
         formulation="nitsche", elasticity=elasticity, trace=trace,
         qp=convex_form(system) if symmetric else None, recover=recover,
         row_coordinate=s_points, transfer=transfer, system=system,
-        qp_transfer=lambda previous: slack_warm_start(transfer(previous) > 0),
+        qp_is_slack_form=True,
         no_qp="" if symmetric else f"theta={theta:g} is not the optimality condition of a "
                                    "convex functional (only theta = 1 is)")

@@ -51,7 +51,6 @@ from formulations.base import (
     QPSolution,
     Residuals,
     slack_qp,
-    slack_warm_start,
 )
 from formulations.contact import (
     contact_trace,
@@ -182,8 +181,7 @@ def discretise(scene: Scene, mesh: MeshTri, epsilon_0: float = DEFAULT_EPSILON_0
             pressure_mismatch=mismatch,
             details=PenaltyDetails(epsilon_0=epsilon_0, epsilon=epsilon, slacks=slacks))
 
-    # warm starts: the previous pressure at the Gauss points, or the slack QP's active rows
+    # warm starts: the previous pressure at the Gauss points (the system's unknowns)
     return Discretisation(formulation="penalty", elasticity=elasticity, trace=trace, qp=qp,
                           recover=recover, row_coordinate=s_points.ravel(), system=system,
-                          qp_transfer=lambda previous: slack_warm_start(
-                              previous.pressure_at(s_points.ravel()) > 0))
+                          qp_is_slack_form=True)
