@@ -6,11 +6,12 @@ smaller coordinate. Normals are OUTER unit normals (docs/theory.md, section 1).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from skfem import MeshTri
 
+from formulations.contact_surface import contact_surface, triangle_lagrange
 from scenes import Scene
 
 
@@ -36,10 +37,25 @@ class ContactTrace:
     length: np.ndarray
     coordinate: np.ndarray
     element: np.ndarray
+    dim = 2  # of the body (``formulations.contact_surface.ContactSurface`` is the 3D one)
 
     @property
     def size(self) -> int:
         return int(self.facets.size)
+
+    @property
+    def measure(self) -> np.ndarray:
+        """The facets' measures (lengths): what ``ContactSurface.measure`` is in 3D."""
+        return self.length
+
+    @property
+    def diameter(self) -> np.ndarray:
+        return self.length
+
+    @staticmethod
+    def rule(degree: int) -> tuple[np.ndarray, np.ndarray]:
+        """The Gauss-Legendre rule exact to ``degree`` (``(degree + 2) // 2`` points)."""
+        return gauss_legendre((int(degree) + 2) // 2)
 
     def points(self, t: np.ndarray) -> np.ndarray:
         """Points at local coordinates t in [0, 1] on each facet; shape (2, n, len(t))."""
@@ -58,9 +74,29 @@ class ContactTrace:
         a, b = self.mesh.p[:, self.vertices[0]], self.mesh.p[:, self.vertices[1]]
         return (b - a) / self.length
 
+    @staticmethod
+    def interpolation(points: np.ndarray, t: np.ndarray) -> np.ndarray:
+        """The Lagrange polynomials on ``points`` (k,) at t; shape (k, len(t))."""
+        return lagrange_basis(points, t)
+
     def integrate(self, values: np.ndarray, w: np.ndarray) -> np.ndarray:
         """Per-facet integrals of ``values`` (n, nq) given at points with weights w on [0, 1]."""
         return (values * w[None, :]).sum(axis=1) * self.length
+
+
+@dataclass(frozen=True, eq=False)
+class TraceNodes:
+    """The Lagrange nodes of the displacement on Gamma_C: the facet end vertices, then the
+    p - 1 nodes inside every facet. ``facet_rows`` (n_facets, p + 1) gives, per facet, the row
+    of each node in order of t = k / p."""
+
+    points: np.ndarray        # (2, m)
+    normal: np.ndarray        # (2, m) unit, length-weighted mean at a vertex
+    weight: np.ndarray        # (m,) int_{Gamma_C} phi_i ds (lumped boundary mass)
+    facet_rows: np.ndarray    # (n_facets, p + 1); 3D: (n_facets, 3 or 6), ElementTriP2's order
+    vertices: np.ndarray      # mesh vertex of each of the first rows
+    edges: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))  # 3D P2: then
+    # the mesh edge of each midpoint row
 
 
 def lagrange_nodes(order: int) -> np.ndarray:
@@ -104,7 +140,10 @@ def outer_normals(mesh: MeshTri, v0: np.ndarray, v1: np.ndarray, element: np.nda
     return length, normal
 
 
-def contact_trace(scene: Scene, mesh: MeshTri) -> ContactTrace:
+def contact_trace(scene: Scene, mesh: MeshTri):
+    """Gamma_C of ``mesh``: a ``ContactTrace`` (2D) or a ``ContactSurface`` (3D)."""
+    if mesh.dim() == 3:
+        return contact_surface(scene, mesh)
     facets = scene.contact_facets(mesh)
     v0, v1 = mesh.facets[0, facets], mesh.facets[1, facets]
     s0 = scene.contact_coordinate(mesh.p[:, v0])
@@ -126,6 +165,10 @@ def gap_interpolant(scene: Scene, trace, order: int):
     local coordinates t (n_facets, len(t)). The penalty and Nitsche's method use it
     (docs/theory.md, sections 3 and 12) so that g - g_h, multiplied by 1/eps or gamma, cannot
     spoil lambda_h between quadrature points."""
+    if trace.dim == 3:
+        nodes, basis = triangle_lagrange(order)
+        values = np.asarray(scene.gap(trace.points(nodes)), dtype=float)  # (n, k)
+        return lambda t: values @ basis(np.asarray(t, dtype=float))
     nodes = lagrange_nodes(order)
     values = np.asarray(scene.gap(trace.points(nodes).reshape(2, -1)),
                         dtype=float).reshape(trace.size, nodes.size)

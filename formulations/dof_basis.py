@@ -19,7 +19,8 @@ from skfem import CellBasis, MeshTri
 from skfem.element import Element
 
 CENTROID_RULE = (np.full((2, 1), 1.0 / 3.0), np.array([0.5]))  # reference triangle, weight = area
-_NO_POINTS = (np.zeros((2, 0)), np.zeros(0))
+# the reference tetrahedron's centroid, weight its volume
+TET_CENTROID_RULE = (np.full((3, 1), 1.0 / 4.0), np.array([1.0 / 6.0]))
 
 
 class DofBasis(CellBasis):
@@ -27,9 +28,11 @@ class DofBasis(CellBasis):
     gradients there) is computed when first asked for; otherwise scikit-fem's own."""
 
     def __init__(self, mesh: MeshTri, elem: Element):
-        super().__init__(mesh, elem, quadrature=_NO_POINTS)  # numbering and maps, no values
+        d = mesh.dim()
+        # numbering and maps, no values
+        super().__init__(mesh, elem, quadrature=(np.zeros((d, 0)), np.zeros(0)))
         self.__dict__.pop("basis", None)  # scikit-fem's empty list: the property below answers
-        self.X, self.W = CENTROID_RULE
+        self.X, self.W = CENTROID_RULE if d == 2 else TET_CENTROID_RULE
         self.dx = np.abs(self.mapping.detDF(self.X)) * np.broadcast_to(self.W, (self.nelems, 1))
 
     @functools.cached_property

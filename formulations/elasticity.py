@@ -1,5 +1,5 @@
-"""Lagrange P_p (p = 1, 2, 3; triangles) linear elasticity on scikit-fem: stiffness, loads,
-stresses (docs/theory.md, sections 1 and 9).
+"""Lagrange P_p (p = 1, 2, 3 on triangles; p = 1, 2 on tetrahedra) linear elasticity on
+scikit-fem: stiffness, loads, stresses (docs/theory.md, sections 1, 9 and 13).
 
 Plane stress uses lambda* = E nu / (1 - nu^2), plane strain lambda = E nu / ((1+nu)(1-2nu)).
 Everything is vectorised over elements by scikit-fem's assembly.
@@ -14,6 +14,8 @@ import numpy as np
 from scipy import sparse
 from skfem import (
     Basis,
+    ElementTetP1,
+    ElementTetP2,
     ElementTriP1,
     ElementTriP2,
     ElementTriP3,
@@ -36,6 +38,12 @@ from scenes.topology import RefinementPlan, ensure_topology
 
 ELEMENTS = {1: ElementTriP1, 2: ElementTriP2, 3: ElementTriP3}
 ORDERS = tuple(ELEMENTS)
+TET_ELEMENTS = {1: ElementTetP1, 2: ElementTetP2}  # scikit-fem has no P3 tetrahedron
+
+
+def scalar_elements(dim: int) -> dict:
+    """The scalar Lagrange elements by order on a mesh of dimension ``dim``."""
+    return ELEMENTS if dim == 2 else TET_ELEMENTS
 
 
 def order_descriptions() -> dict[str, str]:
@@ -51,9 +59,18 @@ def check_order(order) -> int:
     return int(order)
 
 
-def vector_element(order: int = 1) -> ElementVector:
-    """The displacement element: vector Lagrange P_order on triangles."""
-    return ElementVector(ELEMENTS[check_order(order)]())
+def check_order_in(order, dim: int) -> int:
+    """``check_order``, and refused in 3D above the orders tetrahedra have here."""
+    order = check_order(order)
+    if order not in scalar_elements(dim):
+        raise ValueError(f"order={order!r} is not one of "
+                         f"{', '.join(map(str, scalar_elements(dim)))} in {dim}D")
+    return order
+
+
+def vector_element(order: int = 1, dim: int = 2) -> ElementVector:
+    """The displacement element: vector Lagrange P_order on triangles (tetrahedra in 3D)."""
+    return ElementVector(scalar_elements(dim)[check_order_in(order, dim)]())
 
 
 @dataclass(frozen=True, eq=False)
@@ -90,7 +107,7 @@ class Elasticity:
         return float(0.5 * u @ (self.K @ u) - self.F @ u)
 
     def nodal(self, u: np.ndarray) -> np.ndarray:
-        """Displacement at the mesh vertices, shape (2, n_vertices) (for every order: the
+        """Displacement at the mesh vertices, shape (d, n_vertices) (for every order: the
         vertex DOFs of a Lagrange element are the values there)."""
         return u[self.basis.nodal_dofs]
 
@@ -104,13 +121,22 @@ def dof_basis(mesh: MeshTri, order: int = 1) -> Basis:
     """The displacement basis an ``Elasticity`` carries: its DOF numbering, element maps and
     element, on the one-point centroid rule (nothing integrates with it: each integral builds
     the basis of its own rule, and the quadrature data of a default basis cost more than K)."""
-    return DofBasis(mesh, vector_element(order))
+    return DofBasis(mesh, vector_element(order, mesh.dim()))
 
 
 def element_diameters(mesh: MeshTri) -> np.ndarray:
-    """Longest edge of every triangle (h_T)."""
-    p = mesh.p[:, mesh.t]
-    return np.max([np.linalg.norm(p[:, i] - p[:, (i + 1) % 3], axis=0) for i in range(3)], axis=0)
+    """Longest edge of every triangle or tetrahedron (h_T)."""
+    p, k = mesh.p[:, mesh.t], mesh.t.shape[0]
+    return np.max([np.linalg.norm(p[:, i] - p[:, j], axis=0)
+                   for i in range(k) for j in range(i + 1, k)], axis=0)
+
+
+def stress_tensor_from_gradient(grad: np.ndarray, lam: float, mu: float) -> np.ndarray:
+    """sigma = lam tr(eps) I + 2 mu eps as the full (d, d, ...) tensor, in any dimension."""
+    d = grad.shape[0]
+    strain = 0.5 * (grad + np.swapaxes(grad, 0, 1))
+    trace = np.trace(grad)
+    return 2 * mu * strain + lam * trace * np.eye(d).reshape((d, d) + (1,) * (grad.ndim - 2))
 
 
 def stress_from_gradient(grad: np.ndarray, lam: float, mu: float) -> np.ndarray:
@@ -131,11 +157,14 @@ def von_mises(stress: np.ndarray) -> np.ndarray:
 def assemble_elasticity(scene: Scene, mesh: MeshTri, order: int = 1) -> Elasticity:
     """Stiffness K, load F = (f, v) + (q, v)_{Gamma_N}, and the free DOFs for ``mesh`` with
     P_order displacements."""
-    order = check_order(order)
+    order = check_order_in(order, mesh.dim())
     ensure_topology(mesh)
     basis = dof_basis(mesh, order)
     lam, mu = scene.material.lame
-    if order == 1:  # constant strains: the closed-form local matrices (formulations.p1_stiffness)
+    if mesh.dim() == 3:  # strain products have degree 2(p - 1): a rule of that order is exact
+        K = asm(linear_elasticity(lam, mu),
+                Basis(mesh, basis.elem, intorder=max(2 * (order - 1), 1))).tocsr()
+    elif order == 1:  # constant strains: the closed-form local matrices (formulations.p1_stiffness)
         K = p1_stiffness(mesh, lam, mu)
     elif order == 2:  # the same straight into CSR (formulations.p2_stiffness)
         K = p2_stiffness(mesh, lam, mu)
@@ -153,10 +182,15 @@ def assemble_elasticity(scene: Scene, mesh: MeshTri, order: int = 1) -> Elastici
 
         F += asm(surface, FacetBasis(mesh, basis.elem, facets=neumann,
                                      intorder=max(4, 2 * order)))
-    is_free = np.ones(basis.N, dtype=bool)  # a mask, not a sorted set difference: O(N)
-    is_free[basis.get_dofs(scene.dirichlet_facets(mesh)).all()] = False
-    free = np.flatnonzero(is_free)
+    free = free_dofs(basis, scene.dirichlet_facets(mesh))
     return Elasticity(mesh=mesh, basis=basis, lame=(lam, mu), K=K, F=F, free=free, order=order)
+
+
+def free_dofs(basis: Basis, dirichlet: np.ndarray) -> np.ndarray:
+    """The DOFs not on a clamped facet, sorted."""
+    is_free = np.ones(basis.N, dtype=bool)  # a mask, not a sorted set difference: O(N)
+    is_free[basis.get_dofs(dirichlet).all()] = False
+    return np.flatnonzero(is_free)
 
 
 def lagrange_dofs(vertices: int, edges: int, triangles: int, order: int) -> int:
@@ -168,6 +202,10 @@ def count_free_dofs(scene: Scene, mesh: MeshTri, order: int = 1) -> int:
     """The number of unknowns ``assemble_elasticity`` would give on ``mesh``, without
     assembling: two per Lagrange node, none on a node of a clamped facet."""
     dirichlet = scene.dirichlet_facets(mesh)
+    if mesh.dim() == 3:  # P1, P2: one node per vertex, p - 1 per edge
+        clamped = (np.unique(mesh.facets[:, dirichlet]).size
+                   + (order - 1) * np.unique(mesh.f2e[:, dirichlet]).size)
+        return int(3 * (mesh.p.shape[1] + (order - 1) * mesh.edges.shape[1] - clamped))
     clamped = np.unique(mesh.facets[:, dirichlet]).size + (order - 1) * dirichlet.size
     nodes = lagrange_dofs(mesh.p.shape[1], mesh.facets.shape[1], mesh.t.shape[1], order)
     return int(2 * (nodes - clamped))
@@ -180,6 +218,8 @@ def predict_refined_free_dofs(scene: Scene, plan: RefinementPlan, order: int = 1
     that scikit-fem carries out itself is counted after refining (uniform ones by
     ``predict_uniform_free_dofs``)."""
     mesh = plan.mesh
+    if mesh.dim() == 3:
+        return count_free_dofs(scene, plan.refined, order)
     if plan.split is None:
         return (predict_uniform_free_dofs(scene, mesh, order) if plan.marked is None
                 else count_free_dofs(scene, plan.refined, order))

@@ -47,7 +47,7 @@ class PointEvaluation:
         """The sparse operator u -> sigma_nn(u_h)(x_i) = n_i . sigma(u_h) n_i with
         sigma = lam tr(eps) I + 2 mu eps (docs/theory.md, section 1)."""
         lam, mu = lame
-        vals = np.concatenate([lam * (g[0, 0] + g[1, 1])
+        vals = np.concatenate([lam * np.trace(g)
                                + 2 * mu * np.einsum("in,ijn,jn->n", normal, g, normal)
                                for g in self.gradients])
         rows = np.tile(np.arange(self.size), len(self.gradients))
@@ -55,18 +55,18 @@ class PointEvaluation:
         return sparse.csr_matrix((vals, (rows, cols)), shape=(self.size, self.basis.N))
 
     def value(self, u: np.ndarray) -> np.ndarray:
-        """u_h at the points, shape (2, n)."""
+        """u_h at the points, shape (d, n)."""
         dofs = self.basis.element_dofs[:, self.cells]
         return sum(v * u[dofs[k]] for k, v in enumerate(self.values))
 
     def gradient(self, u: np.ndarray) -> np.ndarray:
-        """grad u_h at the points, grad[i, j] = d u_i / d x_j; shape (2, 2, n)."""
+        """grad u_h at the points, grad[i, j] = d u_i / d x_j; shape (d, d, n)."""
         dofs = self.basis.element_dofs[:, self.cells]
         return sum(g * u[dofs[k]] for k, g in enumerate(self.gradients))
 
 
 def evaluate_at(basis: Basis, x: np.ndarray, cells: np.ndarray) -> PointEvaluation:
-    """The basis functions of ``basis`` at points ``x`` (2, n) lying in elements ``cells``."""
+    """The basis functions of ``basis`` at points ``x`` (d, n) lying in elements ``cells``."""
     X = basis.mapping.invF(x[:, :, None], tind=cells)
     if isinstance(basis.elem, ElementVector) and isinstance(basis.elem.elem, ElementH1):
         values, gradients = _vector_h1_at(basis, X, cells)
@@ -80,15 +80,16 @@ def evaluate_at(basis: Basis, x: np.ndarray, cells: np.ndarray) -> PointEvaluati
 
 def _vector_h1_at(basis: Basis, X: np.ndarray, cells: np.ndarray):
     """What ``gbasis`` gives for vector Lagrange elements, with the inverse Jacobian computed
-    once instead of once per basis function (vector function k = 2 j + c is the scalar
+    once instead of once per basis function (vector function k = d j + c is the scalar
     function j in component c, scikit-fem's order)."""
-    inverse = basis.mapping.invDF(X, tind=cells)[..., 0]  # (2, 2, n)
+    inverse = basis.mapping.invDF(X, tind=cells)[..., 0]  # (d, d, n)
+    d = inverse.shape[0]
     values, gradients = [], []
-    for j in range(basis.Nbfun // 2):
+    for j in range(basis.Nbfun // d):
         phi, dphi = basis.elem.elem.lbasis(X, j)
         grad = np.einsum("ijn,in->jn", inverse, dphi[..., 0])
-        for c in range(2):
-            value, gradient = np.zeros((2, cells.size)), np.zeros((2, 2, cells.size))
+        for c in range(d):
+            value, gradient = np.zeros((d, cells.size)), np.zeros((d, d, cells.size))
             value[c], gradient[c] = phi[..., 0], grad
             values.append(value)
             gradients.append(gradient)
@@ -96,22 +97,25 @@ def _vector_h1_at(basis: Basis, X: np.ndarray, cells: np.ndarray):
 
 
 def evaluate_on_trace(basis: Basis, trace, t: np.ndarray) -> PointEvaluation:
-    """The basis functions at local coordinates ``t`` of every contact facet of ``trace``
-    (facet f, point q -> point f * len(t) + q)."""
+    """The basis functions at local coordinates ``t`` ((nq,) on segments, (2, nq) on
+    triangles) of every contact facet of ``trace`` (facet f, point q -> point f * nq + q)."""
     t = np.asarray(t, dtype=float)
-    return evaluate_at(basis, trace.points(t).reshape(2, -1), np.repeat(trace.element, t.size))
+    nq = t.shape[-1]
+    return evaluate_at(basis, trace.points(t).reshape(trace.dim, -1),
+                       np.repeat(trace.element, nq))
 
 
 def normal_trace_matrix(basis: Basis, trace, t: np.ndarray) -> sparse.csr_matrix:
-    """u -> u_h . n at local coordinates ``t`` of every contact facet (row f * len(t) + q), on
+    """u -> u_h . n at local coordinates ``t`` of every contact facet (row f * nq + q), on
     all DOFs."""
     t = np.asarray(t, dtype=float)
-    return evaluate_on_trace(basis, trace, t).matrix(np.repeat(trace.normal, t.size, axis=1))
+    return evaluate_on_trace(basis, trace, t).matrix(np.repeat(trace.normal, t.shape[-1],
+                                                               axis=1))
 
 
 def gradients_at_reference(basis: Basis, u: np.ndarray, X: np.ndarray) -> np.ndarray:
-    """grad u_h at the same reference points X (2, nX) of every element; shape
-    (2, 2, n_elements, nX), element-major. Vector Lagrange elements on affine meshes: the
+    """grad u_h at the same reference points X (d, nX) of every element; shape
+    (d, d, n_elements, nX), element-major. Vector Lagrange elements on affine meshes: the
     reference gradients of the scalar functions (the same for every element) through each
     element's inverse Jacobian (no basis object at the points); others: scikit-fem's
     interpolation."""
@@ -120,12 +124,13 @@ def gradients_at_reference(basis: Basis, u: np.ndarray, X: np.ndarray) -> np.nda
                                and isinstance(basis.elem.elem, ElementH1)):
         at = Basis(basis.mesh, basis.elem, quadrature=(X, np.ones(X.shape[1])))
         return at.interpolate(u).grad
-    out = np.zeros((2, 2, inverse.shape[2], X.shape[1]))
-    for j in range(basis.Nbfun // 2):
-        _, reference = basis.elem.elem.lbasis(X, j)  # (2, nX)
+    d = inverse.shape[0]
+    out = np.zeros((d, d, inverse.shape[2], X.shape[1]))
+    for j in range(basis.Nbfun // d):
+        _, reference = basis.elem.elem.lbasis(X, j)  # (d, nX)
         gradient = np.einsum("rde,rq->deq", inverse, reference)  # of scalar function j
-        for c in range(2):  # vector function 2 j + c: scalar function j in component c
-            out[c] += u[basis.element_dofs[2 * j + c]][None, :, None] * gradient
+        for c in range(d):  # vector function d j + c: scalar function j in component c
+            out[c] += u[basis.element_dofs[d * j + c]][None, :, None] * gradient
     return out
 
 
@@ -138,11 +143,12 @@ def p1_gradients(basis: Basis, u: np.ndarray) -> np.ndarray:
 
 
 def gradients_at(basis: Basis, u: np.ndarray, x: np.ndarray, cells: np.ndarray) -> np.ndarray:
-    """grad u_h at many points (2, n) in elements ``cells``, in blocks of CHUNK points;
-    shape (2, 2, n)."""
-    if basis.elem.maxdeg == 1 and isinstance(basis.elem, ElementVector):  # constant per element
-        return p1_gradients(basis, u)[:, :, cells]
-    out = np.empty((2, 2, x.shape[1]))
+    """grad u_h at many points (d, n) in elements ``cells``, in blocks of CHUNK points;
+    shape (d, d, n)."""
+    d = x.shape[0]
+    if basis.elem.maxdeg == 1 and isinstance(basis.elem, ElementVector) and d == 2:
+        return p1_gradients(basis, u)[:, :, cells]  # constant per triangle
+    out = np.empty((d, d, x.shape[1]))
     for start in range(0, x.shape[1], CHUNK):
         block = slice(start, start + CHUNK)
         out[:, :, block] = evaluate_at(basis, x[:, block], cells[block]).gradient(u)

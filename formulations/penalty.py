@@ -52,12 +52,7 @@ from formulations.base import (
     Residuals,
     slack_qp,
 )
-from formulations.contact import (
-    contact_trace,
-    gap_interpolant,
-    gauss_legendre,
-    lagrange_basis,
-)
+from formulations.contact import contact_trace, gap_interpolant
 from formulations.discretisation import Discretisation, discrete_solution
 from formulations.elasticity import assemble_elasticity, check_order
 from formulations.evaluation import normal_trace_matrix
@@ -105,8 +100,9 @@ def pressure_mismatch(penetration: np.ndarray, epsilon: np.ndarray, multipliers:
 def penalty_pressure(elasticity, trace, gap_h, epsilon: np.ndarray, u_free: np.ndarray,
                      penetration_at_points: np.ndarray, t: np.ndarray):
     """lambda_h(t) on every contact facet (module docstring): (u_hn - g_h)_+ / eps for P1; for
-    p >= 2 the degree-p interpolant of its values at the p + 1 Gauss points ``t``, clipped at 0
-    (the same polynomial where a facet penetrates throughout)."""
+    p >= 2 the degree-p interpolant of its values at the quadrature points ``t`` (p + 1 Gauss
+    points in 2D, the 6 points of the degree-4 rule on triangles), clipped at 0 (the same
+    polynomial where a facet penetrates throughout)."""
     if elasticity.order == 1:
         u_full = elasticity.expand(u_free)
 
@@ -120,7 +116,7 @@ def penalty_pressure(elasticity, trace, gap_h, epsilon: np.ndarray, u_free: np.n
     at_points = penetration_at_points / epsilon[:, None]  # (n_facets, p + 1)
 
     def interpolant(tt):
-        return np.maximum(at_points @ lagrange_basis(t, np.asarray(tt, dtype=float)), 0.0)
+        return np.maximum(at_points @ trace.interpolation(t, np.asarray(tt, dtype=float)), 0.0)
 
     return interpolant
 
@@ -135,25 +131,27 @@ def discretise(scene: Scene, mesh: MeshTri, epsilon_0: float = DEFAULT_EPSILON_0
     order = elasticity.order
     trace = contact_trace(scene, mesh)
     young = float(scene.material.young_modulus)
-    t, w = gauss_legendre(order + 1)
-    nf, nq = trace.size, t.size
+    t, w = trace.rule(2 * order)  # 2D: the p + 1 Gauss points; 3D: 3 (P1) or 6 (P2) points
+    nf, nq = trace.size, t.shape[-1]
     n = elasticity.free.size
     ns = nf * nq
     gap_h = gap_interpolant(scene, trace, order)
     gap = gap_h(t)
     P = normal_trace_matrix(elasticity.basis, trace, t)[:, elasticity.free].tocsr()
-    epsilon = epsilon_0 * trace.length / (order**2 * young)
-    # per Gauss point: eps, and Gauss weight x facet length (its share of Gamma_C)
-    row_epsilon, row_length = np.repeat(epsilon, nq), np.tile(w, nf) * np.repeat(trace.length, nq)
+    epsilon = epsilon_0 * trace.diameter / (order**2 * young)
+    # per Gauss point: eps, and Gauss weight x facet measure (its share of Gamma_C)
+    row_epsilon, row_length = np.repeat(epsilon, nq), np.tile(w, nf) * np.repeat(trace.measure,
+                                                                                 nq)
     system = SemismoothSystem(K=elasticity.K_free, F=elasticity.F[elasticity.free],
                               S=sparse.csr_matrix((0, n)), N=P, gap=gap.ravel(),
                               weight=row_length, gamma=1.0 / row_epsilon, theta=0.0,
                               objective_scale=young)
-    # D_q = w_q h_e / eps_e = p^2 E w_q / eps_0
+    # D_q = w_q |e| / eps_e = p^2 E w_q / eps_0 (|e| / h_e: 1 in 2D, exactly)
     qp = slack_qp(elasticity.K_free, elasticity.F[elasticity.free], P, gap.ravel(),
-                  order**2 * young / epsilon_0 * np.tile(w, nf), young)
+                  order**2 * young / epsilon_0 * np.tile(w, nf)
+                  * np.repeat(trace.measure / trace.diameter, nq), young)
     s_points = trace.coordinates_at(t)
-    pressure_floor = young * np.abs(gap).max(initial=0.0) / trace.length.sum()
+    pressure_floor = young * np.abs(gap).max(initial=0.0) / trace.measure.sum()
 
     def recover(answer: QPSolution, residuals: Residuals, status: str,
                 reason: str) -> DiscreteSolution:
@@ -175,13 +173,16 @@ def discretise(scene: Scene, mesh: MeshTri, epsilon_0: float = DEFAULT_EPSILON_0
         penetrating = int((penetration_at_points > 0).sum())
         return discrete_solution(
             "penalty", elasticity, trace, answer, residuals, status, reason, u_free=u_free,
-            pressure=pressure, multiplier_breaks=np.append(trace.coordinate[0],
-                                                           trace.coordinate[1, -1]),
+            pressure=pressure, multiplier_breaks=(
+                np.append(trace.coordinate[0], trace.coordinate[1, -1]) if trace.dim == 2
+                else np.zeros(0)),
             active_constraints=penetrating,
             pressure_mismatch=mismatch,
             details=PenaltyDetails(epsilon_0=epsilon_0, epsilon=epsilon, slacks=slacks))
 
     # warm starts: the previous pressure at the Gauss points (the system's unknowns)
     return Discretisation(formulation="penalty", elasticity=elasticity, trace=trace, qp=qp,
-                          recover=recover, row_coordinate=s_points.ravel(), system=system,
+                          recover=recover,
+                          row_coordinate=s_points.reshape(-1) if trace.dim == 2
+                          else s_points.reshape(2, -1), system=system,
                           qp_is_slack_form=True)

@@ -21,12 +21,19 @@ from scipy import sparse
 from skfem import MeshTri
 
 from formulations.base import ContactQP, DiscreteSolution, QPSolution, Residuals
-from formulations.contact import contact_trace, gauss_legendre, lagrange_basis_1d, lagrange_nodes
+from formulations.contact import (
+    TraceNodes,
+    contact_trace,
+    gauss_legendre,
+    lagrange_basis_1d,
+    lagrange_nodes,
+)
 from formulations.discretisation import Discretisation, discrete_solution
 from formulations.elasticity import assemble_elasticity, check_order
 from formulations.evaluation import evaluate_on_trace
 from formulations.kkt import count_active
 from formulations.registry import register_formulation
+from formulations.surface_nodes import surface_nodes, surface_pressure, surface_rows
 from scenes import Scene
 
 
@@ -46,19 +53,6 @@ def newton_cotes(order: int) -> np.ndarray:
     Simpson; 1/8, 3/8, 3/8, 1/8 for P3); all positive for p <= 3."""
     t, w = gauss_legendre(order + 1)
     return lagrange_basis_1d(order, t) @ w
-
-
-@dataclass(frozen=True, eq=False)
-class TraceNodes:
-    """The Lagrange nodes of the displacement on Gamma_C: the facet end vertices, then the
-    p - 1 nodes inside every facet. ``facet_rows`` (n_facets, p + 1) gives, per facet, the row
-    of each node in order of t = k / p."""
-
-    points: np.ndarray        # (2, m)
-    normal: np.ndarray        # (2, m) unit, length-weighted mean at a vertex
-    weight: np.ndarray        # (m,) int_{Gamma_C} phi_i ds (lumped boundary mass)
-    facet_rows: np.ndarray    # (n_facets, p + 1)
-    vertices: np.ndarray      # mesh vertex of each of the first rows
 
 
 def trace_nodes(mesh: MeshTri, trace, order: int) -> TraceNodes:
@@ -104,9 +98,13 @@ def constraint_rows(elasticity, trace, nodes: TraceNodes) -> sparse.csr_matrix:
 def discretise(scene: Scene, mesh: MeshTri, order: int = 1) -> Discretisation:
     elasticity = assemble_elasticity(scene, mesh, check_order(order))
     trace = contact_trace(scene, mesh)
-    nodes = trace_nodes(mesh, trace, elasticity.order)
+    if trace.dim == 3:
+        nodes = surface_nodes(mesh, trace, elasticity.order)
+        B = surface_rows(elasticity, nodes)
+    else:
+        nodes = trace_nodes(mesh, trace, elasticity.order)
+        B = constraint_rows(elasticity, trace, nodes)
     m = nodes.weight.size
-    B = constraint_rows(elasticity, trace, nodes)
     G = np.asarray(scene.gap(nodes.points), dtype=float)
     # rows of B are dimensionless (a normal), so the multipliers are forces; row_scale 1
     qp = ContactQP(K=elasticity.K_free, F=elasticity.F[elasticity.free],
@@ -122,13 +120,16 @@ def discretise(scene: Scene, mesh: MeshTri, order: int = 1) -> Discretisation:
         values = lam[nodes.facet_rows]  # (n_facets, p + 1)
 
         def pressure(t):
+            if trace.dim == 3:
+                return surface_pressure(values, t)
             x = np.clip(np.asarray(t, dtype=float), 0.0, 1.0) * pieces
             k = np.minimum(np.floor(x).astype(int), pieces - 1)
             return values[:, k] + (values[:, k + 1] - values[:, k]) * (x - k)[None, :]
 
         return discrete_solution(
             "vi", elasticity, trace, answer, residuals, status, reason, u_free=answer.u,
-            pressure=pressure, multiplier_breaks=np.sort(coordinate),
+            pressure=pressure,
+            multiplier_breaks=np.sort(coordinate) if trace.dim == 2 else np.zeros(0),
             active_constraints=count_active(qp, answer.u, reaction),
             details=NodalDetails(reactions=reaction, nodal_pressure=lam,
                                  contact_nodes=nodes.vertices))

@@ -4,7 +4,15 @@ Importing this package registers every scene module listed below; adding a scene
 module with a ``@register_scene`` factory and one import line here.
 """
 
-from scenes import free_boundary, hard, hertz, paper  # noqa: F401  (register themselves)
+from scenes import (  # noqa: F401  (register themselves)
+    free_boundary,
+    free_boundary_3d,
+    hard,
+    hertz,
+    hertz_3d,
+    paper,
+    paper_3d,
+)
 from scenes.base import ContactPrediction, ExactSolution, Material, Scene, SceneError
 from scenes.registry import get_scene, register_scene, scene_descriptions, scene_names
 

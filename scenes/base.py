@@ -12,10 +12,35 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
-from skfem import MeshTri
+from skfem import Mesh, MeshTri
 
 PointFunction = Callable[[np.ndarray], np.ndarray]
-"""A function of points ``x`` with shape (2, ...) returning values of shape (...) or (2, ...)."""
+"""A function of points ``x`` with shape (d, ...) (d = 2 or 3) returning values of shape (...)
+or (d, ...)."""
+
+# the corners of the reference triangle and its centroid, as (2, 4) local coordinates: where a
+# 3D scene's gap is checked on every contact facet
+TRIANGLE_CHECK_POINTS = np.array([[0.0, 1.0, 0.0, 1 / 3], [0.0, 0.0, 1.0, 1 / 3]])
+
+
+def simplex_points(corners: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """Points of facets with corner points ``corners`` (d, k, n) (k = 2: segments, k = 3:
+    triangles) at local coordinates t: (nq,) along a segment, (2, nq) in the reference triangle
+    (x = a + t_0 (b - a) + t_1 (c - a)); shape (d, n, nq)."""
+    t = np.asarray(t, dtype=float)
+    a = corners[:, 0][:, :, None]
+    if corners.shape[1] == 2:
+        return a + (corners[:, 1][:, :, None] - a) * t.reshape(1, 1, -1)
+    return (a + (corners[:, 1][:, :, None] - a) * t[0][None, None, :]
+            + (corners[:, 2][:, :, None] - a) * t[1][None, None, :])
+
+
+def simplex_measures(corners: np.ndarray) -> np.ndarray:
+    """Lengths of segments or areas of triangles with corner points ``corners`` (d, k, n)."""
+    if corners.shape[1] == 2:
+        return np.linalg.norm(corners[:, 1] - corners[:, 0], axis=0)
+    return 0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0],
+                                         corners[:, 2] - corners[:, 0], axis=0), axis=0)
 
 
 class SceneError(ValueError):
@@ -98,17 +123,19 @@ class ContactPrediction:
 
 @dataclass(frozen=True, eq=False)
 class Scene:
-    """A Signorini problem on a 2D body (docs/theory.md, section 2).
+    """A Signorini problem on a 2D or 3D body (docs/theory.md, sections 2 and 13).
 
     Boundary parts are given as predicates on facet midpoints; every boundary facet that is
     neither Dirichlet nor contact is a Neumann facet (traction ``traction``, zero if None).
     ``contact_coordinate`` maps points of Gamma_C to a monotone arclength-like coordinate,
-    used to order the contact facets (the multiplier mesh of the mixed method lives on it).
+    used to order the contact facets (the multiplier mesh of the mixed method lives on it); in
+    3D (a tetrahedral mesh) it maps points of Gamma_C to two coordinates (2, ...) on it, and the
+    material is the 3D one (``plane="strain"``: the same Lame parameters).
     """
 
     name: str
     description: str
-    mesh: MeshTri
+    mesh: Mesh
     material: Material
     is_dirichlet: PointFunction
     is_contact: PointFunction
@@ -127,9 +154,16 @@ class Scene:
     def __post_init__(self):
         _check(isinstance(self.material, Material), "material", self.material,
                "a scenes.Material")
+        _check(self.dim == 2 or self.material.plane == "strain", "material.plane",
+               self.material.plane, "'strain' in 3D (the 3D Lame parameters are plane strain's)")
         self.check_mesh()
 
-    def check_mesh(self, mesh: MeshTri | None = None, level: int | None = None) -> None:
+    @property
+    def dim(self) -> int:
+        """2 for a triangle mesh, 3 for a tetrahedral one."""
+        return int(self.mesh.dim())
+
+    def check_mesh(self, mesh: Mesh | None = None, level: int | None = None) -> None:
         """The boundary parts and the gap checked on ``mesh`` (default: the initial mesh), as
         every refined mesh must be: refinement puts new facet midpoints under the predicates,
         which may then overlap or meet a non-finite gap. SceneError names the level."""
@@ -137,49 +171,56 @@ class Scene:
         dirichlet, contact = self.dirichlet_facets(mesh), self.contact_facets(mesh)
         _check(contact.size > 0, "contact boundary", "empty" + where,
                "non-empty (no boundary facet satisfies is_contact)")
-        _check(self.facet_lengths(dirichlet, mesh).sum() > 0, "dirichlet boundary",
+        _check(self.facet_measures(dirichlet, mesh).sum() > 0, "dirichlet boundary",
                "of measure 0" + where, "of positive measure (rigid motion not prevented: the "
                "body must be clamped somewhere)")
         both = np.intersect1d(dirichlet, contact)
         _check(both.size == 0, "dirichlet boundary",
                f"overlapping the contact boundary{where} on {both.size} facets, the first "
-               f"at x={self.facet_points(both[:1], np.array([0.5]), mesh).ravel().tolist()}"
+               f"at x={self._facet_midpoints(both[:1], mesh).ravel().tolist()}"
                if both.size else "", "disjoint from the contact boundary")
         # the gap at a few points per contact facet, including the end points
-        x = self.facet_points(contact, np.array([0.0, 0.5, 1.0]), mesh)
+        x = self.facet_points(contact, np.array([0.0, 0.5, 1.0]) if self.dim == 2
+                              else TRIANGLE_CHECK_POINTS, mesh)
         g = np.asarray(self.gap(x), dtype=float)
         bad = ~np.isfinite(g)
         _check(not bad.any(), "gap", f"{g[bad].ravel()[0]} at x={x[:, bad][:, 0].tolist()}"
                f"{where}" if bad.any() else None, "finite on the contact boundary")
 
     # --- boundary parts -------------------------------------------------------------------
-    def dirichlet_facets(self, mesh: MeshTri | None = None) -> np.ndarray:
+    def dirichlet_facets(self, mesh: Mesh | None = None) -> np.ndarray:
         return self._facets_of(self.is_dirichlet, mesh)
 
-    def contact_facets(self, mesh: MeshTri | None = None) -> np.ndarray:
+    def contact_facets(self, mesh: Mesh | None = None) -> np.ndarray:
         return self._facets_of(self.is_contact, mesh)
 
-    def neumann_facets(self, mesh: MeshTri | None = None) -> np.ndarray:
+    def neumann_facets(self, mesh: Mesh | None = None) -> np.ndarray:
         mesh = self.mesh if mesh is None else mesh
         facets = mesh.boundary_facets()
         taken = np.union1d(self.dirichlet_facets(mesh), self.contact_facets(mesh))
         return np.setdiff1d(facets, taken)
 
-    def _facets_of(self, predicate: PointFunction, mesh: MeshTri | None) -> np.ndarray:
+    def _facets_of(self, predicate: PointFunction, mesh: Mesh | None) -> np.ndarray:
         mesh = self.mesh if mesh is None else mesh
         facets = mesh.boundary_facets()
         mid = mesh.p[:, mesh.facets[:, facets]].mean(axis=1)
         return facets[np.asarray(predicate(mid), dtype=bool)]
 
     def facet_lengths(self, facets: np.ndarray, mesh: MeshTri | None = None) -> np.ndarray:
+        """Lengths of 2D facets (``facet_measures`` in any dimension)."""
+        return self.facet_measures(facets, mesh)
+
+    def facet_measures(self, facets: np.ndarray, mesh: Mesh | None = None) -> np.ndarray:
+        """Lengths (2D) or areas (3D) of the given facets."""
         mesh = self.mesh if mesh is None else mesh
-        a, b = mesh.p[:, mesh.facets[0, facets]], mesh.p[:, mesh.facets[1, facets]]
-        return np.linalg.norm(b - a, axis=0)
+        return simplex_measures(mesh.p[:, mesh.facets[:, facets]])
 
     def facet_points(self, facets: np.ndarray, t: np.ndarray,
-                     mesh: MeshTri | None = None) -> np.ndarray:
-        """Points a + t (b - a) on each facet; shape (2, n_facets, len(t))."""
+                     mesh: Mesh | None = None) -> np.ndarray:
+        """Points at local coordinates t (``simplex_points``) on each facet: a + t (b - a) in
+        2D; shape (d, n_facets, n_t)."""
         mesh = self.mesh if mesh is None else mesh
-        a = mesh.p[:, mesh.facets[0, facets]][:, :, None]
-        b = mesh.p[:, mesh.facets[1, facets]][:, :, None]
-        return a + (b - a) * t[None, None, :]
+        return simplex_points(mesh.p[:, mesh.facets[:, facets]], t)
+
+    def _facet_midpoints(self, facets: np.ndarray, mesh: Mesh) -> np.ndarray:
+        return mesh.p[:, mesh.facets[:, facets]].mean(axis=1)
