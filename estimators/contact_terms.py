@@ -28,6 +28,7 @@ from formulations.evaluation import evaluate_on_trace
 # w has kinks where u_hn crosses g inside a facet; 10 Gauss points keep that quadrature error far
 # below the discretisation error the term measures.
 QUADRATURE_POINTS = 10
+QUADRATURE_DEGREE_3D = 10  # the same idea on triangles: 25 points
 # central difference step (relative to the facet) for the tangential derivative of g
 _DT = 1e-6
 
@@ -39,26 +40,47 @@ class ContactTerms:
     per_element: np.ndarray   # shares of geometric + complementarity per element
 
 
+def tangential_derivatives(scene, trace, t: np.ndarray, gradient: np.ndarray) -> list:
+    """d/dtau (g - u_hn) (n, nq) along each unit tangent tau of the facets (one in 2D, two
+    orthogonal ones in 3D): g by central differences, u_hn from grad u_h (d, d, n nq) exactly."""
+    nq = t.shape[-1]
+    normal = np.repeat(trace.normal, nq, axis=1)
+    x = trace.points(t)
+    if trace.dim == 2:  # along the facet in its local coordinate
+        tangents = [trace.tangent]
+        dg = [(scene.gap(trace.points(t + _DT)) - scene.gap(trace.points(t - _DT)))
+              / (2 * _DT * trace.length[:, None])]
+    else:
+        first = trace.points(np.array([[1.0], [0.0]]))[:, :, 0] - trace.points(
+            np.array([[0.0], [0.0]]))[:, :, 0]
+        first /= np.linalg.norm(first, axis=0)
+        tangents = [first, np.cross(trace.normal, first, axis=0)]
+        step = _DT * trace.diameter[None, :, None]
+        dg = [(scene.gap(x + step * tau[:, :, None]) - scene.gap(x - step * tau[:, :, None]))
+              / (2 * step[0]) for tau in tangents]
+    return [dg_k - np.einsum("in,ijn,jn->n", normal, gradient,
+                             np.repeat(tau, nq, axis=1)).reshape(trace.size, nq)
+            for dg_k, tau in zip(dg, tangents, strict=True)]
+
+
 def contact_terms(scene, solution: DiscreteSolution) -> ContactTerms:
     trace = solution.trace
-    t, w = gauss_legendre(QUADRATURE_POINTS)
+    t, w = (gauss_legendre(QUADRATURE_POINTS) if trace.dim == 2
+            else trace.rule(QUADRATURE_DEGREE_3D))
     at_points = evaluate_on_trace(solution.elasticity.basis, trace, t)
-    nq = t.size
-    normal, tangent = (np.repeat(v, nq, axis=1) for v in (trace.normal, trace.tangent))
+    nq = t.shape[-1]
+    normal = np.repeat(trace.normal, nq, axis=1)
     u_n = np.einsum("in,in->n", at_points.value(solution.u), normal).reshape(trace.size, nq)
     g = scene.gap(trace.points(t))
     d = g - u_n
     inside = d < 0
     wval = np.where(inside, d, 0.0)
-    # d/ds (g - u_hn): g by central differences along the facet, u_hn from grad u_h exactly
-    dg = (scene.gap(trace.points(t + _DT)) - scene.gap(trace.points(t - _DT))) / (
-        2 * _DT * trace.length[:, None])
-    du = np.einsum("in,ijn,jn->n", normal, at_points.gradient(solution.u),
-                   tangent).reshape(trace.size, nq)
-    dw = np.where(inside, dg - du, 0.0)
+    # the tangential gradient of g - u_hn where it penetrates
+    dw2 = sum(np.where(inside, dk, 0.0) ** 2 for dk in
+              tangential_derivatives(scene, trace, t, at_points.gradient(solution.u)))
 
     l2 = trace.integrate(wval**2, w)
-    h1 = l2 + trace.integrate(dw**2, w)
+    h1 = l2 + trace.integrate(dw2, w)
     young = float(scene.material.young_modulus)
     geometric = young * float(np.sqrt(l2.sum() * h1.sum()))
     local_geo = np.sqrt(l2 * h1)

@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 from estimators.base import Estimate, register_estimator
-from estimators.residual import edge_residuals, element_residual
+from estimators.residual import volume_terms
 from formulations import DiscreteSolution
 
 
@@ -33,8 +33,7 @@ def nitsche_only(scene=None, formulation: str = "", **_) -> str | None:
                                         "for nitsche: eta_0 with the Nitsche contact residual, "
                                         "no eq. (8) terms", applies=nitsche_only)
 def estimate(scene, solution: DiscreteSolution) -> Estimate:
-    young = float(scene.material.young_modulus)
-    local = (element_residual(scene, solution) + edge_residuals(scene, solution)) / young
+    local = volume_terms(scene, solution)
     eta = float(np.sqrt(local.sum()))
     return Estimate(estimator="nitsche-residual", eta=eta, eta_0=eta, eta_geometric=0.0,
                     eta_complementarity=0.0, indicators=local)

@@ -1,4 +1,5 @@
-"""``residual``: the paper's eta of (8) with the residual eta_0 of its section 5.
+"""``residual``: the paper's eta of (8) with the residual eta_0 of its section 5 (on
+tetrahedra: ``estimators.residual_3d``).
 
 eta_0^2 = sum_T ( (h_T/p)^2 R_{0,T}^2 + sum_{e in E_T} (h_e/p) R_{0,e}^2 ),
 R_{0,T} = ||f + div sigma(u_h)||_{0,T},
@@ -21,6 +22,7 @@ from skfem import Basis, ElementTriP0
 
 from estimators.base import Estimate, combine, register_estimator
 from estimators.contact_terms import contact_terms
+from estimators.residual_3d import element_residual_3d, face_residuals_3d
 from formulations import DiscreteSolution
 from formulations.contact import gauss_legendre, outer_normals
 from formulations.elasticity import ELEMENTS, element_diameters, stress_from_gradient
@@ -135,6 +137,13 @@ def edge_residuals(scene, solution: DiscreteSolution) -> np.ndarray:
 @register_estimator("residual", "residual eta_0 (seed paper, section 5) plus the geometric and "
                                 "complementarity contact terms of eq. (8)")
 def estimate(scene, solution: DiscreteSolution) -> Estimate:
+    return combine("residual", volume_terms(scene, solution), contact_terms(scene, solution))
+
+
+def volume_terms(scene, solution: DiscreteSolution) -> np.ndarray:
+    """eta_0^2 per element: element residuals and edge (2D) or face (3D) residuals, over E."""
     young = float(scene.material.young_modulus)
-    eta0_local = (element_residual(scene, solution) + edge_residuals(scene, solution)) / young
-    return combine("residual", eta0_local, contact_terms(scene, solution))
+    if solution.trace.dim == 3:
+        return (element_residual_3d(scene, solution)
+                + face_residuals_3d(scene, solution)) / young
+    return (element_residual(scene, solution) + edge_residuals(scene, solution)) / young

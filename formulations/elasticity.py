@@ -68,6 +68,14 @@ def check_order_in(order, dim: int) -> int:
     return order
 
 
+def why_no_element(order: int, dim: int) -> str | None:
+    """Why there is no P_order element in ``dim`` dimensions here, or None."""
+    if order in scalar_elements(dim):
+        return None
+    return (f"order {order} on {'triangles' if dim == 2 else 'tetrahedra'} is not available "
+            f"(orders {', '.join(map(str, scalar_elements(dim)))})")
+
+
 def vector_element(order: int = 1, dim: int = 2) -> ElementVector:
     """The displacement element: vector Lagrange P_order on triangles (tetrahedra in 3D)."""
     return ElementVector(scalar_elements(dim)[check_order_in(order, dim)]())

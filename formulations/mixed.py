@@ -112,9 +112,19 @@ def segment_weights(trace, segment: np.ndarray, breaks: np.ndarray, degree: int,
                              shape=(m, nf * nq))
 
 
+def planar_only(scene=None, **_) -> str | None:
+    """Why ``mixed`` does not apply: its coarser multiplier mesh is a mesh of the contact
+    coordinate along a curve Gamma_C, which a 3D body's contact surface is not."""
+    if scene is not None and scene.dim != 2:
+        return ("mixed: the coarser multiplier mesh is built along a 1D Gamma_C; a multiplier "
+                "on patches of contact triangles (3D) is not implemented")
+    return None
+
+
 @register_formulation("mixed", "Haslinger's mixed method: multiplier of degree p - 1 "
                                "(piecewise constant for P1) on a coarser contact mesh, "
-                               "h/H <= 1/2 (seed paper, eq. (3))")
+                               "h/H <= 1/2 (seed paper, eq. (3)); 2D only",
+                      applies=planar_only)
 def discretise(scene: Scene, mesh: MeshTri, h_over_H: float = 0.5, order: int = 1,
                multiplier_degree: int | None = None) -> Discretisation:
     """``h_over_H``: the largest allowed ratio of a facet to its multiplier segment. The

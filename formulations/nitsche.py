@@ -36,7 +36,7 @@ from scipy import sparse
 from skfem import MeshTri
 
 from formulations.base import ContactQP, DiscreteSolution, QPSolution, Residuals, slack_qp
-from formulations.contact import contact_trace, gap_interpolant, gauss_legendre
+from formulations.contact import contact_trace, gap_interpolant
 from formulations.discretisation import Discretisation, discrete_solution
 from formulations.elasticity import assemble_elasticity, check_order
 from formulations.evaluation import evaluate_on_trace
@@ -86,12 +86,13 @@ def pressure_function(gap_h, elasticity, trace, gamma_facet: np.ndarray, u_free:
 
     def pressure(t):
         t = np.asarray(t, dtype=float)
+        nq = t.shape[-1]
         at = evaluate_on_trace(elasticity.basis, trace, t)
-        normal = np.repeat(trace.normal, t.size, axis=1)
+        normal = np.repeat(trace.normal, nq, axis=1)
         sigma = at.normal_stress_matrix(normal, elasticity.lame) @ u
         u_n = at.matrix(normal) @ u
-        argument = sigma + np.repeat(gamma_facet, t.size) * (gap_h(t).ravel() - u_n)
-        return -np.minimum(argument, 0.0).reshape(trace.size, t.size)
+        argument = sigma + np.repeat(gamma_facet, nq) * (gap_h(t).ravel() - u_n)
+        return -np.minimum(argument, 0.0).reshape(trace.size, nq)
 
     return pressure
 
@@ -99,7 +100,7 @@ def pressure_function(gap_h, elasticity, trace, gamma_facet: np.ndarray, u_free:
 def nitsche_system(scene: Scene, elasticity, trace, gap_h, t: np.ndarray, w: np.ndarray,
                    gamma_facet: np.ndarray, theta: float) -> SemismoothSystem:
     """The discrete equation of the module docstring as a ``SemismoothSystem``."""
-    free, nq = elasticity.free, t.size
+    free, nq = elasticity.free, t.shape[-1]
     at = evaluate_on_trace(elasticity.basis, trace, t)
     normal = np.repeat(trace.normal, nq, axis=1)
     return SemismoothSystem(
@@ -107,7 +108,7 @@ def nitsche_system(scene: Scene, elasticity, trace, gap_h, t: np.ndarray, w: np.
         S=at.normal_stress_matrix(normal, elasticity.lame)[:, free].tocsr(),
         N=at.matrix(normal)[:, free].tocsr(),
         gap=gap_h(t).ravel(),
-        weight=np.tile(w, trace.size) * np.repeat(trace.length, nq),
+        weight=np.tile(w, trace.size) * np.repeat(trace.measure, nq),
         gamma=np.repeat(gamma_facet, nq), theta=float(theta),
         objective_scale=float(scene.material.young_modulus))
 
@@ -120,11 +121,12 @@ def discretise(scene: Scene, mesh: MeshTri, theta: float = 1.0,
     check_options(theta, gamma_0)
     elasticity = assemble_elasticity(scene, mesh, check_order(order))
     trace = contact_trace(scene, mesh)
-    t, w = gauss_legendre(elasticity.order + 1)
-    gamma_facet = gamma_0 * float(scene.material.young_modulus) / trace.length
+    t, w = trace.rule(2 * elasticity.order)  # 2D: the p + 1 Gauss points
+    gamma_facet = gamma_0 * float(scene.material.young_modulus) / trace.diameter
     gap_h = gap_interpolant(scene, trace, elasticity.order)
     system = nitsche_system(scene, elasticity, trace, gap_h, t, w, gamma_facet, theta)
-    n, s_points = system.n, trace.coordinates_at(t).ravel()
+    s_points = trace.coordinates_at(t)
+    n, s_points = system.n, (s_points.ravel() if trace.dim == 2 else s_points.reshape(2, -1))
     details = NitscheDetails(theta=float(theta), gamma_0=float(gamma_0), gamma=gamma_facet)
 
     def recover(answer: QPSolution, residuals: Residuals, status: str,
@@ -135,7 +137,8 @@ def discretise(scene: Scene, mesh: MeshTri, theta: float = 1.0,
             "nitsche", elasticity, trace, replace(answer, multipliers=pressure_at_points),
             residuals, status, reason, u_free=u_free,
             pressure=pressure_function(gap_h, elasticity, trace, gamma_facet, u_free),
-            multiplier_breaks=np.append(trace.coordinate[0], trace.coordinate[1, -1]),
+            multiplier_breaks=(np.append(trace.coordinate[0], trace.coordinate[1, -1])
+                               if trace.dim == 2 else np.zeros(0)),
             active_constraints=int((pressure_at_points > 0).sum()), details=details)
 
     def transfer(previous: DiscreteSolution) -> np.ndarray:

@@ -14,6 +14,7 @@ from bench.sequence.rows import ResultRow, identity_columns
 from estimators.base import ESTIMATORS
 from formulations import STATUS_FAILED, STATUS_SKIPPED
 from formulations.discretisation import why_unsolvable
+from formulations.elasticity import why_no_element
 from formulations.registry import FORMULATIONS, get_formulation
 from formulations.solvers.registry import SOLVERS
 from scenes import Scene
@@ -30,7 +31,8 @@ def why_skipped(scene: Scene, formulation: str, solver: str, estimator: str,
                 options: dict | None = None, order: int = 1) -> str | None:
     """The reason a combination is impossible (declared by the registrations, or no method of
     the solver for the problem the formulation offers with these options), or None."""
-    reason = (FORMULATIONS.why_not(formulation, scene=scene)
+    reason = (why_no_element(order, scene.dim)
+              or FORMULATIONS.why_not(formulation, scene=scene)
               or (SOLVERS.why_not(solver, scene=scene, formulation=formulation)
                   if solver in SOLVERS.names() else None)
               or ESTIMATORS.why_not(estimator, scene=scene, formulation=formulation))
@@ -74,6 +76,7 @@ def run_spec(spec: SequenceSpec, run: dict, out, truth_of: Callable[[Scene], obj
     try:
         scene = build_scene(spec)
         check_formulation_options(spec)
+        names["dim"] = scene.dim
         reason = why_skipped(scene, spec.formulation, spec.solver, spec.estimator,
                              dict(spec.formulation_options), spec.order)
         if reason is not None:

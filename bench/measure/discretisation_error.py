@@ -20,7 +20,7 @@ from skfem import Basis
 from bench.measure.contact import contact_zone, zone_error
 from formulations import DiscreteSolution
 from formulations.contact import gauss_legendre
-from formulations.elasticity import stress_from_gradient
+from formulations.elasticity import stress_from_gradient, stress_tensor_from_gradient
 
 EXACT_INTORDER = 6  # plus 2 (p - 1) for P_p: the u_h part of the integrand stays exact
 PRESSURE_POINTS = 6  # Gauss points per contact facet for ||lambda - lambda_h||
@@ -36,7 +36,9 @@ class Errors:
 
 
 def energy_density(grad: np.ndarray, lam: float, mu: float) -> np.ndarray:
-    """sigma(e) : eps(e) for the displacement gradient grad[i, j] of e."""
+    """sigma(e) : eps(e) for the displacement gradient grad[i, j] of e (2D or 3D)."""
+    if grad.shape[0] == 3:
+        return np.einsum("ij...,ij...->...", stress_tensor_from_gradient(grad, lam, mu), grad)
     s11, s22, s12 = stress_from_gradient(grad, lam, mu)
     return s11 * grad[0, 0] + s22 * grad[1, 1] + s12 * (grad[0, 1] + grad[1, 0])
 
@@ -45,6 +47,10 @@ def pressure_error(solution: DiscreteSolution, true_pressure, trace=None) -> flo
     """||lambda - lambda_h||_{0,Gamma_C} on the facets of ``trace`` (the finer one; default
     u_h's), with ``true_pressure(s)`` a function of the contact coordinate."""
     trace = solution.trace if trace is None else trace
+    if trace.dim == 3:  # on u_h's own facets: lambda_h at the rule's points directly
+        t, w = trace.rule(2 * PRESSURE_POINTS - 1)
+        diff = true_pressure(trace.coordinates_at(t)) - solution.pressure(t)
+        return float(np.sqrt(trace.integrate(diff**2, w).sum()))
     t, w = gauss_legendre(PRESSURE_POINTS)
     s = trace.coordinates_at(t)
     diff = true_pressure(s) - solution.pressure_at(s.ravel()).reshape(s.shape)

@@ -103,7 +103,7 @@ def refinement(mesh: MeshTri, sol, est, config: LoopConfig) -> RefinementPlan:
     if config.strategy == "uniform":
         return refinement_plan(mesh)
     marked = mark(est.indicators, config.marking, config.theta)
-    if config.grade_contact:
+    if config.grade_contact and sol.trace.dim == 2:  # a 2:1 grading along a 1D Gamma_C
         trace = sol.trace
         marked = grade_contact_trace(marked, trace.length, trace.element, trace.coordinate,
                                      mesh.t.shape[1])
@@ -123,11 +123,12 @@ def target_reason(config: LoopConfig, est) -> str | None:
     return f"target reached: guaranteed eta={est.eta:.4g} <= {config.target_error:g}"
 
 
-def memory_refusal(level: int, ndofs: int, solver: str, config: LoopConfig) -> str | None:
+def memory_refusal(level: int, ndofs: int, solver: str, config: LoopConfig,
+                   dim: int = 2) -> str | None:
     """Why a level of ``ndofs`` unknowns must not be built (its predicted peak memory does not
     fit), or None."""
     backend = check_backend(config.solver_options.get("backend"))
-    need = predict_peak_gib(ndofs, solver, backend, config.order)
+    need = predict_peak_gib(ndofs, solver, backend, config.order, dim)
     limit = config.max_memory_gib if config.max_memory_gib is not None else available_gib()
     if need <= limit:
         return None
@@ -149,14 +150,15 @@ def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
     discretise = functools.partial(get_formulation(formulation), order=config.order,
                                    **(formulation_options or {}))
     estimate = get_estimator(estimator)
-    ident = identity_columns(scene.name, formulation, solver, estimator, config, identity)
+    ident = identity_columns(scene.name, formulation, solver, estimator, config, identity,
+                             scene.dim)
     mesh = scene.mesh if mesh is None else mesh
     t_refine, previous = 0.0, None
     for level in range(config.max_levels):
         ndofs = count_free_dofs(scene, mesh, config.order)  # budgets: before any assembly
         if level > 0 and ndofs > config.max_dofs:
             return "budget"
-        refusal = memory_refusal(level, ndofs, solver, config)
+        refusal = memory_refusal(level, ndofs, solver, config, scene.dim)
         if refusal is not None:
             yield LevelResult(ResultRow(**ident, level=level, ndofs=ndofs,
                                         n_elements=mesh.t.shape[1], status=STATUS_FAILED,

@@ -18,6 +18,12 @@ Higher order: a P_p DOF couples to more DOFs (stiffness nonzeros per row 12 / 22
 p = 1 / 2 / 3; CHOLMOD's factor about the same per DOF), so the per-DOF slope is scaled by
 ORDER_FACTOR, measured with ``python -m bench scaling --sizes 1e4,1e5 --order 1,2,3`` (cholmod):
 peak 0.83 GiB at 100 800 P2 DOFs (1.4 x the P1 slope) and 0.62 GiB at 56 784 P3 DOFs (1.7 x).
+
+Tetrahedra: a 3D factor fills faster than N (nested dissection: N^(4/3) nonzeros), so the 3D
+slope is DIM3_FACTOR times the 2D one at DIM3_AT DOFs and grows like N^(1/3) from there
+(bounded below by the factor itself). Measured on ``free-boundary-3d`` (vi, active-set,
+pardiso, one uniform level in a fresh process): peak 1.48 GiB at 104 544 P1 DOFs (5.1 x the
+2D slope) and 1.69 GiB at 104 544 P2 DOFs (4.2 x the 2D P2 slope).
 """
 
 from __future__ import annotations
@@ -43,6 +49,8 @@ class MemoryLine:
 
 REFERENCE_BOUND = "cholmod"  # the back-end whose measured line bounds the reference (docstring)
 ORDER_FACTOR = {1: 1.0, 2: 1.4, 3: 1.7}  # per-DOF memory of P_p relative to P1 (docstring)
+# 3D: per-DOF memory relative to 2D at DIM3_AT DOFs (docstring), then growing like N^(1/3)
+DIM3_FACTOR, DIM3_AT = 5.1, 1.05e5
 
 
 def memory_line(route_name: str) -> MemoryLine:
@@ -58,11 +66,16 @@ def route(solver: str, backend: str) -> str:
     return REFERENCE_SOLVER if solver == REFERENCE_SOLVER else backend
 
 
-def predict_peak_gib(ndofs: int, solver: str, backend: str, order: int = 1) -> float:
+def predict_peak_gib(ndofs: int, solver: str, backend: str, order: int = 1,
+                     dim: int = 2) -> float:
     """The predicted peak memory of a level with ``ndofs`` unknowns of order ``order`` (GiB);
-    a back-end without a measured line gets the steepest one (a bound, not a fit)."""
+    a back-end without a measured line gets the steepest one (a bound, not a fit). In 3D the
+    per-DOF slope grows like N^(1/3) (a 3D factor's fill), from DIM3_FACTOR at DIM3_AT DOFs."""
     line = memory_line(route(solver, backend))
-    return line.base_gib + ORDER_FACTOR[order] * line.per_dof_gib * ndofs
+    per_dof = ORDER_FACTOR[order] * line.per_dof_gib
+    if dim == 3:
+        per_dof *= DIM3_FACTOR * max(ndofs / DIM3_AT, 1.0) ** (1 / 3)
+    return line.base_gib + per_dof * ndofs
 
 
 def available_gib(meminfo: str | Path = "/proc/meminfo") -> float:

@@ -19,6 +19,7 @@ class ResultRow:
     strategy: str
     level: int
     order: int = 1  # polynomial order p of the displacements
+    dim: int = 2  # of the body: 2 (triangles) or 3 (tetrahedra)
     ndofs: int = 0
     n_elements: int = 0
     h_max: float = math.nan
@@ -97,12 +98,12 @@ PHASE_TIMES = ["t_assemble", "t_solve", "t_estimate", "t_refine"]
 
 
 def identity_columns(scene: str, formulation: str, solver: str, estimator: str, config,
-                     run: dict | None = None) -> dict:
+                     run: dict | None = None, dim: int = 2) -> dict:
     """The columns that name a sequence: the combination, its marking (``config`` is a
     ``bench.sequence.loop.LoopConfig``) and the run's identity, sweep labels and provenance
-    (``run``)."""
+    (``run``) and the body's dimension."""
     return dict(scene=scene, formulation=formulation, solver=solver, estimator=estimator,
-                strategy=config.strategy, order=config.order, marking=config.marking,
+                strategy=config.strategy, order=config.order, dim=dim, marking=config.marking,
                 theta=config.theta,
                 **(run or {}))
 
@@ -113,6 +114,7 @@ def with_labels(frame):
     row."""
     frame = frame.copy()
     frame["order"] = (frame["order"].fillna(1).astype(int) if "order" in frame else 1)
+    frame["dim"] = (frame["dim"].fillna(2).astype(int) if "dim" in frame else 2)
     for column in LABELS + ["sequence_key", "sequence_end"]:
         frame[column] = (frame[column].astype(object).fillna("").astype(str) if column in frame
                          else "")

@@ -1,0 +1,108 @@
+"""The residual estimator's eta_0 on tetrahedra (docs/theory.md, section 13.1): the terms of
+``estimators.residual`` with triangular faces for edges,
+
+    eta_0^2 = (1/E) sum_T ( (h_T/p)^2 ||f + div sigma(u_h)||_T^2 + sum_{F in T} (h_F/p) R_F^2 ),
+
+R_F = 1/2 ||[sigma_n(u_h)]||_F inside, ||sigma_n(u_h) - q||_F on Gamma_N and
+||sigma_nn(u_h) + lambda_h||_F + ||sigma_nt(u_h)||_F on Gamma_C; h_F is the face's diameter.
+For P1 and P2 on affine tetrahedra sigma(u_h) is of degree p - 1, so div sigma(u_h) is 0 (P1)
+or constant per element (P2).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from skfem import Basis, ElementTetP0, ElementTetP1
+
+from formulations import DiscreteSolution
+from formulations.contact_surface import outer_triangle_normals, triangle_rule
+from formulations.elasticity import element_diameters, stress_tensor_from_gradient
+from formulations.evaluation import gradients_at, gradients_at_reference
+from scenes.base import simplex_measures, simplex_points
+
+BOUNDARY_DEGREE = 6  # Neumann and contact faces: q and lambda_h are not polynomials
+
+
+def stress_at(solution: DiscreteSolution, x: np.ndarray, cells: np.ndarray) -> np.ndarray:
+    """sigma(u_h) (3, 3, n) at points x (3, n) of elements ``cells``."""
+    grad = gradients_at(solution.elasticity.basis, solution.u, x, cells)
+    return stress_tensor_from_gradient(grad, *solution.elasticity.lame)
+
+
+def element_residual_3d(scene, solution: DiscreteSolution) -> np.ndarray:
+    """(h_T / p)^2 ||f + div sigma(u_h)||_T^2 per tetrahedron."""
+    elasticity = solution.elasticity
+    mesh, order = elasticity.mesh, elasticity.order
+    if scene.body_force is None and order == 1:
+        return np.zeros(mesh.t.shape[1])
+    basis = Basis(mesh, ElementTetP0(), intorder=2 * order)
+    residual = np.zeros((3,) + basis.dx.shape)
+    if scene.body_force is not None:
+        residual += scene.body_force(np.asarray(basis.global_coordinates()))
+    if order == 2:  # sigma(u_h) is linear: its values at the vertices, differentiated
+        vertices = ElementTetP1()
+        grad = gradients_at_reference(elasticity.basis, solution.u, vertices.doflocs.T)
+        sigma = stress_tensor_from_gradient(grad, *elasticity.lame)  # (3, 3, nE, 4)
+        inverse = elasticity.basis.mapping.invA  # (3, 3, nE)
+        for k in range(4):
+            _, reference = vertices.lbasis(vertices.doflocs.T[:, :1], k)
+            gradient = np.einsum("rde,r->de", inverse, reference[:, 0])  # (3, nE)
+            residual += np.einsum("ije,je->ie", sigma[:, :, :, k], gradient)[:, :, None]
+    norm2 = ((residual**2).sum(axis=0) * basis.dx).sum(axis=1)
+    return (element_diameters(mesh) / order) ** 2 * norm2
+
+
+def face_data(mesh, facets: np.ndarray, degree: int):
+    """Points (3, n * nq), weights w (nq,), areas, diameters and corner points of faces."""
+    corners = mesh.p[:, mesh.facets[:, facets]]
+    t, w = triangle_rule(degree)
+    diameter = np.max([np.linalg.norm(corners[:, i] - corners[:, (i + 1) % 3], axis=0)
+                       for i in range(3)], axis=0)
+    return simplex_points(corners, t).reshape(3, -1), w, simplex_measures(corners), diameter, \
+        corners
+
+
+def interior_jumps_3d(solution: DiscreteSolution) -> np.ndarray:
+    """(h_F / p) (1/2 ||[sigma_n]||_F)^2 added to both tetrahedra of every interior face."""
+    mesh, order = solution.elasticity.mesh, solution.elasticity.order
+    interior = np.flatnonzero(mesh.f2t[1] >= 0)
+    t1, t2 = mesh.f2t[:, interior]
+    x, w, area, h, corners = face_data(mesh, interior, 2 * (order - 1))
+    nq = w.size
+    n = np.repeat(outer_triangle_normals(mesh, corners, t1), nq, axis=1)
+    jump = stress_at(solution, x, np.repeat(t1, nq)) - stress_at(solution, x, np.repeat(t2, nq))
+    jn = np.einsum("ijn,jn->in", jump, n)
+    norm2 = ((jn**2).sum(axis=0).reshape(-1, nq) * w).sum(axis=1) * area
+    share = h / order * 0.25 * norm2
+    n_elements = mesh.t.shape[1]
+    return np.bincount(t1, share, n_elements) + np.bincount(t2, share, n_elements)
+
+
+def face_residuals_3d(scene, solution: DiscreteSolution) -> np.ndarray:
+    """sum_{F in T} (h_F / p) R_F^2 per tetrahedron."""
+    mesh, order = solution.elasticity.mesh, solution.elasticity.order
+    n_elements = mesh.t.shape[1]
+    out = interior_jumps_3d(solution)
+    neumann = scene.neumann_facets(mesh)
+    if neumann.size:
+        element = mesh.f2t[0, neumann]
+        x, w, area, h, corners = face_data(mesh, neumann, BOUNDARY_DEGREE)
+        nq = w.size
+        n = np.repeat(outer_triangle_normals(mesh, corners, element), nq, axis=1)
+        sn = np.einsum("ijn,jn->in", stress_at(solution, x, np.repeat(element, nq)), n)
+        if scene.traction is not None:
+            sn = sn - scene.traction(x)
+        norm2 = ((sn**2).sum(axis=0).reshape(-1, nq) * w).sum(axis=1) * area
+        out += np.bincount(element, h / order * norm2, n_elements)
+    trace = solution.trace
+    t, w = trace.rule(BOUNDARY_DEGREE)
+    nq = w.size
+    normal = np.repeat(trace.normal, nq, axis=1)
+    sigma = stress_at(solution, trace.points(t).reshape(3, -1), np.repeat(trace.element, nq))
+    sn = np.einsum("ijn,jn->in", sigma, normal)
+    snn = np.einsum("in,in->n", sn, normal)
+    snt2 = ((sn - snn * normal) ** 2).sum(axis=0).reshape(-1, nq)
+    normal_part = np.sqrt(trace.integrate((snn.reshape(-1, nq) + solution.pressure(t)) ** 2, w))
+    r_f = normal_part + np.sqrt(trace.integrate(snt2, w))
+    out += np.bincount(trace.element, trace.diameter / order * r_f**2, n_elements)
+    return out
