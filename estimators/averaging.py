@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 from skfem import Basis
 
-from estimators.base import Estimate, combine, register_estimator
+from estimators.base import Estimate, combine, planar_only, register_estimator
 from estimators.contact_terms import contact_terms
 from formulations import DiscreteSolution
 from formulations.elasticity import ELEMENTS, stress_from_gradient
@@ -69,6 +69,8 @@ def averaging_indicators(solution: DiscreteSolution) -> np.ndarray:
 
 
 @register_estimator("averaging", "Zienkiewicz-Zhu nodal stress averaging in the energy norm "
-                                 "plus the geometric and complementarity contact terms of (8)")
+                                 "plus the geometric and complementarity contact terms of (8)",
+                    applies=planar_only("averaging", "the nodal stress recovery is written for "
+                                                     "3 stress components"))
 def estimate(scene, solution: DiscreteSolution) -> Estimate:
     return combine("averaging", averaging_indicators(solution), contact_terms(scene, solution))

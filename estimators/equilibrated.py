@@ -21,7 +21,7 @@ import numpy as np
 from skfem import Basis, ElementDG, FacetBasis
 
 from estimators.averaging import compliance_energy, element_areas
-from estimators.base import Estimate, register_estimator
+from estimators.base import Estimate, planar_only, register_estimator
 from estimators.constants import domain_constants
 from estimators.equilibration import (
     BoundaryData,
@@ -50,7 +50,9 @@ class NotEquilibrated(RuntimeError):
 
 @register_estimator("equilibrated", "guaranteed upper bound: equilibrated RT stress on vertex "
                                     "patches (Prager-Synge) plus Theorem 1's contact terms, "
-                                    "every constant computed", guaranteed=True)
+                                    "every constant computed", guaranteed=True,
+                    applies=planar_only("equilibrated", "the Raviart-Thomas patch "
+                                                         "equilibration is built on triangles"))
 def estimate(scene, solution: DiscreteSolution) -> Estimate:
     rec, interior, load, lam_star, boundary, clamped = equilibrate(scene, solution)
     lam, mu = solution.elasticity.lame

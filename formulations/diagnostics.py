@@ -54,7 +54,10 @@ def inf_sup_constant(discretisation, backend: str | None = None,
 
 
 def pressure_oscillation(solution: DiscreteSolution, samples: int = 5) -> float:
-    """TV(lambda_h) / (2 max lambda_h) along Gamma_C (see the module docstring)."""
+    """TV(lambda_h) / (2 max lambda_h) along Gamma_C (see the module docstring); NaN on a 3D
+    contact surface, which has no order along it."""
+    if solution.trace.dim != 2:
+        return float("nan")
     values = solution.pressure(np.linspace(0.0, 1.0, samples)).ravel()  # facets in order
     if not np.isfinite(values).all():
         return float("nan")

@@ -222,5 +222,6 @@ class Scene:
         mesh = self.mesh if mesh is None else mesh
         return simplex_points(mesh.p[:, mesh.facets[:, facets]], t)
 
-    def _facet_midpoints(self, facets: np.ndarray, mesh: Mesh) -> np.ndarray:
+    def _facet_midpoints(self, facets: np.ndarray, mesh: Mesh | None) -> np.ndarray:
+        mesh = self.mesh if mesh is None else mesh
         return mesh.p[:, mesh.facets[:, facets]].mean(axis=1)

@@ -46,7 +46,7 @@ from formulations.registry import FORMULATIONS
 from formulations.solvers.backends import check_backend
 from formulations.solvers.backends.base import REGISTRY as BACKENDS
 from formulations.solvers.registry import FAST_SOLVER, SOLVERS, SYSTEM_SOLVERS
-from scenes import scene_descriptions, scene_names
+from scenes import get_scene, scene_descriptions, scene_names
 from scenes.registry import BUILT_IN, SCENES
 
 SUMMARY_COLUMNS = ["level", "ndofs", "energy", "contact_force", "active_constraints", "eta",
@@ -145,10 +145,11 @@ def compare_command(args) -> int:
     estimator x {uniform, adaptive} with the active-set solver, then the hard cases into the
     same folder, then the report."""
     config = configured(
-        scenes=[n for n in scene_names() if n not in hard_scene_names()],
+        scenes=[n for n in scene_names() if n not in hard_scene_names()
+                and get_scene(n).dim == args.dim],
         formulations=formulation_names(), solvers=(FAST_SOLVER,),
         estimators=estimator_names(), strategies=("uniform", "adaptive"),
-        max_dofs=args.max_dofs, reference_dofs=args.reference_dofs,
+        max_dofs=args.max_dofs, reference_dofs=args.reference_dofs if args.dim == 2 else None,
         crosscheck_dofs=args.crosscheck_dofs, max_memory_gib=args.max_memory, out=args.out,
         overwrite=True, workers=args.workers, scheduler=args.scheduler, cache=args.cache,
         scene_files=tuple(args.scene_file), command=" ".join(["python -m bench", *args.argv]))
@@ -162,7 +163,7 @@ def compare_command(args) -> int:
     if config is None:
         return status
     args.case = None
-    hard_status = hard_command(args)
+    hard_status = hard_command(args) if args.dim == 2 else 0  # the hard cases are 2D
     print(f"wrote {write_report(read_results(args.out), args.reports, args.out)}")
     if args.readme is not None:
         write_compare_block(args.readme, args.out, time.perf_counter() - start)

@@ -209,6 +209,9 @@ def _compare_parser(sub) -> None:
     compare.add_argument("--crosscheck-dofs", type=non_negative_int("crosscheck_dofs"),
                          default=3000, help="cross-check levels up to this size with the "
                          "reference solver (default: 3000)")
+    compare.add_argument("--dim", type=int, choices=(2, 3), default=2,
+                         help="the scenes' dimension (default: 2); 3 runs the tetrahedral "
+                              "scenes only, errors against exact solutions (no 3D references)")
     compare.add_argument("--out", default="results", help="results folder (default: results)")
     compare.add_argument("--reports", default="reports", help="report folder (default: reports)")
     compare.add_argument("--readme", default=None,

@@ -45,8 +45,8 @@ def save_artifact(path: Path, result, scene=None) -> Path | None:
     energy-norm error per element; on Gamma_C: the facets' vertices, lambda_h and the gap at
     the facet ends (the fields ``python -m bench export`` writes)."""
     sol = result.solution
-    if sol is None or not np.all(np.isfinite(sol.u)):
-        return None
+    if sol is None or not np.all(np.isfinite(sol.u)) or sol.trace.dim != 2:
+        return None  # 3D fields are not written yet (docs/theory.md, section 13.5)
     mesh = sol.elasticity.mesh
     n_elements = mesh.t.shape[1]
     stress = sol.elasticity.element_stress(sol.u)

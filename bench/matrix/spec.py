@@ -13,6 +13,8 @@ from dataclasses import dataclass, replace
 
 from bench.sequence.loop import LoopConfig
 from formulations import get_formulation
+from formulations.elasticity import why_no_element
+from formulations.registry import FORMULATIONS
 from scenes import get_scene
 from scenes.registry import SCENES
 
@@ -139,7 +141,8 @@ def check_formulation_options(spec: SequenceSpec, scene=None) -> None:
                          "--order (RunConfig.orders), not as a formulation option")
     discretise = get_formulation(spec.formulation)
     check_parameters("formulation", spec.formulation, spec.formulation_options, discretise)
-    if scene is not None:
+    if scene is not None and why_no_element(spec.order, scene.dim) is None and \
+            FORMULATIONS.why_not(spec.formulation, scene=scene) is None:  # else a skipped row
         try:
             discretise(scene, scene.mesh, order=spec.order, **dict(spec.formulation_options))
         except (ValueError, TypeError) as error:

@@ -16,11 +16,12 @@ def solution_difference(discretisation, solution, other) -> tuple[float, float]:
     or pressure (nothing touches) is not divided by zero."""
     K = discretisation.elasticity.K
     du = solution.u - other.u
-    t = np.linspace(0.0, 1.0, PRESSURE_SAMPLES)
+    t = (np.linspace(0.0, 1.0, PRESSURE_SAMPLES) if discretisation.trace.dim == 2
+         else discretisation.trace.rule(2)[0])  # 3D: three points inside each facet
     lam, lam_other = solution.pressure(t), other.pressure(t)
     young, gap = discretisation.objective_scale, discretisation.gap_scale
     scale = max(np.sqrt(other.u @ K @ other.u), np.sqrt(young) * gap, 1e-300)
     pressure_scale = max(np.abs(lam_other).max(), young * gap
-                         / discretisation.trace.length.sum(), 1e-300)
+                         / discretisation.trace.measure.sum(), 1e-300)
     return (float(np.sqrt(du @ K @ du) / scale),
             float(np.abs(lam - lam_other).max() / pressure_scale))

@@ -60,7 +60,7 @@ def _scene(name: str):
 def _pressure_curve(scene, artifacts: dict):
     """The true pressure to draw beside lambda_h: the exact one, or the scene's closed-form
     prediction at the computed contact force of the first adaptive artifact."""
-    if scene is None:
+    if scene is None or scene.dim != 2:  # 3D: no curve along Gamma_C
         return None
     if scene.exact is not None:
         s = np.linspace(*np.sort(scene.contact_coordinate(scene.mesh.p))[[0, -1]], 801)
@@ -86,7 +86,8 @@ def scene_section(name: str, group: pd.DataFrame, results: Path | None, figs: Fi
     preferred = _first_adaptive(artifacts)
     live = interactive_figures(group, name)
     for figure, suffix, caption in (
-            (figures.scene_picture(scene) if scene is not None else None, "scene",
+            (figures.scene_picture(scene) if scene is not None and scene.dim == 2 else None,
+             "scene",
              "Geometry (initial mesh), boundary parts and the obstacle."),
             (figures.convergence(group), "convergence",
              "Error and estimator against ndofs, uniform (squares) and adaptive (circles), with "
