@@ -1,4 +1,4 @@
-"""The residual estimator's eta_0 on tetrahedra (docs/theory.md, section 13.1): the terms of
+"""The residual estimator's eta_0 on tetrahedra (docs/theory.md, section 14.1): the terms of
 ``estimators.residual`` with triangular faces for edges,
 
     eta_0^2 = (1/E) sum_T ( (h_T/p)^2 ||f + div sigma(u_h)||_T^2 + sum_{F in T} (h_F/p) R_F^2 ),

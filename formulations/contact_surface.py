@@ -1,5 +1,5 @@
 """The contact boundary Gamma_C of a tetrahedral mesh: triangular facets, their outer normals,
-quadrature on them and the location of contact coordinates (docs/theory.md, section 13).
+quadrature on them and the location of contact coordinates (docs/theory.md, section 14).
 
 It answers the same questions as the 2D ``ContactTrace`` (``formulations.contact``), with local
 coordinates t of shape (2, nq) in the reference triangle (x = a + t_0 (b - a) + t_1 (c - a))

@@ -1,5 +1,5 @@
 """Lagrange P_p (p = 1, 2, 3 on triangles; p = 1, 2 on tetrahedra) linear elasticity on
-scikit-fem: stiffness, loads, stresses (docs/theory.md, sections 1, 9 and 13).
+scikit-fem: stiffness, loads, stresses (docs/theory.md, sections 1, 9 and 14).
 
 Plane stress uses lambda* = E nu / (1 - nu^2), plane strain lambda = E nu / ((1+nu)(1-2nu)).
 Everything is vectorised over elements by scikit-fem's assembly.

@@ -1,5 +1,5 @@
 """The constraint nodes of the nodal variational inequality on a 3D contact surface
-(docs/theory.md, section 13.1): the Lagrange nodes of P1 or P2 on the contact triangles, their
+(docs/theory.md, section 14.1): the Lagrange nodes of P1 or P2 on the contact triangles, their
 lumped boundary mass and mean normals, and the rows B_i = n_i' u_h(x_i).
 
 Lumping: P1 gives each vertex a third of every facet's area. For P2 the integral of a vertex's

@@ -123,7 +123,7 @@ class ContactPrediction:
 
 @dataclass(frozen=True, eq=False)
 class Scene:
-    """A Signorini problem on a 2D or 3D body (docs/theory.md, sections 2 and 13).
+    """A Signorini problem on a 2D or 3D body (docs/theory.md, sections 2 and 14).
 
     Boundary parts are given as predicates on facet midpoints; every boundary facet that is
     neither Dirichlet nor contact is a Neumann facet (traction ``traction``, zero if None).

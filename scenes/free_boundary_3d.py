@@ -1,5 +1,5 @@
 """``free-boundary-3d``: an exact 3D Signorini solution whose contact zone, a disc, ends inside
-Gamma_C (docs/theory.md, section 13.2).
+Gamma_C (docs/theory.md, section 14.2).
 
 Omega = (-1, 1)^3 clamped on top (z = 1), Gamma_C the bottom face (outer normal (0, 0, -1)), the
 sides loaded by the exact traction. The 2D scene ``free-boundary`` turned about the z axis:

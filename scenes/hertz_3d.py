@@ -1,4 +1,4 @@
-"""``hertz-3d``: Hertz's contact of a sphere, as Hertz modelled it (docs/theory.md, 13.3).
+"""``hertz-3d``: Hertz's contact of a sphere, as Hertz modelled it (docs/theory.md, 14.3).
 
 Hertz's theory (K. L. Johnson, Contact Mechanics, 1985, section 4.2) treats the body as an
 elastic half-space pressed by a rigid sphere of radius R, i.e. the paraboloid gap

@@ -1,4 +1,4 @@
-"""``paper-3d``: the seed paper's scene lifted to 3D (docs/theory.md, section 13.4).
+"""``paper-3d``: the seed paper's scene lifted to 3D (docs/theory.md, section 14.4).
 
 Omega = (-1, 1)^3, Gamma_C the bottom face (outer normal (0, 0, -1)), Gamma_D the top face,
 traction-free sides, f = 0, E = 70000 N/mm^2, nu = 0.33 (3D elasticity). The obstacle is the

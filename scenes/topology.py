@@ -12,10 +12,27 @@ the mesh, ours or scikit-fem's, finds them.
 from __future__ import annotations
 
 import functools
+import logging
+from contextlib import contextmanager
 from dataclasses import dataclass, replace
 
 import numpy as np
 from skfem import MeshTri
+
+
+@contextmanager
+def quiet_skfem():
+    """scikit-fem's tetrahedral refinement builds its mesh from non-contiguous arrays and logs a
+    warning for every mesh ("Transforming over 1000 elements to C_CONTIGUOUS"): a note about
+    its own speed, not about the result, which would drown a run's output."""
+    logger = logging.getLogger("skfem.mesh.mesh")
+    level = logger.level
+    logger.setLevel(logging.ERROR)
+    try:
+        yield
+    finally:
+        logger.setLevel(level)
+
 
 # a triangle's facets as pairs of its local vertices: scikit-fem's RefTri.facets
 TRIANGLE_EDGES = ((0, 1), (1, 2), (0, 2))
@@ -109,7 +126,9 @@ class RefinementPlan:
     def refined(self) -> MeshTri:
         mesh, marked = self.mesh, self.marked
         if self.split is None:
-            return ensure_topology(mesh.refined() if marked is None else mesh.refined(marked))
+            with quiet_skfem():
+                return ensure_topology(mesh.refined() if marked is None
+                                       else mesh.refined(marked))
         p, t, _ = MeshTri._adaptive_split_elements(self.sorted_mesh, self.split, None)
         return ensure_topology(replace(mesh, doflocs=p, t=t, _boundaries=None,
                                        _subdomains=None))

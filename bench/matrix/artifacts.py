@@ -46,7 +46,7 @@ def save_artifact(path: Path, result, scene=None) -> Path | None:
     the facet ends (the fields ``python -m bench export`` writes)."""
     sol = result.solution
     if sol is None or not np.all(np.isfinite(sol.u)) or sol.trace.dim != 2:
-        return None  # 3D fields are not written yet (docs/theory.md, section 13.5)
+        return None  # 3D fields are not written yet (docs/theory.md, section 14.5)
     mesh = sol.elasticity.mesh
     n_elements = mesh.t.shape[1]
     stress = sol.elasticity.element_stress(sol.u)

@@ -30,7 +30,7 @@ def contact_zone(solution: DiscreteSolution) -> tuple[float, float]:
 def contact_disc(solution: DiscreteSolution) -> tuple[float, float]:
     """A 3D contact zone as (c - r, c + r): r the radius of the disc of the same area as the
     part of Gamma_C where lambda_h > ACTIVE_FRACTION x max lambda_h (by quadrature), c the
-    first contact coordinate of its centroid (docs/theory.md, section 13.2)."""
+    first contact coordinate of its centroid (docs/theory.md, section 14.2)."""
     trace = solution.trace
     t, w = trace.rule(DISC_DEGREE)
     values = solution.pressure(t)

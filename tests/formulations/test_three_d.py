@@ -73,7 +73,7 @@ def test_mixed_and_p3_are_skipped_in_3d_with_their_reasons():
 
 def test_uniform_p1_converges_against_the_exact_3d_solution():
     # the energy error of vi on three uniform levels (300, 1944, 13872 DOFs); measured slope
-    # -0.24 against N, tending to the smooth rate -1/3 (section 13.2 of docs/theory.md). The
+    # -0.24 against N, tending to the smooth rate -1/3 (section 14.2 of docs/theory.md). The
     # bound -0.15 fails if the error stalls, while the pre-asymptotic slope still passes.
     scene = get_scene("free-boundary-3d")
     n, errors = [], []
