@@ -121,8 +121,14 @@ class Elasticity:
 
     def element_stress(self, u: np.ndarray) -> np.ndarray:
         """Stress (s11, s22, s12) per element at its centroid (the basis's rule); shape
-        (3, n_elements) (P1: the constant stress of the element)."""
-        return stress_from_gradient(self.basis.interpolate(u).grad[:, :, :, 0], *self.lame)
+        (3, n_elements) (P1: the constant stress of the element). On tetrahedra the six
+        components (s11, s22, s33, s23, s13, s12)."""
+        grad = self.basis.interpolate(u).grad[:, :, :, 0]
+        if grad.shape[0] == 3:
+            sigma = stress_tensor_from_gradient(grad, *self.lame)
+            return np.array([sigma[0, 0], sigma[1, 1], sigma[2, 2], sigma[1, 2], sigma[0, 2],
+                             sigma[0, 1]])
+        return stress_from_gradient(grad, *self.lame)
 
 
 def dof_basis(mesh: MeshTri, order: int = 1) -> Basis:
@@ -157,7 +163,12 @@ def stress_from_gradient(grad: np.ndarray, lam: float, mu: float) -> np.ndarray:
 
 def von_mises(stress: np.ndarray) -> np.ndarray:
     """Plane-stress von Mises stress sqrt(s11^2 + s22^2 - s11 s22 + 3 s12^2) (docs/theory.md,
-    section 1)."""
+    section 1); from the six 3D components (s11, s22, s33, s23, s13, s12),
+    sqrt(((s11 - s22)^2 + (s22 - s33)^2 + (s33 - s11)^2) / 2 + 3 (s23^2 + s13^2 + s12^2))."""
+    if len(stress) == 6:
+        s11, s22, s33, s23, s13, s12 = stress
+        return np.sqrt(((s11 - s22) ** 2 + (s22 - s33) ** 2 + (s33 - s11) ** 2) / 2
+                       + 3 * (s23**2 + s13**2 + s12**2))
     s11, s22, s12 = stress
     return np.sqrt(s11**2 + s22**2 - s11 * s22 + 3 * s12**2)
 

@@ -36,7 +36,7 @@ def hertz_sphere(young_modulus: float, poisson_ratio: float, radius: float,
 @register_scene("hertz-3d", "Hertz contact of a sphere: a block pressed by a rigid paraboloid "
                             "of radius R (half-space model); closed-form radius and peak pressure")
 def hertz_3d(young_modulus: float = 1000.0, poisson_ratio: float = 0.3, radius: float = 1.0,
-             approach: float = 0.02, half_size: float = 2.0, initial_divisions: int = 4) -> Scene:
+             approach: float = 0.02, half_size: float = 2.0, initial_divisions: int = 8) -> Scene:
     if not (is_integer(initial_divisions) and initial_divisions >= 2
             and initial_divisions % 2 == 0):
         raise SceneError(f"initial_divisions={initial_divisions!r} is not an even integer >= 2")

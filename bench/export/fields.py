@@ -18,7 +18,10 @@ FORMATS = {"vtu": ".vtu", "xdmf": ".xdmf"}
 
 def stress_tensor(stress: np.ndarray) -> np.ndarray:
     """(s11, s22, s12) per element as 3 x 3 tensors (plane: zeros in the third row and
-    column), the layout ParaView reads as a tensor."""
+    column), the layout ParaView reads as a tensor; in 3D from (s11, s22, s33, s23, s13, s12)."""
+    if len(stress) == 6:
+        s11, s22, s33, s23, s13, s12 = stress
+        return np.stack([s11, s12, s13, s12, s22, s23, s13, s23, s33], axis=1)
     s11, s22, s12 = stress
     out = np.zeros((s11.size, 3, 3))
     out[:, 0, 0], out[:, 1, 1], out[:, 0, 1], out[:, 1, 0] = s11, s22, s12, s12
@@ -26,31 +29,35 @@ def stress_tensor(stress: np.ndarray) -> np.ndarray:
 
 
 def body_mesh(data: dict):
-    """The triangles with their point and cell fields (3D points, z = 0)."""
+    """The triangles (3D points, z = 0) or tetrahedra with their point and cell fields."""
     import meshio
 
-    points = np.vstack([data["p"], np.zeros(data["p"].shape[1])]).T
-    u = np.vstack([data["u"], np.zeros(data["u"].shape[1])]).T
+    planar = data["p"].shape[0] == 2
+    points = (np.vstack([data["p"], np.zeros(data["p"].shape[1])]) if planar else data["p"]).T
+    u = (np.vstack([data["u"], np.zeros(data["u"].shape[1])]) if planar else data["u"]).T
     cells = {"stress": stress_tensor(data["stress"]), "von_mises": data["von_mises"],
              "indicator": data["indicators"], "error_density": data["error_density"]}
-    return meshio.Mesh(points, [("triangle", data["t"].T)], point_data={"displacement": u},
+    return meshio.Mesh(points, [("triangle" if planar else "tetra", data["t"].T)],
+                       point_data={"displacement": u},
                        cell_data={k: [np.asarray(v, dtype=float)] for k, v in cells.items()})
 
 
 def contact_mesh(data: dict):
-    """Gamma_C as line cells, each facet with its own two points (lambda_h and the gap may
-    jump between facets), with lambda_h and the gap at the facet ends."""
+    """Gamma_C as line cells (triangles in 3D), each facet with its own points (lambda_h and the
+    gap may jump between facets), with lambda_h and the gap at the facet's vertices."""
     import meshio
 
-    vertices = data["trace_vertices"]  # (2, n_facets): start and end vertex of each facet
-    n = vertices.shape[1]
-    ends = np.concatenate([vertices[0], vertices[1]])  # point k: start (k < n) or end
-    points = np.vstack([data["p"][:, ends], np.zeros(2 * n)]).T
-    lines = np.column_stack([np.arange(n), np.arange(n, 2 * n)])
-    point_data = {"lambda_h": np.concatenate([data["trace_pressure"][0],
-                                              data["trace_pressure"][1]]),
-                  "gap": np.concatenate([data["trace_gap"][0], data["trace_gap"][1]])}
-    return meshio.Mesh(points, [("line", lines)], point_data=point_data)
+    vertices = data["trace_vertices"]  # (k, n_facets): the k vertices of each facet
+    k, n = vertices.shape
+    corners = vertices.ravel()  # point j n + f: vertex j of facet f
+    points = data["p"][:, corners]
+    if points.shape[0] == 2:
+        points = np.vstack([points, np.zeros(k * n)])
+    cells = (np.arange(k)[None, :] * n + np.arange(n)[:, None])
+    point_data = {"lambda_h": np.asarray(data["trace_pressure"]).ravel(),
+                  "gap": np.asarray(data["trace_gap"]).ravel()}
+    return meshio.Mesh(points.T, [("line" if k == 2 else "triangle", cells)],
+                       point_data=point_data)
 
 
 LEVELS = ("last", "all")

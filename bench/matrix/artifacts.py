@@ -15,6 +15,7 @@ import numpy as np
 from bench.measure.contact import contact_zone
 from bench.measure.discretisation_error import element_energy_errors
 from bench.sequence.rows import KEYS
+from formulations.contact_surface import TRIANGLE_VERTICES
 from formulations.elasticity import von_mises
 
 PRESSURE_SAMPLES = np.linspace(0.0, 1.0, 9)
@@ -40,22 +41,25 @@ def level_artifact_path(out: str | Path, row) -> Path:
 def save_artifact(path: Path, result, scene=None) -> Path | None:
     """Write a level of a sequence (``bench.sequence.loop.LevelResult``) to ``path`` (its
     ``level_artifact_path``); None if it has no solution. Fields per element: the centroid
-    stress (s11, s22, s12), von Mises, the estimator's squared indicators and, where ``scene``
-    has an exact solution, the squared
-    energy-norm error per element; on Gamma_C: the facets' vertices, lambda_h and the gap at
-    the facet ends (the fields ``python -m bench export`` writes)."""
+    stress (s11, s22, s12; in 3D s11, s22, s33, s23, s13, s12), von Mises, the estimator's
+    squared indicators and, where ``scene`` has an exact solution, the squared energy-norm
+    error per element; on Gamma_C: the facets' vertices, lambda_h and the gap at the facet
+    ends (the triangles' corners in 3D) (the fields ``python -m bench export`` writes)."""
     sol = result.solution
-    if sol is None or not np.all(np.isfinite(sol.u)) or sol.trace.dim != 2:
-        return None  # 3D fields are not written yet (docs/theory.md, section 14.5)
+    if sol is None or not np.all(np.isfinite(sol.u)):
+        return None
     mesh = sol.elasticity.mesh
     n_elements = mesh.t.shape[1]
     stress = sol.elasticity.element_stress(sol.u)
     estimate = result.estimate
     indicators = (estimate.indicators if estimate is not None
                   else np.full(n_elements, np.nan))
-    ends = sol.pressure(np.array([0.0, 1.0]))  # (n_facets, 2)
-    gap = (np.asarray(scene.gap(mesh.p[:, sol.trace.vertices].reshape(2, -1)), dtype=float)
-           .reshape(2, -1) if scene is not None else np.full(sol.trace.vertices.shape, np.nan))
+    trace, dim = sol.trace, mesh.dim()
+    corners = np.array([0.0, 1.0]) if dim == 2 else TRIANGLE_VERTICES
+    ends = sol.pressure(corners)  # (n_facets, 2 or 3): at each facet's vertices
+    k = trace.vertices.shape[0]
+    gap = (np.asarray(scene.gap(mesh.p[:, trace.vertices].reshape(dim, -1)), dtype=float)
+           .reshape(k, -1) if scene is not None else np.full(trace.vertices.shape, np.nan))
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_suffix(".tmp.npz")
     np.savez_compressed(
@@ -63,7 +67,8 @@ def save_artifact(path: Path, result, scene=None) -> Path | None:
         von_mises=von_mises(stress), indicators=indicators,
         error_density=element_error_density(scene, sol, n_elements),
         trace_vertices=sol.trace.vertices, trace_pressure=ends.T, trace_gap=gap,
-        trace_coordinate=sol.trace.coordinate, pressure=sol.pressure(PRESSURE_SAMPLES),
+        trace_coordinate=sol.trace.coordinate,
+        pressure=sol.pressure(PRESSURE_SAMPLES) if dim == 2 else ends,
         zone=np.array(contact_zone(sol)), contact_force=sol.contact_force(),
         ndofs=sol.elasticity.ndofs, level=result.row.level)
     os.replace(tmp, path)

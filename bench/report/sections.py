@@ -10,7 +10,7 @@ import numpy as np
 import pandas as pd
 
 from bench.matrix.artifacts import artifact_path, file_stem, load_artifact
-from bench.report import figures
+from bench.report import figures, figures_3d
 from bench.report.interactive import interactive_figures
 from bench.sequence.rows import KEYS
 from scenes import get_scene
@@ -78,6 +78,31 @@ def _first_adaptive(artifacts: dict):
     return next(iter(v for k, v in sorted(artifacts.items()) if k[2] == "adaptive"), None)
 
 
+def field_figures(scene, name: str, artifacts: dict, preferred) -> tuple:
+    """The 2D figures drawn from the artifacts: meshes, deformed body, pressure curve."""
+    return (
+        (figures.meshes(artifacts), "meshes",
+         "Final adaptive meshes per formulation/estimator (the paper's Figure 1b)."),
+        (figures.deformed(preferred, name), "deformed",
+         "Deformed body coloured by von Mises stress; the colour scale is clipped at the "
+         f"{figures.VON_MISES_PERCENTILE:g}th percentile because the stress is singular at "
+         "the clamped corners (the paper's Figure 1a)."),
+        (figures.pressures(artifacts, _pressure_curve(scene, artifacts)), "pressure",
+         "Contact pressure lambda_h along Gamma_C (adaptive, last level) per formulation; "
+         "dotted lines are the contact-zone end points."))
+
+
+def field_figures_3d(artifacts: dict) -> tuple:
+    """The 3D figures drawn from the artifacts: pressure maps and mesh slices."""
+    return (
+        (figures_3d.pressure_maps(artifacts), "pressure",
+         "Contact pressure lambda_h on Gamma_C over the contact coordinates (x, y) (adaptive, "
+         "last level) per formulation; the dashed circle has the contact zone's area."),
+        (figures_3d.mesh_slices(artifacts), "meshes",
+         "Final adaptive meshes cut by the plane y = 0, coloured by von Mises stress (clipped "
+         f"at its {figures.VON_MISES_PERCENTILE:g}th percentile)."))
+
+
 def scene_section(name: str, group: pd.DataFrame, results: Path | None, figs: Figures,
                   truth: dict) -> dict:
     scene = _scene(name)
@@ -98,15 +123,8 @@ def scene_section(name: str, group: pd.DataFrame, results: Path | None, figs: Fi
             (figures.work_precision(group), "work-precision",
              "Work-precision: error (eta without a truth) against cumulative wall time and "
              "against the level's solve time."),
-            (figures.meshes(artifacts), "meshes",
-             "Final adaptive meshes per formulation/estimator (the paper's Figure 1b)."),
-            (figures.deformed(preferred, name), "deformed",
-             "Deformed body coloured by von Mises stress; the colour scale is clipped at the "
-             f"{figures.VON_MISES_PERCENTILE:g}th percentile because the stress is singular at "
-             "the clamped corners (the paper's Figure 1a)."),
-            (figures.pressures(artifacts, _pressure_curve(scene, artifacts)), "pressure",
-             "Contact pressure lambda_h along Gamma_C (adaptive, last level) per formulation; "
-             "dotted lines are the contact-zone end points.")):
+            *(field_figures(scene, name, artifacts, preferred) if scene is None
+              or scene.dim == 2 else field_figures_3d(artifacts))):
         item = figs.add(figure, file_stem(name, suffix), caption, live.get(suffix))
         if item is not None:
             section["figures"].append(item)
