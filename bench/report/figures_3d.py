@@ -45,7 +45,7 @@ def pressure_maps(artifacts: dict):
     if not chosen:
         return None
     fig, axes = _grid(len(chosen))
-    for ax, (formulation, (key, data)) in zip(axes, chosen.items(), strict=False):
+    for ax, (formulation, (_, data)) in zip(axes, chosen.items(), strict=False):
         s = data["trace_coordinate"]  # (2, 3, n): the corners' contact coordinates
         n = s.shape[2]
         points = s.transpose(0, 2, 1).reshape(2, -1)  # point 3 f + j: corner j of facet f
