@@ -8,7 +8,9 @@ constant stresses of the elements at a vertex), and
     eta_A^2 = sum_T ||C^{-1/2} (sigma_h - A sigma_h)||_{0,T}^2,
     sigma : C^{-1} sigma = (sigma : sigma - lambda/(2 (lambda + mu)) (tr sigma)^2) / (2 mu)
 
-with the 2D Lame constants of the scene (lambda* in plane stress). This is in energy-norm units
+with the 2D Lame constants of the scene (lambda* in plane stress); on tetrahedra the same with
+the nine stress entries and sigma : C^{-1} sigma = (sigma : sigma - lambda / (3 lambda + 2 mu)
+(tr sigma)^2) / (2 mu), weights the elements' volumes. This is in energy-norm units
 already (no weighting needed, unlike ``residual``). The integrand has degree 2p on each
 triangle, integrated exactly. A sigma_h is one degree above sigma_h (degree p - 1), as for P1,
 which is what lets it approximate sigma to the order sigma_h does (docs/theory.md, section 9).
@@ -21,10 +23,14 @@ from __future__ import annotations
 import numpy as np
 from skfem import Basis
 
-from estimators.base import Estimate, combine, planar_only, register_estimator
+from estimators.base import Estimate, combine, register_estimator
 from estimators.contact_terms import contact_terms
 from formulations import DiscreteSolution
-from formulations.elasticity import ELEMENTS, stress_from_gradient
+from formulations.elasticity import (
+    scalar_elements,
+    stress_from_gradient,
+    stress_tensor_from_gradient,
+)
 from formulations.evaluation import gradients_at_reference
 from formulations.p1_stiffness import barycentric_gradients
 
@@ -41,15 +47,28 @@ def averaged_stress(solution: DiscreteSolution, scalar: Basis) -> np.ndarray:
     mesh = elasticity.mesh
     grad = gradients_at_reference(elasticity.basis, solution.u, scalar.elem.doflocs.T)
     n_local = grad.shape[-1]
-    stress = stress_from_gradient(grad, *elasticity.lame).reshape(3, -1)  # element-major
+    stress = stresses(grad, elasticity.lame).reshape(-1, grad.shape[2] * n_local)
     dofs = scalar.element_dofs.T.ravel()  # element-major, as ``stress``
-    weight = np.repeat(element_areas(mesh), n_local)
+    sizes = element_areas(mesh) if mesh.dim() == 2 else scalar.dx.sum(axis=1)  # volumes
+    weight = np.repeat(sizes, n_local)
     total = np.bincount(dofs, weight, scalar.N)
     return np.array([np.bincount(dofs, weight * s, scalar.N) for s in stress]) / total
 
 
+def stresses(grad: np.ndarray, lame: tuple[float, float]) -> np.ndarray:
+    """sigma(grad) as (s11, s22, s12, ...) in 2D, as the nine tensor entries in 3D."""
+    if grad.shape[0] == 3:
+        sigma = stress_tensor_from_gradient(grad, *lame)
+        return sigma.reshape((9,) + sigma.shape[2:])
+    return stress_from_gradient(grad, *lame)
+
+
 def compliance_energy(stress: np.ndarray, lam: float, mu: float) -> np.ndarray:
-    """sigma : C^-1 sigma for stresses given as (s11, s22, s12, ...)."""
+    """sigma : C^-1 sigma for stresses given as (s11, s22, s12, ...); in 3D as the nine
+    entries, (sigma : sigma - lambda / (3 lambda + 2 mu) (tr sigma)^2) / (2 mu)."""
+    if len(stress) == 9:
+        trace = stress[0] + stress[4] + stress[8]
+        return ((stress**2).sum(axis=0) - lam / (3 * lam + 2 * mu) * trace**2) / (2 * mu)
     s11, s22, s12 = stress
     trace = s11 + s22
     return (s11**2 + s22**2 + 2 * s12**2 - lam / (2 * (lam + mu)) * trace**2) / (2 * mu)
@@ -60,17 +79,16 @@ def averaging_indicators(solution: DiscreteSolution) -> np.ndarray:
     elasticity = solution.elasticity
     lam, mu = elasticity.lame
     order = elasticity.order
-    scalar = Basis(elasticity.mesh, ELEMENTS[order](), intorder=2 * order)
+    mesh = elasticity.mesh
+    scalar = Basis(mesh, scalar_elements(mesh.dim())[order](), intorder=2 * order)
     recovered = averaged_stress(solution, scalar)
     at_points = np.array([np.asarray(scalar.interpolate(r)) for r in recovered])
-    grad = Basis(elasticity.mesh, elasticity.basis.elem, quadrature=scalar.quadrature)
-    stress = stress_from_gradient(grad.interpolate(solution.u).grad, lam, mu)
+    grad = Basis(mesh, elasticity.basis.elem, quadrature=scalar.quadrature)
+    stress = stresses(grad.interpolate(solution.u).grad, (lam, mu))
     return (compliance_energy(stress - at_points, lam, mu) * scalar.dx).sum(axis=1)
 
 
 @register_estimator("averaging", "Zienkiewicz-Zhu nodal stress averaging in the energy norm "
-                                 "plus the geometric and complementarity contact terms of (8)",
-                    applies=planar_only("averaging", "the nodal stress recovery is written for "
-                                                     "3 stress components"))
+                                 "plus the geometric and complementarity contact terms of (8)")
 def estimate(scene, solution: DiscreteSolution) -> Estimate:
     return combine("averaging", averaging_indicators(solution), contact_terms(scene, solution))

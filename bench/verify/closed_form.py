@@ -11,11 +11,12 @@ from bench.sequence.loop import LoopConfig, run_sequence
 from scenes import get_scene
 
 PEAK_SAMPLES = 8001  # points over +-4 half-widths where the computed peak pressure is sought
+PEAK_GRID_3D = 201  # 3D: a grid of 201 x 201 points over +-2 contact radii
 
 
 def closed_form_table(run: dict) -> pd.DataFrame:
-    """One row per formulation: computed and predicted half-width and peak pressure, and their
-    relative errors (``run``: the ``[closed_form]`` entry of expected.toml)."""
+    """One row per formulation: computed and predicted half-width (the contact radius in 3D, that
+    of the disc of the contact zone's area) and peak pressure, and their relative errors (``run``: the ``[closed_form]`` entry of expected.toml)."""
     scene = get_scene(run["scene"])
     rows = []
     for formulation in run["formulations"]:
@@ -27,7 +28,11 @@ def closed_form_table(run: dict) -> pd.DataFrame:
         start, end = contact_zone(sol)
         b = predicted.half_width
         s = np.linspace(predicted.centre - 4 * b, predicted.centre + 4 * b, PEAK_SAMPLES)
-        rows.append({"scene": scene.name, "formulation": formulation,
+        if scene.dim == 3:  # a square grid over the disc's surroundings
+            line = np.linspace(predicted.centre - 2 * b, predicted.centre + 2 * b,
+                               PEAK_GRID_3D)
+            s = np.array(np.meshgrid(line, line - predicted.centre)).reshape(2, -1)
+        rows.append({"scene": scene.name, "formulation": formulation, "dim": scene.dim,
                      "ndofs": result.row.ndofs, "contact_force": force,
                      "half_width": 0.5 * (end - start), "predicted_half_width": b,
                      "peak_pressure": float(sol.pressure_at(s).max()),
