@@ -16,7 +16,8 @@ PEAK_GRID_3D = 201  # 3D: a grid of 201 x 201 points over +-2 contact radii
 
 def closed_form_table(run: dict) -> pd.DataFrame:
     """One row per formulation: computed and predicted half-width (the contact radius in 3D, that
-    of the disc of the contact zone's area) and peak pressure, and their relative errors (``run``: the ``[closed_form]`` entry of expected.toml)."""
+    of the disc of the contact zone's area) and peak pressure, and their relative errors
+    (``run``: the ``[closed_form]`` entry of expected.toml)."""
     scene = get_scene(run["scene"])
     rows = []
     for formulation in run["formulations"]:
