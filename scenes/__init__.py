@@ -8,6 +8,7 @@ from scenes import (  # noqa: F401  (register themselves)
     free_boundary,
     free_boundary_3d,
     hard,
+    hard_3d,
     hertz,
     hertz_3d,
     paper,
