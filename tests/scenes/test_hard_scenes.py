@@ -8,6 +8,7 @@ import pytest
 from bench.hard import check_expected
 from bench.verify import load_expected
 from formulations import formulation_names, get_formulation, solve
+from formulations.registry import FORMULATIONS
 from scenes import get_scene, scene_names
 
 HARD = [name for name in scene_names() if "hard" in get_scene(name).tags]
@@ -18,23 +19,31 @@ def test_the_catalogue_has_the_hard_scenes():
             "traction", "corner", "graded"} <= set(HARD)
 
 
-def expected_to_fail(case: str, formulation: str, solver: str) -> bool:
-    """Whether bench/verify/expected.toml expects this hard-scene solve to fail (the
-    symmetric Nitsche functional is not convex on some hard scenes: no reference)."""
+def expected_verdicts(case: str, formulation: str, solver: str) -> set[str]:
+    """The verdicts bench/verify/expected.toml allows for this hard-scene solve (the symmetric
+    Nitsche functional is not convex on some hard scenes: no reference)."""
     row = pd.DataFrame([{"case": case, "formulation": formulation, "solver": solver,
                          "variant": "", "verdict": "failed"}])
-    return check_expected(row, load_expected().get("hard", []))[0]["expected"] == "failed"
+    return set(check_expected(row, load_expected().get("hard", []))[0]["expected"].split("|"))
 
 
-@pytest.fixture(scope="module", params=[(s, f) for s in HARD for f in formulation_names()],
-                ids=lambda p: "-".join(p))
+def refinements(scene) -> int:
+    """Uniform refinements of a hard scene here: 2 in 2D (544..4752 DOFs), 1 in 3D."""
+    return 2 if scene.dim == 2 else 1
+
+
+@pytest.fixture(scope="module", params=[
+    (s, f) for s in HARD for f in formulation_names()
+    if FORMULATIONS.why_not(f, scene=get_scene(s)) is None], ids=lambda p: "-".join(p))
 def solved(request):
     name, formulation = request.param
     scene = get_scene(name)
-    disc = get_formulation(formulation)(scene, scene.mesh.refined(2))
+    disc = get_formulation(formulation)(scene, scene.mesh.refined(refinements(scene)))
     reference = solve(disc, "reference")
-    if expected_to_fail(name, formulation, "reference"):
+    allowed = expected_verdicts(name, formulation, "reference")
+    if allowed == {"failed"}:
         assert reference.status == "failed"
+    if "failed" in allowed and reference.status != "ok":
         reference = None
     return scene, disc, solve(disc, "active-set"), reference
 
@@ -65,7 +74,7 @@ def test_fast_and_reference_agree(solved):
 
 def _fast(name, formulation):
     scene = get_scene(name)
-    disc = get_formulation(formulation)(scene, scene.mesh.refined(2))
+    disc = get_formulation(formulation)(scene, scene.mesh.refined(refinements(scene)))
     return disc, solve(disc, "active-set")
 
 
