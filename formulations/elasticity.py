@@ -32,6 +32,7 @@ from formulations.dof_basis import DofBasis
 from formulations.load import body_load
 from formulations.p1_stiffness import p1_stiffness
 from formulations.p2_stiffness import p2_stiffness
+from formulations.tet_stiffness import tet_stiffness
 from scenes import Scene
 from scenes.base import is_integer
 from scenes.topology import RefinementPlan, ensure_topology
@@ -180,9 +181,8 @@ def assemble_elasticity(scene: Scene, mesh: MeshTri, order: int = 1) -> Elastici
     ensure_topology(mesh)
     basis = dof_basis(mesh, order)
     lam, mu = scene.material.lame
-    if mesh.dim() == 3:  # strain products have degree 2(p - 1): a rule of that order is exact
-        K = asm(linear_elasticity(lam, mu),
-                Basis(mesh, basis.elem, intorder=max(2 * (order - 1), 1))).tocsr()
+    if mesh.dim() == 3:  # local matrices on affine tetrahedra (formulations.tet_stiffness)
+        K = tet_stiffness(basis, lam, mu)
     elif order == 1:  # constant strains: the closed-form local matrices (formulations.p1_stiffness)
         K = p1_stiffness(mesh, lam, mu)
     elif order == 2:  # the same straight into CSR (formulations.p2_stiffness)
