@@ -32,7 +32,8 @@ from bench.matrix.plugins import FAILURES, load_plugins
 from bench.matrix.run import RunRefused
 from bench.matrix.scene_files import load_scene_files, scene_files_in
 from bench.matrix.store import ResultsError, read_results
-from bench.perf.scaling import run_scaling, write_scaling
+from bench.perf.scaling import SIZES, run_scaling, write_scaling
+from bench.perf.scaling_3d import SIZES_3D, run_scaling_3d, write_scaling_3d
 from bench.perf.sequence import SEQUENCES, run_sequences, write_sequences
 from bench.report import write_report
 from bench.sequence.loop import LevelResult
@@ -216,10 +217,26 @@ def scaling_command(args) -> int:
         raise InputError(f"--backend: {error}") from None
     if args.sequence:
         return sequence_command(args)
-    frame = run_scaling(args.sizes, args.backend, args.reference_max_dofs, on_row=show,
+    sizes = args.sizes or list(SIZES_3D if args.dim == 3 else SIZES)
+    allowed = SIZES_3D if args.dim == 3 else SIZES
+    wrong = [size for size in sizes if size not in allowed]
+    if wrong:
+        raise InputError(f"--sizes={','.join(wrong)} is not one of {', '.join(allowed)} "
+                         f"in {args.dim}D")
+    if args.dim == 3:
+        frame = run_scaling_3d(sizes, args.backend, args.order, on_row=show_3d)
+        print(f"wrote {write_scaling_3d(frame, args.out, args.readme)}")
+        return 0
+    frame = run_scaling(sizes, args.backend, args.reference_max_dofs, on_row=show,
                         orders=args.order)
     print(f"wrote {write_scaling(frame, args.out, args.readme)}")
     return 0
+
+
+def show_3d(row) -> None:
+    print(f"{row['size']} P{row['order']} 3D: ndofs {row['ndofs']}  assembly "
+          f"{row['t_assemble']:.2f} s  linear {row['t_linear_solve']:.2f} s  fast "
+          f"{row['t_fast_solve']:.2f} s  peak {row['peak_gib']:.2f} GiB", flush=True)
 
 
 def sequence_command(args) -> int:

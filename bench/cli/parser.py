@@ -20,6 +20,7 @@ from bench.export import FORMATS, LEVELS
 from bench.hard import hard_case_names
 from bench.matrix.run import COMPARE_REFERENCE_DOFS
 from bench.perf.scaling import SIZES
+from bench.perf.scaling_3d import SIZES_3D
 from bench.perf.sequence import SEQUENCES
 from bench.sequence.loop import STRATEGIES
 from bench.sequence.marking import MARKINGS
@@ -165,8 +166,12 @@ def _scaling_parser(sub) -> None:
         "the estimator against N, with peak memory",
         description="Measure every phase once per size, each size in a fresh process, and "
         "write OUT/scaling.{md,csv} (and the README's table with --readme).")
-    scaling.add_argument("--sizes", type=name_list("size", list(SIZES)), default=list(SIZES),
-                         help=f"sizes, comma-separated: {', '.join(SIZES)} (default: all)")
+    scaling.add_argument("--sizes", type=name_list("size", sorted(set(SIZES) | set(SIZES_3D))),
+                         default=None, help=f"sizes, comma-separated: {', '.join(SIZES)}; with "
+                         f"--dim 3: {', '.join(SIZES_3D)} (default: all of the dimension's)")
+    scaling.add_argument("--dim", type=int, choices=(2, 3), default=2,
+                         help="2 (default): the paper scene, mixed; 3: paper-3d, vi, on "
+                              "tetrahedra (OUT/scaling-3d.{md,csv})")
     scaling.add_argument("--backend", choices=backend_names(), default=None,
                          help="sparse back-end (default: the first available of "
                               + ", ".join(backend_names()) + ")")
