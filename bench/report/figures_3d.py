@@ -78,8 +78,8 @@ def slice_polygons(p: np.ndarray, t: np.ndarray, y0: float):
     points = p[:, a] + frac[None] * (p[:, b] - p[:, a])  # (3, 6, nE), NaN off the cut
     xz = points[[0, 2]].transpose(2, 1, 0)  # (nE, 6, 2)
     count = crossing.sum(axis=0)
-    centre = np.nanmean(np.where(crossing.T[:, :, None], xz, np.nan), axis=1,
-                        keepdims=True) if count.any() else xz[:, :1]
+    centre = (np.where(crossing.T[:, :, None], xz, 0.0).sum(axis=1, keepdims=True)
+              / np.maximum(count, 1)[:, None, None])
     angle = np.where(crossing.T, np.arctan2(xz[..., 1] - centre[..., 1],
                                             xz[..., 0] - centre[..., 0]), np.inf)
     ordered = np.take_along_axis(xz, np.argsort(angle, axis=1)[:, :, None], axis=1)
