@@ -33,7 +33,12 @@ from formulations.elasticity import assemble_elasticity, check_order
 from formulations.evaluation import evaluate_on_trace
 from formulations.kkt import count_active
 from formulations.registry import register_formulation
-from formulations.surface_nodes import surface_nodes, surface_pressure, surface_rows
+from formulations.surface_nodes import (
+    nodal_pressures,
+    surface_nodes,
+    surface_pressure,
+    surface_rows,
+)
 from scenes import Scene
 
 
@@ -116,7 +121,8 @@ def discretise(scene: Scene, mesh: MeshTri, order: int = 1) -> Discretisation:
     def recover(answer: QPSolution, residuals: Residuals, status: str,
                 reason: str) -> DiscreteSolution:
         reaction = np.maximum(answer.multipliers, 0.0)
-        lam = reaction / nodes.weight
+        lam = (reaction / nodes.weight if trace.dim == 2
+               else nodal_pressures(trace, nodes, reaction))
         values = lam[nodes.facet_rows]  # (n_facets, p + 1)
 
         def pressure(t):
