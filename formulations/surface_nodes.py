@@ -11,8 +11,8 @@ oscillates and its error stalls (measured on free-boundary-3d: 1.44e-3 from 1e5 
 So P2 solves the consistent boundary mass system M lambda = r (M_ij = int phi_i phi_j over
 Gamma_C), which reproduces any P2 pressure and keeps the contact force (1'M lambda = 1'r), and
 clips lambda at 0 (next to the contact zone's edge the solve can give small negative values);
-lambda_h is the P2 interpolant of those values. The lumped weights still weigh the nodal
-normals.
+lambda_h is the P2 interpolant of those values, clipped at 0. The lumped weights still weigh
+the nodal normals.
 """
 
 from __future__ import annotations
@@ -80,5 +80,7 @@ def nodal_pressures(trace, nodes: TraceNodes, reaction: np.ndarray) -> np.ndarra
 
 def surface_pressure(values: np.ndarray, t: np.ndarray) -> np.ndarray:
     """lambda_h (n_facets, nq) at local coordinates t (2, nq) from its values at the facet's
-    nodes (n_facets, 3 or 6): the P1 or P2 Lagrange interpolant on the facet."""
-    return values @ triangle_lagrange(values.shape[1] // 3)[1](np.asarray(t, dtype=float))
+    nodes (n_facets, 3 or 6): the P1 or P2 Lagrange interpolant on the facet, clipped at 0 (a
+    quadratic through non-negative values can dip below 0 between them)."""
+    basis = triangle_lagrange(values.shape[1] // 3)[1]
+    return np.maximum(values @ basis(np.asarray(t, dtype=float)), 0.0)

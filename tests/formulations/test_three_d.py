@@ -106,7 +106,7 @@ def test_uniform_p1_converges_against_the_exact_3d_solution():
 
 def test_p2_nodal_pressure_of_vi_converges():
     # P2 reactions through the consistent boundary mass (formulations.surface_nodes): the
-    # pressure error against the exact one falls 1.70e-3 -> 7.0e-4 (1944 -> 13 872 DOFs;
+    # pressure error against the exact one falls 1.64e-3 -> 6.9e-4 (1944 -> 13 872 DOFs;
     # sub-triangle lumping stalled at 1.4e-3); 0.6 leaves room for the rule's round-off only
     scene = get_scene("free-boundary-3d")
     errors = []
