@@ -105,6 +105,15 @@ def evaluate_on_trace(basis: Basis, trace, t: np.ndarray) -> PointEvaluation:
                        np.repeat(trace.element, nq))
 
 
+def drop_roundoff(matrix: sparse.csr_matrix, relative: float = 1e-12) -> sparse.csr_matrix:
+    """``matrix`` without its entries below ``relative`` x its largest: the values of basis
+    functions that vanish on a facet, evaluated there, are round-off (~1e-17), not coupling."""
+    matrix = matrix.tocsr(copy=True)
+    matrix.data[np.abs(matrix.data) < relative * np.abs(matrix.data).max(initial=0.0)] = 0.0
+    matrix.eliminate_zeros()
+    return matrix
+
+
 def normal_trace_matrix(basis: Basis, trace, t: np.ndarray) -> sparse.csr_matrix:
     """u -> u_h . n at local coordinates ``t`` of every contact facet (row f * nq + q), on
     all DOFs."""

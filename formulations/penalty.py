@@ -55,7 +55,7 @@ from formulations.base import (
 from formulations.contact import contact_trace, gap_interpolant
 from formulations.discretisation import Discretisation, discrete_solution
 from formulations.elasticity import assemble_elasticity, check_order
-from formulations.evaluation import normal_trace_matrix
+from formulations.evaluation import drop_roundoff, normal_trace_matrix
 from formulations.registry import register_formulation
 from formulations.semismooth import SemismoothSystem
 from scenes import Scene
@@ -138,6 +138,8 @@ def discretise(scene: Scene, mesh: MeshTri, epsilon_0: float = DEFAULT_EPSILON_0
     gap_h = gap_interpolant(scene, trace, order)
     gap = gap_h(t)
     P = normal_trace_matrix(elasticity.basis, trace, t)[:, elasticity.free].tocsr()
+    if trace.dim == 3:  # round-off of the functions that vanish on the facet, and normal
+        P = drop_roundoff(P)  # components it lacks: not columns of the Schur set
     epsilon = epsilon_0 * trace.diameter / (order**2 * young)
     # per Gauss point: eps, and Gauss weight x facet measure (its share of Gamma_C)
     row_epsilon, row_length = np.repeat(epsilon, nq), np.tile(w, nf) * np.repeat(trace.measure,

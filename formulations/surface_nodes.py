@@ -57,8 +57,12 @@ def surface_rows(elasticity, nodes: TraceNodes) -> sparse.csr_matrix:
     if nodes.edges.size:
         dofs = np.concatenate([dofs, basis.edge_dofs[:, nodes.edges]], axis=1)
     m = dofs.shape[1]
-    return sparse.csr_matrix((nodes.normal.ravel(), (np.tile(np.arange(m), 3), dofs.ravel())),
+    rows = sparse.csr_matrix((nodes.normal.ravel(), (np.tile(np.arange(m), 3), dofs.ravel())),
                              shape=(m, basis.N))
+    # a component a normal does not have is no column of B: on a plane Gamma_C the condensed
+    # solvers' Schur set is then one DOF per node, not three (a dense block 9x smaller)
+    rows.eliminate_zeros()
+    return rows
 
 
 def nodal_pressures(trace, nodes: TraceNodes, reaction: np.ndarray) -> np.ndarray:
