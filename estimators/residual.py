@@ -18,11 +18,11 @@ material constants, so rates and marking are unaffected by the weight).
 from __future__ import annotations
 
 import numpy as np
-from skfem import Basis, ElementTriP0
+from skfem import Basis, ElementTetP0, ElementTriP0
 
 from estimators.base import Estimate, combine, register_estimator
 from estimators.contact_terms import contact_terms
-from estimators.residual_3d import element_residual_3d, face_residuals_3d
+from estimators.residual_3d import face_residuals_3d, stress_divergence_3d
 from formulations import DiscreteSolution
 from formulations.contact import gauss_legendre, outer_normals
 from formulations.elasticity import ELEMENTS, element_diameters, stress_from_gradient
@@ -63,19 +63,22 @@ def stress_divergence(solution: DiscreteSolution, basis: Basis) -> np.ndarray:
 
 
 def element_residual(scene, solution: DiscreteSolution) -> np.ndarray:
-    """(h_T / p)^2 ||f + div sigma(u_h)||_T^2 per element (div sigma(u_h) = 0 for P1)."""
+    """(h_T / p)^2 ||f + div sigma(u_h)||_T^2 per triangle or tetrahedron (div sigma(u_h) = 0
+    for P1)."""
     elasticity = solution.elasticity
     mesh, order = elasticity.mesh, elasticity.order
     if scene.body_force is None and order == 1:
         return np.zeros(mesh.t.shape[1])
     # scikit-fem's default rule for P_p; a scalar P0 basis carries it (dx and the points)
     # without the vector basis functions nothing here reads
-    basis = Basis(mesh, ElementTriP0(), intorder=2 * order)
-    residual = np.zeros((2,) + basis.dx.shape)
+    d = mesh.dim()
+    basis = Basis(mesh, ElementTriP0() if d == 2 else ElementTetP0(), intorder=2 * order)
+    residual = np.zeros((d,) + basis.dx.shape)
     if scene.body_force is not None:
         residual += scene.body_force(np.asarray(basis.global_coordinates()))
     if order > 1:
-        residual += stress_divergence(solution, basis)
+        residual += (stress_divergence(solution, basis) if d == 2
+                     else stress_divergence_3d(solution, basis.dx.shape[1]))
     norm2 = ((residual**2).sum(axis=0) * basis.dx).sum(axis=1)
     return (element_diameters(mesh) / order) ** 2 * norm2
 
@@ -144,6 +147,6 @@ def volume_terms(scene, solution: DiscreteSolution) -> np.ndarray:
     """eta_0^2 per element: element residuals and edge (2D) or face (3D) residuals, over E."""
     young = float(scene.material.young_modulus)
     if solution.trace.dim == 3:
-        return (element_residual_3d(scene, solution)
+        return (element_residual(scene, solution)
                 + face_residuals_3d(scene, solution)) / young
     return (element_residual(scene, solution) + edge_residuals(scene, solution)) / young

@@ -6,17 +6,18 @@
 R_F = 1/2 ||[sigma_n(u_h)]||_F inside, ||sigma_n(u_h) - q||_F on Gamma_N and
 ||sigma_nn(u_h) + lambda_h||_F + ||sigma_nt(u_h)||_F on Gamma_C; h_F is the face's diameter.
 For P1 and P2 on affine tetrahedra sigma(u_h) is of degree p - 1, so div sigma(u_h) is 0 (P1)
-or constant per element (P2).
+or constant per element (P2, ``stress_divergence_3d``); the element residual itself is
+``estimators.residual.element_residual``, the same in both dimensions.
 """
 
 from __future__ import annotations
 
 import numpy as np
-from skfem import Basis, ElementTetP0, ElementTetP1
+from skfem import ElementTetP1
 
 from formulations import DiscreteSolution
 from formulations.contact_surface import outer_triangle_normals, triangle_rule
-from formulations.elasticity import element_diameters, stress_tensor_from_gradient
+from formulations.elasticity import stress_tensor_from_gradient
 from formulations.evaluation import gradients_at, gradients_at_reference
 from scenes.base import simplex_measures, simplex_points
 
@@ -29,27 +30,20 @@ def stress_at(solution: DiscreteSolution, x: np.ndarray, cells: np.ndarray) -> n
     return stress_tensor_from_gradient(grad, *solution.elasticity.lame)
 
 
-def element_residual_3d(scene, solution: DiscreteSolution) -> np.ndarray:
-    """(h_T / p)^2 ||f + div sigma(u_h)||_T^2 per tetrahedron."""
+def stress_divergence_3d(solution: DiscreteSolution, n_points: int) -> np.ndarray:
+    """div sigma(u_h) (3, n_elements, n_points) of P2 on tetrahedra: sigma(u_h) is linear, so
+    its values at the vertices, differentiated, give the constant divergence."""
     elasticity = solution.elasticity
-    mesh, order = elasticity.mesh, elasticity.order
-    if scene.body_force is None and order == 1:
-        return np.zeros(mesh.t.shape[1])
-    basis = Basis(mesh, ElementTetP0(), intorder=2 * order)
-    residual = np.zeros((3,) + basis.dx.shape)
-    if scene.body_force is not None:
-        residual += scene.body_force(np.asarray(basis.global_coordinates()))
-    if order == 2:  # sigma(u_h) is linear: its values at the vertices, differentiated
-        vertices = ElementTetP1()
-        grad = gradients_at_reference(elasticity.basis, solution.u, vertices.doflocs.T)
-        sigma = stress_tensor_from_gradient(grad, *elasticity.lame)  # (3, 3, nE, 4)
-        inverse = elasticity.basis.mapping.invA  # (3, 3, nE)
-        for k in range(4):
-            _, reference = vertices.lbasis(vertices.doflocs.T[:, :1], k)
-            gradient = np.einsum("rde,r->de", inverse, reference[:, 0])  # (3, nE)
-            residual += np.einsum("ije,je->ie", sigma[:, :, :, k], gradient)[:, :, None]
-    norm2 = ((residual**2).sum(axis=0) * basis.dx).sum(axis=1)
-    return (element_diameters(mesh) / order) ** 2 * norm2
+    vertices = ElementTetP1()
+    grad = gradients_at_reference(elasticity.basis, solution.u, vertices.doflocs.T)
+    sigma = stress_tensor_from_gradient(grad, *elasticity.lame)  # (3, 3, nE, 4)
+    inverse = elasticity.basis.mapping.invA  # (3, 3, nE)
+    div = np.zeros((3, inverse.shape[2]))
+    for k in range(4):
+        _, reference = vertices.lbasis(vertices.doflocs.T[:, :1], k)
+        gradient = np.einsum("rde,r->de", inverse, reference[:, 0])  # (3, nE)
+        div += np.einsum("ije,je->ie", sigma[:, :, :, k], gradient)
+    return np.repeat(div[:, :, None], n_points, axis=2)
 
 
 def face_data(mesh, facets: np.ndarray, degree: int):

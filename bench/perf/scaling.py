@@ -69,7 +69,7 @@ def measure(size: str, backend: str | None = None, reference: bool = True,
     ``peak_gib_without_reference``: after the semismooth systems too)."""
     from estimators import get_estimator
     from formulations import get_formulation, solve
-    from formulations.solvers.backends import check_backend, factorise
+    from formulations.solvers.backends import check_backend
 
     backend = check_backend(backend)
     warm_up(backend)
@@ -79,12 +79,7 @@ def measure(size: str, backend: str | None = None, reference: bool = True,
     row = {"size": size, "order": order, "ndofs": disc.ndofs, "n_constraints": disc.qp.m,
            "backend": backend,
            "t_assemble": time.perf_counter() - start}
-    start = time.perf_counter()
-    factorise(disc.qp.K, backend)(linear_rhs(disc.qp))
-    row["t_linear_solve"] = time.perf_counter() - start
-    fast = solve(disc, FAST_SOLVER, backend=backend)
-    row.update(t_fast_solve=fast.solve_time, fast_iterations=fast.iterations,
-               fast_status=fast.status, fast_max_residual=max(vars(fast.residuals).values()))
+    fast = time_linear_and_fast(disc, backend, row)
     row.update({phase_column(name): seconds for name, seconds in fast.diagnostics.phases})
     start = time.perf_counter()
     get_estimator("residual")(scene, fast)
@@ -105,6 +100,22 @@ def measure(size: str, backend: str | None = None, reference: bool = True,
                    max_lambda_difference=pressure)
     row["peak_gib"] = peak_gib()
     return row
+
+
+def time_linear_and_fast(disc, backend: str, row: dict):
+    """One plain linear solve of the QP's K (``t_linear_solve``) and the fast contact solve
+    (``t_fast_solve`` and its iterations, status and largest residual) into ``row``; returns
+    the fast solution."""
+    from formulations import solve
+    from formulations.solvers.backends import factorise
+
+    start = time.perf_counter()
+    factorise(disc.qp.K, backend)(linear_rhs(disc.qp))
+    row["t_linear_solve"] = time.perf_counter() - start
+    fast = solve(disc, FAST_SOLVER, backend=backend)
+    row.update(t_fast_solve=fast.solve_time, fast_iterations=fast.iterations,
+               fast_status=fast.status, fast_max_residual=max(vars(fast.residuals).values()))
+    return fast
 
 
 def warm_up(backend: str) -> None:

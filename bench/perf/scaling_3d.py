@@ -14,10 +14,10 @@ import pandas as pd
 
 from bench.perf.scaling import (
     in_fresh_process,
-    linear_rhs,
     machine_line,
     peak_gib,
     replace_in_readme,
+    time_linear_and_fast,
     warm_up,
 )
 from formulations.solvers.registry import FAST_SOLVER
@@ -43,8 +43,8 @@ def paper_3d_problem(size: str, order: int = 1):
 def measure_3d(size: str, backend: str | None = None, order: int = 1) -> dict:
     """Time every phase once at ``size`` (run in a fresh process for a meaningful peak)."""
     from estimators import get_estimator
-    from formulations import get_formulation, solve
-    from formulations.solvers.backends import check_backend, factorise
+    from formulations import get_formulation
+    from formulations.solvers.backends import check_backend
 
     backend = check_backend(backend)
     warm_up(backend)
@@ -54,13 +54,8 @@ def measure_3d(size: str, backend: str | None = None, order: int = 1) -> dict:
     row = {"size": size, "order": order, "dim": 3, "ndofs": disc.ndofs,
            "n_constraints": disc.qp.m, "backend": backend,
            "t_assemble": time.perf_counter() - start}
-    start = time.perf_counter()
-    factorise(disc.qp.K, backend)(linear_rhs(disc.qp))
-    row["t_linear_solve"] = time.perf_counter() - start
-    fast = solve(disc, FAST_SOLVER, backend=backend)
-    row.update(t_fast_solve=fast.solve_time, fast_iterations=fast.iterations,
-               fast_status=fast.status, fast_max_residual=max(vars(fast.residuals).values()),
-               active_constraints=fast.active_constraints)
+    fast = time_linear_and_fast(disc, backend, row)
+    row["active_constraints"] = fast.active_constraints
     start = time.perf_counter()
     get_estimator("residual")(scene, fast)
     row["t_estimate"] = time.perf_counter() - start
