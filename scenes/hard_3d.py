@@ -31,8 +31,8 @@ def _box(name, description, gap, *, width=2.0, height=2.0, n=4, nz=4, poisson_ra
 @register_scene("thin-3d", "hard: a 50:1 plate pressed by a paraboloid (thin body, flat "
                            "elements)")
 def thin_3d() -> Scene:
-    return _box("thin-3d", "plate (-1,1)^2 x (-0.02,0.02), g = r^2 - 0.001",
-                lambda x: x[0] ** 2 + x[1] ** 2 - 0.001, height=0.04, n=16, nz=1)
+    return _box("thin-3d", "plate (-1,1)^2 x (-0.02,0.02), g = r^2 - 0.01",
+                lambda x: x[0] ** 2 + x[1] ** 2 - 0.01, height=0.04, n=8, nz=1)
 
 
 @register_scene("incompressible-3d", "hard: paper-3d's ball on a nearly incompressible body "

@@ -4,15 +4,18 @@ written and the README block replaced."""
 import pandas as pd
 import pytest
 
-from bench.perf.scaling_3d import measure_3d, paper_3d_problem, write_scaling_3d
+from bench.perf.scaling_3d import SIZES_3D, measure_3d, paper_3d_problem, write_scaling_3d
 from formulations.elasticity import count_free_dofs
 
 
 def test_sizes_give_the_dof_counts_they_name():
-    # 3 n (n + 1)^2 unknowns for n cubes per side (the top face clamped)
-    for size, n in (("1e4", 14), ("1e5", 32), ("5e5", 56)):
+    # 3 n (n + 1)^2 unknowns for n = d 2^r cubes per side (the top face clamped); the largest
+    # size by its n alone (its mesh has 10^6 tetrahedra)
+    for size, n in (("1e4", 14), ("1e5", 32)):
         scene, mesh = paper_3d_problem(size)
         assert count_free_dofs(scene, mesh) == 3 * n * (n + 1) ** 2
+    divisions, refinements = SIZES_3D["5e5"]
+    assert 3 * (divisions * 2**refinements) * (divisions * 2**refinements + 1) ** 2 == 545832
     with pytest.raises(ValueError, match="size='1e6' is not one of"):
         paper_3d_problem("1e6")
 
