@@ -74,6 +74,11 @@ class ContactTrace:
         a, b = self.mesh.p[:, self.vertices[0]], self.mesh.p[:, self.vertices[1]]
         return (b - a) / self.length
 
+    def row_coordinates(self, t: np.ndarray) -> np.ndarray:
+        """Contact coordinates of the points t of every facet, one per row (facet f, point q
+        -> row f * len(t) + q): what a formulation's ``row_coordinate`` holds."""
+        return self.coordinates_at(t).ravel()
+
     @staticmethod
     def interpolation(points: np.ndarray, t: np.ndarray) -> np.ndarray:
         """The Lagrange polynomials on ``points`` (k,) at t; shape (k, len(t))."""

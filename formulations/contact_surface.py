@@ -90,6 +90,11 @@ class ContactSurface:
         facet of a plane Gamma_C)."""
         return simplex_points(self.coordinate, t)
 
+    def row_coordinates(self, t: np.ndarray) -> np.ndarray:
+        """Contact coordinates (2, n * nq) of the points t of every facet, one column per row
+        (facet f, point q -> f * nq + q)."""
+        return self.coordinates_at(t).reshape(2, -1)
+
     @staticmethod
     def rule(degree: int) -> tuple[np.ndarray, np.ndarray]:
         """Quadrature exact to ``degree`` on every facet (``triangle_rule``)."""

@@ -125,8 +125,7 @@ def discretise(scene: Scene, mesh: MeshTri, theta: float = 1.0,
     gamma_facet = gamma_0 * float(scene.material.young_modulus) / trace.diameter
     gap_h = gap_interpolant(scene, trace, elasticity.order)
     system = nitsche_system(scene, elasticity, trace, gap_h, t, w, gamma_facet, theta)
-    s_points = trace.coordinates_at(t)
-    n, s_points = system.n, (s_points.ravel() if trace.dim == 2 else s_points.reshape(2, -1))
+    n, s_points = system.n, trace.row_coordinates(t)
     details = NitscheDetails(theta=float(theta), gamma_0=float(gamma_0), gamma=gamma_facet)
 
     def recover(answer: QPSolution, residuals: Residuals, status: str,

@@ -152,7 +152,6 @@ def discretise(scene: Scene, mesh: MeshTri, epsilon_0: float = DEFAULT_EPSILON_0
     qp = slack_qp(elasticity.K_free, elasticity.F[elasticity.free], P, gap.ravel(),
                   order**2 * young / epsilon_0 * np.tile(w, nf)
                   * np.repeat(trace.measure / trace.diameter, nq), young)
-    s_points = trace.coordinates_at(t)
     pressure_floor = young * np.abs(gap).max(initial=0.0) / trace.measure.sum()
 
     def recover(answer: QPSolution, residuals: Residuals, status: str,
@@ -185,6 +184,5 @@ def discretise(scene: Scene, mesh: MeshTri, epsilon_0: float = DEFAULT_EPSILON_0
     # warm starts: the previous pressure at the Gauss points (the system's unknowns)
     return Discretisation(formulation="penalty", elasticity=elasticity, trace=trace, qp=qp,
                           recover=recover,
-                          row_coordinate=s_points.reshape(-1) if trace.dim == 2
-                          else s_points.reshape(2, -1), system=system,
+                          row_coordinate=trace.row_coordinates(t), system=system,
                           qp_is_slack_form=True)
