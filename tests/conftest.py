@@ -2,6 +2,10 @@
 
 from __future__ import annotations
 
+import signal
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 from skfem import MeshTri
@@ -9,6 +13,15 @@ from skfem import MeshTri
 from scenes import Material, Scene
 
 TOL = 1e-10
+
+
+def interruptible_bench(*args, cwd=None) -> subprocess.Popen:
+    """``python -m bench ARGS`` as a child that Ctrl-C (SIGINT) reaches: a shell without job
+    control starts background commands with SIGINT ignored, children inherit that, and Python
+    then installs no KeyboardInterrupt handler, so the child is reset to the default first."""
+    return subprocess.Popen([sys.executable, "-m", "bench", *args], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, cwd=cwd,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
 
 
 def square_scene(gap, *, young_modulus=1000.0, poisson_ratio=0.0, divisions=4,

@@ -4,8 +4,6 @@ recovery, never in a traceback or a machine out of memory."""
 import os
 import shutil
 import signal
-import subprocess
-import sys
 import time
 from dataclasses import replace
 
@@ -20,7 +18,7 @@ from bench.report import write_report
 from bench.sequence.loop import LoopConfig, run_sequence
 from bench.sequence.memory import available_gib, memory_line, predict_peak_gib
 from bench.truth import cache
-from conftest import square_scene
+from conftest import interruptible_bench, square_scene
 from formulations.solvers import backends
 from scenes import SceneError, get_scene
 
@@ -243,10 +241,8 @@ def test_scaling_with_a_missing_backend_is_refused(monkeypatch, tmp_path, capsys
 
 def test_sigint_ends_with_one_line_and_keeps_every_finished_row(tmp_path):
     out = tmp_path / "r"
-    process = subprocess.Popen([sys.executable, "-m", "bench", "run", "--strategy", "uniform",
-                                "--max-dofs", "2000000", "--solver", "reference", "--out",
-                                str(out)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                               text=True, cwd=tmp_path)
+    process = interruptible_bench("run", "--strategy", "uniform", "--max-dofs", "2000000",
+                                  "--solver", "reference", "--out", str(out), cwd=tmp_path)
     deadline = time.time() + 120
     while time.time() < deadline:  # wait for three finished rows
         csv = out / "results.csv"

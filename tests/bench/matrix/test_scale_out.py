@@ -2,8 +2,6 @@
 
 import os
 import signal
-import subprocess
-import sys
 import time
 
 import numpy as np
@@ -13,15 +11,11 @@ import pytest
 from bench.matrix import RunConfig, run
 from bench.matrix.store import ResultStore
 from bench.report.render import latest_run
+from conftest import interruptible_bench
 
 NUMBERS = ["ndofs", "energy", "contact_force", "eta", "energy_error", "effectivity_index"]
 SMALL = dict(scenes=("free-boundary",), formulations=("mixed", "vi"), solvers=("active-set",),
              estimators=("residual",), strategies=("uniform", "adaptive"), max_dofs=2500)
-
-
-def cli(*args, cwd=None):
-    return subprocess.Popen([sys.executable, "-m", "bench", *args], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True, cwd=cwd)
 
 
 def same_rows(a: pd.DataFrame, b: pd.DataFrame) -> None:
@@ -39,12 +33,12 @@ def same_rows(a: pd.DataFrame, b: pd.DataFrame) -> None:
 
 def test_two_runs_into_one_folder_at_once_lose_nothing(tmp_path):
     out = tmp_path / "shared"
-    first = cli("run", "--scene", "free-boundary", "--formulation", "mixed", "--solver",
-                "active-set", "--strategy", "uniform,adaptive", "--max-dofs", "3000",
-                "--out", str(out))
-    second = cli("run", "--scene", "free-boundary", "--formulation", "vi", "--solver",
-                 "active-set", "--strategy", "uniform,adaptive", "--max-dofs", "3000",
-                 "--out", str(out))
+    first = interruptible_bench("run", "--scene", "free-boundary", "--formulation", "mixed",
+                                "--solver", "active-set", "--strategy", "uniform,adaptive",
+                                "--max-dofs", "3000", "--out", str(out))
+    second = interruptible_bench("run", "--scene", "free-boundary", "--formulation", "vi",
+                                 "--solver", "active-set", "--strategy", "uniform,adaptive",
+                                 "--max-dofs", "3000", "--out", str(out))
     for process in (first, second):
         _, err = process.communicate(timeout=300)
         assert process.returncode == 0, err
@@ -86,7 +80,7 @@ def test_an_interrupted_run_is_resumed(tmp_path):
     out = tmp_path / "r"
     args = ["run", "--scene", "paper,free-boundary", "--formulation", "mixed,vi", "--solver",
             "active-set", "--strategy", "uniform", "--max-dofs", "140000", "--out", str(out)]
-    process = cli(*args)
+    process = interruptible_bench(*args)
     deadline = time.time() + 120
     while time.time() < deadline:  # until the first sequences have finished
         parts = list((out / "sequences").glob("*.parquet")) if out.exists() else []
@@ -99,7 +93,7 @@ def test_an_interrupted_run_is_resumed(tmp_path):
     before = pd.read_parquet(out / "results.parquet")
     finished = set(before.loc[before["sequence_end"] == "budget", "sequence_key"])
     assert finished and "interrupted" in set(before["sequence_end"])
-    again = cli(*args)
+    again = interruptible_bench(*args)
     stdout, err = again.communicate(timeout=300)
     assert again.returncode == 0, err
     assert f"reused {len(finished)} sequences" in stdout
