@@ -6,7 +6,8 @@ the element's reference coordinates (degree p - 1 for P_p): evaluating it at any
 element, or just outside it, is a gather and a dot product, with no scikit-fem basis to build
 per point. A ``Locator`` finds the element containing each point: the element of the nearest
 centroid (a k-d tree), then a walk across the edge of the most negative barycentric coordinate,
-all points at once.
+all points at once. On tetrahedra the locator is ``bench.measure.locator_3d.TetLocator`` and the
+polynomials are in three reference coordinates (docs/theory.md, section 14.6).
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ from matplotlib.tri import Triangulation
 from scipy.spatial import cKDTree
 from skfem import Basis, MeshTri
 
+from bench.measure.locator_3d import TetLocator
 from formulations.elasticity import vector_element
 from formulations.evaluation import gradients_at_reference, p1_gradients
 from formulations.p1_stiffness import barycentric_gradients
@@ -107,21 +109,33 @@ class Locator:
         return cells
 
 
-def monomials(degree: int) -> list[tuple[int, int]]:
-    """Exponents (i, j) of xi^i eta^j with i + j <= degree."""
+def monomials(degree: int, dim: int = 2) -> list[tuple[int, ...]]:
+    """Exponents (i, j) of xi^i eta^j with i + j <= degree; (i, j, k) in 3D."""
+    if dim == 3:
+        return [(i, j, total - i - j) for total in range(degree + 1)
+                for i in range(total, -1, -1) for j in range(total - i, -1, -1)]
     return [(i, total - i) for total in range(degree + 1) for i in range(total, -1, -1)]
 
 
-def _lattice(degree: int) -> np.ndarray:
-    """Points (2, n) of the reference triangle on which the monomials of ``degree`` are
+def _lattice(degree: int, dim: int = 2) -> np.ndarray:
+    """Points (dim, n) of the reference simplex on which the monomials of ``degree`` are
     unisolvent: the centroid for degree 0, the degree-d lattice otherwise."""
     if degree == 0:
-        return np.array([[1.0 / 3.0], [1.0 / 3.0]])
-    return np.array([[i / degree, j / degree] for i, j in monomials(degree)]).T
+        return np.full((dim, 1), 1.0 / (dim + 1))
+    return np.array([[e / degree for e in exponents]
+                     for exponents in monomials(degree, dim)]).T
 
 
 def _powers(xi: np.ndarray, degree: int) -> np.ndarray:
+    if xi.shape[0] == 3:
+        return np.array([xi[0] ** i * xi[1] ** j * xi[2] ** k
+                         for i, j, k in monomials(degree, 3)])
     return np.array([xi[0] ** i * xi[1] ** j for i, j in monomials(degree)])
+
+
+def locator_for(mesh):
+    """The point locator of a triangle or a tetrahedral mesh."""
+    return TetLocator.from_mesh(mesh) if mesh.dim() == 3 else Locator.from_mesh(mesh)
 
 
 @dataclass(frozen=True, eq=False)
@@ -129,43 +143,44 @@ class GradientField:
     """grad u_h of a P_p field: per element, the coefficients of a polynomial of degree p - 1
     in the reference coordinates (module docstring)."""
 
-    locator: Locator
+    locator: Locator | TetLocator
     degree: int
-    coefficients: np.ndarray  # (2, 2, n_monomials, nE)
+    coefficients: np.ndarray  # (d, d, n_monomials, nE)
 
     @classmethod
     def from_solution(cls, basis: Basis, u: np.ndarray) -> GradientField:
         """The field of the DOF vector ``u`` of a vector P_p ``basis``."""
-        degree = basis.elem.maxdeg - 1
-        if degree == 0:  # P1: the constant gradient of each element
+        degree, dim = basis.elem.maxdeg - 1, basis.mesh.dim()
+        if degree == 0 and dim == 2:  # P1: the constant gradient of each element
             return cls(Locator.from_mesh(basis.mesh), 0, p1_gradients(basis, u)[:, :, None, :])
-        nodes = _lattice(degree)
-        values = gradients_at_reference(basis, u, nodes)  # (2, 2, nE, n_nodes)
+        nodes = _lattice(degree, dim)
+        values = gradients_at_reference(basis, u, nodes)  # (d, d, nE, n_nodes)
         solve = np.linalg.inv(_powers(nodes, degree).T)  # Vandermonde: coefficients <- values
         coefficients = np.einsum("mk,ijek->ijme", solve, values)
-        return cls(Locator.from_mesh(basis.mesh), degree, coefficients)
+        return cls(locator_for(basis.mesh), degree, coefficients)
 
     @classmethod
-    def from_dofs(cls, mesh: MeshTri, order: int, u: np.ndarray) -> GradientField:
-        return cls.from_solution(Basis(mesh, vector_element(order), intorder=1), u)
+    def from_dofs(cls, mesh, order: int, u: np.ndarray) -> GradientField:
+        return cls.from_solution(Basis(mesh, vector_element(order, mesh.dim()), intorder=1), u)
 
     @property
     def area(self) -> np.ndarray:
         return self.locator.area
 
     def at(self, x: np.ndarray, cells: np.ndarray) -> np.ndarray:
-        """grad u_h (2, 2, n) at points x (2, n) from the polynomials of ``cells`` (extended
+        """grad u_h (d, d, n) at points x (d, n) from the polynomials of ``cells`` (extended
         beyond the element for a point outside it)."""
         if self.degree == 0:  # a constant per element (P1): nothing to evaluate
             return self.coefficients[:, :, 0, cells]
-        out = np.empty((2, 2, x.shape[1]))
+        d = x.shape[0]
+        out = np.empty((d, d, x.shape[1]))
         for start in range(0, x.shape[1], CHUNK):
             block = slice(start, start + CHUNK)
             [out[:, :, block]] = self.at_each([x[:, block]], cells[block])
         return out
 
     def at_each(self, points: list[np.ndarray], cells: np.ndarray) -> list[np.ndarray]:
-        """``at(x, cells)`` for every x in ``points`` (each (2, n), the same cells): the cells'
+        """``at(x, cells)`` for every x in ``points`` (each (d, n), the same cells): the cells'
         polynomials and maps are gathered once for all of them."""
         if self.degree == 0:
             return [self.coefficients[:, :, 0, cells]] * len(points)
@@ -173,6 +188,10 @@ class GradientField:
         origin, inv = self.locator.origin[:, cells], self.locator.inverse[:, :, cells]
         out = []
         for x in points:
+            if x.shape[0] == 3:
+                xi = np.einsum("rke,ke->re", inv, x - origin)
+                out.append(np.einsum("ijmn,mn->ijn", coefficients, _powers(xi, self.degree)))
+                continue
             d = x - origin
             xi = np.array([inv[0, 0] * d[0] + inv[0, 1] * d[1],
                            inv[1, 0] * d[0] + inv[1, 1] * d[1]])

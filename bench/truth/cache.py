@@ -12,9 +12,9 @@ import sys
 from pathlib import Path
 
 import numpy as np
-from skfem import MeshTri
+from skfem import MeshTet, MeshTri
 
-from bench.truth.references import PRIMARY, Reference, build_reference, reference_key
+from bench.truth.references import Reference, build_reference, recipes_for, reference_key
 
 
 class CorruptCache(Exception):
@@ -63,7 +63,7 @@ def load_reference(path: Path, key: str) -> Reference:
         with np.load(path) as data:
             meta = json.loads(str(data["meta"]))
             return Reference(key=key, recipe=meta["recipe"], order=meta["order"],
-                             mesh=MeshTri(data["p"], data["t"]), u=data["u"],
+                             mesh=_mesh(data["p"], data["t"]), u=data["u"],
                              lame=tuple(meta["lame"]), pressure_s=data["pressure_s"],
                              pressure_values=data["pressure_values"], ndofs=meta["ndofs"],
                              energy=meta["energy"], norm=meta["norm"],
@@ -74,9 +74,14 @@ def load_reference(path: Path, key: str) -> Reference:
         raise CorruptCache(f"{type(error).__name__}: {error}") from None
 
 
-def load_or_build(scene, max_dofs: int, recipe: str = PRIMARY) -> Reference:
+def _mesh(p: np.ndarray, t: np.ndarray):
+    return (MeshTet if p.shape[0] == 3 else MeshTri)(p, t)
+
+
+def load_or_build(scene, max_dofs: int, recipe: str | None = None) -> Reference:
     """The cached reference for (scene, max_dofs, recipe), built and stored if missing or
-    corrupt."""
+    corrupt; ``recipe`` None: the primary recipe of the scene's dimension."""
+    recipe = recipes_for(scene)[0] if recipe is None else recipe
     key = reference_key(scene, max_dofs, recipe)
     path = cache_folder() / f"{key}.npz"
     if path.exists():

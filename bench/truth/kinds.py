@@ -11,7 +11,7 @@ import numpy as np
 from bench.measure.discretisation_error import Errors, exact_errors
 from bench.truth.cache import load_or_build
 from bench.truth.crosscheck import CrossCheck, cross_check
-from bench.truth.references import CROSSCHECK, TruthError
+from bench.truth.references import TruthError, recipes_for
 
 TOO_COARSE = 0.05  # a reference whose own error exceeds 5 % of the measured error is too coarse
 # A reference of an order no higher than the runs it judges needs at least this many times the
@@ -85,6 +85,6 @@ def truth_for(scene, reference_dofs: int | None, judged_max_dofs: int | None = N
         return None
     reference = load_or_build(scene, reference_dofs)
     check_reference(reference, scene, judged_max_dofs, judged_order)
-    check = (cross_check(reference, load_or_build(scene, reference_dofs, CROSSCHECK))
+    check = (cross_check(reference, load_or_build(scene, reference_dofs, recipes_for(scene)[1]))
              if crosscheck else None)
     return ReferenceTruth(reference, check)

@@ -7,7 +7,11 @@ N^(-1/2) for P1, so that a few hundred thousand DOFs are far sharper than any P1
 Its own energy-norm error is estimated from the differences between its last levels
 (``bench.truth.error_bar``); ``reference_too_coarse`` flags rows whose error is not at least
 1/TOO_COARSE times larger. A second recipe (``CROSSCHECK``, P2) checks the first
-(``bench.truth.crosscheck``).
+(``bench.truth.crosscheck``). On tetrahedra there is neither P3 nor the mixed method, so the
+references are P2: Nitsche's method first, the variational inequality as its cross-check
+(``recipes_for``; docs/theory.md, section 14.6). Nitsche comes first because its pressure,
+sigma_n(u_h) cut at 0, ends where the contact zone ends; the VI's P2 pressure, recovered from
+the consistent boundary mass, keeps small positive lobes outside the zone.
 
 The cache (``bench.truth.cache``) is keyed by a hash of everything that determines the
 reference: scene name and parameters, recipe, DOF budget and ``ASSEMBLY_VERSION`` (bump it when
@@ -24,7 +28,8 @@ import time
 from dataclasses import asdict, dataclass
 
 import numpy as np
-from skfem import MeshTri
+from scipy.interpolate import LinearNDInterpolator
+from skfem import MeshTet, MeshTri
 
 from bench.measure.contact import contact_zone
 from bench.measure.discretisation_error import Errors, errors_from
@@ -55,8 +60,15 @@ class Recipe:
 # the P2 cross-check gets twice the budget: its energy must agree with P3's to 1e-7, and its
 # energy error, ||e||^2 / ||u||^2, is 1.1e-7 on hertz at the same budget (3.3e-4 relative)
 RECIPES = {r.name: r for r in (Recipe("mixed-p3", "mixed", 3),
-                               Recipe("mixed-p2", "mixed", 2, budget_factor=2.0))}
+                               Recipe("mixed-p2", "mixed", 2, budget_factor=2.0),
+                               Recipe("vi-p2", "vi", 2), Recipe("nitsche-p2", "nitsche", 2))}
 PRIMARY, CROSSCHECK = "mixed-p3", "mixed-p2"
+RECIPES_BY_DIM = {2: (PRIMARY, CROSSCHECK), 3: ("nitsche-p2", "vi-p2")}
+
+
+def recipes_for(scene) -> tuple[str, str]:
+    """The primary and the cross-check recipe of a scene's dimension."""
+    return RECIPES_BY_DIM[scene.dim]
 
 
 @dataclass(frozen=True, eq=False)
@@ -64,10 +76,10 @@ class Reference:
     key: str
     recipe: str
     order: int
-    mesh: MeshTri
+    mesh: MeshTri | MeshTet
     u: np.ndarray  # the DOF vector of vector P_order on ``mesh`` (scikit-fem's numbering)
     lame: tuple[float, float]
-    pressure_s: np.ndarray  # contact coordinates and reference pressure there (dense samples)
+    pressure_s: np.ndarray  # contact coordinates ((2, n) in 3D) and reference pressure there
     pressure_values: np.ndarray
     ndofs: int
     energy: float
@@ -79,7 +91,15 @@ class Reference:
     build_seconds: float
 
     def pressure(self, s: np.ndarray) -> np.ndarray:
+        """The reference pressure at contact coordinates ``s``: linear between the samples
+        (in 3D on their Delaunay triangulation, 0 outside their hull)."""
+        if self.pressure_s.ndim == 2:
+            return self._surface_pressure(*s)
         return np.interp(s, self.pressure_s, self.pressure_values)
+
+    @functools.cached_property
+    def _surface_pressure(self) -> LinearNDInterpolator:
+        return LinearNDInterpolator(self.pressure_s.T, self.pressure_values, fill_value=0.0)
 
     @property
     def peak_pressure(self) -> float:
@@ -104,7 +124,8 @@ class Reference:
                 "error_rate": self.rate, "build_seconds": self.build_seconds, "key": self.key}
 
 
-def reference_key(scene, max_dofs: int, recipe: str = PRIMARY) -> str:
+def reference_key(scene, max_dofs: int, recipe: str | None = None) -> str:
+    recipe = recipes_for(scene)[0] if recipe is None else recipe
     spec = {"scene": scene.name, "parameters": scene.parameters, "max_dofs": max_dofs,
             "assembly_version": ASSEMBLY_VERSION, **asdict(RECIPES[recipe])}
     text = json.dumps(spec, sort_keys=True, default=str)
@@ -112,6 +133,11 @@ def reference_key(scene, max_dofs: int, recipe: str = PRIMARY) -> str:
 
 
 def _sampled_pressure(solution: DiscreteSolution):
+    if solution.trace.dim == 3:  # the P2 nodes and the centroid of every contact triangle
+        t = np.array([[0, 1, 0, .5, .5, 0, 1 / 3], [0, 0, 1, 0, .5, .5, 1 / 3]])
+        s = solution.trace.coordinates_at(t).reshape(2, -1)
+        s, index = np.unique(s.round(14), axis=1, return_index=True)
+        return s, solution.pressure(t).ravel()[index]
     t = np.linspace(0.0, 1.0, 9)
     s, values = solution.trace.coordinates_at(t).ravel(), solution.pressure(t).ravel()
     order = np.argsort(s, kind="stable")
@@ -164,7 +190,8 @@ def reference_levels(scene, max_dofs: int, recipe: Recipe):
         yield result.row.ndofs, sol, difference
 
 
-def build_reference(scene, max_dofs: int, recipe: str = PRIMARY) -> Reference:
+def build_reference(scene, max_dofs: int, recipe: str | None = None) -> Reference:
+    recipe = recipes_for(scene)[0] if recipe is None else recipe
     start = time.perf_counter()
     ndofs, differences, sol = [], [], None
     show = LevelProgress(f"reference {scene.name}/{recipe}", max_dofs)
