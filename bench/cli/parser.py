@@ -18,7 +18,7 @@ from bench.cli.option_types import (
 )
 from bench.export import FORMATS, LEVELS
 from bench.hard import hard_case_names
-from bench.matrix.run import COMPARE_REFERENCE_DOFS
+from bench.matrix.run import COMPARE_REFERENCE_DOFS, COMPARE_REFERENCE_DOFS_3D
 from bench.perf.scaling import SIZES
 from bench.perf.scaling_3d import SIZES_3D
 from bench.perf.sequence import SEQUENCES
@@ -205,9 +205,10 @@ def _compare_parser(sub) -> None:
     compare.add_argument("--max-dofs", type=positive_int("max_dofs"), default=20000,
                          help="DOF budget per sequence (default: 20000)")
     compare.add_argument("--reference-dofs", type=positive_int("reference_dofs"),
-                         default=COMPARE_REFERENCE_DOFS,
-                         help="DOF budget of the P3 overkill references (default: "
-                              f"{COMPARE_REFERENCE_DOFS})")
+                         default=None,
+                         help="DOF budget of the overkill references (default: "
+                              f"{COMPARE_REFERENCE_DOFS} for the P3 references in 2D, "
+                              f"{COMPARE_REFERENCE_DOFS_3D} for the P2 references in 3D)")
     _memory_option(compare)
     _scale_out_options(compare)
     _scene_file_option(compare)
@@ -216,7 +217,7 @@ def _compare_parser(sub) -> None:
                          "reference solver (default: 3000)")
     compare.add_argument("--dim", type=int, choices=(2, 3), default=2,
                          help="the scenes' dimension (default: 2); 3 runs the tetrahedral "
-                              "scenes only, errors against exact solutions (no 3D references)")
+                              "scenes only, errors against exact solutions or P2 references")
     compare.add_argument("--out", default="results", help="results folder (default: results)")
     compare.add_argument("--reports", default="reports", help="report folder (default: reports)")
     compare.add_argument("--readme", default=None,

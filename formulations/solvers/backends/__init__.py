@@ -21,6 +21,8 @@ scaling").
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 from scipy import sparse
 
@@ -40,6 +42,9 @@ __all__ = ["BACKENDS", "Backend", "BackendError", "CondensedFactor", "Factorisat
            "available_backends", "backend_names", "check_backend", "condenses",
            "default_backend", "factorise", "factorise_condensed", "register_backend",
            "unregister_backend"]
+
+
+DENSE_COPIES = 3  # the back-end's Schur array, its Cholesky factor, one product of that size
 
 
 def backend_names() -> tuple[str, ...]:
@@ -80,6 +85,19 @@ def factorise(K: sparse.spmatrix, backend: str | None = None) -> Solve:
     return REGISTRY.get(check_backend(backend)).factorise(sparse.csc_matrix(K))
 
 
+def check_dense_block(size: int) -> None:
+    """FactorisationError when DENSE_COPIES dense size x size blocks would not fit in the
+    memory available now: the Schur complement is dense, and a back-end that cannot allocate
+    it may crash the process instead of failing (PARDISO did, at 3D P2 Nitsche's Schur set of
+    every DOF of the tetrahedra on Gamma_C)."""
+    need = DENSE_COPIES * 8.0 * size**2
+    available = os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    if need > available:
+        raise FactorisationError(
+            f"the dense Schur block of {size} contact DOFs needs {need / 2**30:.1f} GiB "
+            f"({DENSE_COPIES} copies), more than the {available / 2**30:.1f} GiB available")
+
+
 def factorise_condensed(K: sparse.spmatrix, contact: np.ndarray,
                         backend: str | None = None) -> CondensedFactor:
     backend = check_backend(backend)
@@ -90,6 +108,7 @@ def factorise_condensed(K: sparse.spmatrix, contact: np.ndarray,
                            "do (the augmented iteration is used instead)")
     K = sparse.csc_matrix(K)
     contact = np.unique(np.asarray(contact, dtype=np.int64))
+    check_dense_block(contact.size)
     is_contact = np.zeros(K.shape[0], dtype=bool)  # a mask, not a sorted set difference
     is_contact[contact] = True
     interior = np.flatnonzero(~is_contact)

@@ -13,7 +13,7 @@ from formulations import get_formulation, solve
 from formulations.elasticity import vector_element
 from scenes import get_scene
 
-BUDGET = 30000  # two levels above 1e4 P2 DOFs: enough differences for the rate fit
+BUDGET = 45000  # measured: the rate fit leaves its clipping floor from here (30 654 DOFs)
 
 
 @pytest.fixture(scope="module")
@@ -25,18 +25,20 @@ def reference(tmp_path_factory):
 
 
 def test_tetrahedral_scenes_get_p2_recipes():
-    assert recipes_for(get_scene("paper-3d")) == ("nitsche-p2", "vi-p2")
+    assert recipes_for(get_scene("paper-3d")) == ("vi-p2", "nitsche-p2")
     assert recipes_for(get_scene("paper")) == ("mixed-p3", "mixed-p2")
 
 
 def test_the_error_bar_is_of_the_size_of_the_true_error(reference):
     scene, ref = reference
-    assert isinstance(ref.mesh, MeshTet) and ref.recipe == "nitsche-p2" and ref.order == 2
+    assert isinstance(ref.mesh, MeshTet) and ref.recipe == "vi-p2" and ref.order == 2
     basis = Basis(ref.mesh, vector_element(2, 3), intorder=8)
     diff = scene.exact.gradient(np.asarray(basis.global_coordinates())) - \
         basis.interpolate(ref.u).grad
     true_error = np.sqrt((energy_density(diff, *ref.lame) * basis.dx).sum())
-    # the 2D standard (tests/bench/measure): a model, right within a factor 2; measured 0.93
+    # the 2D standard (tests/bench/measure): a model, right within a factor 2; measured 0.65
+    # here, 0.71 at 46 122 DOFs, 1.48 at 172 284 (below 30 654 DOFs the fitted rate sits on its
+    # floor 1/4 and the bar is 2.2 x the true error: safe, but outside the band)
     assert 0.5 < ref.estimated_error / true_error < 2.0, (ref.estimated_error, true_error)
 
 
@@ -64,9 +66,10 @@ def test_the_pressure_is_interpolated_over_the_contact_plane(reference):
     x = np.array([[0.0, 0.1, 0.3, 0.9], [0.0, 0.2, 0.1, 0.0]])
     values = ref.pressure(x)
     exact = scene.exact.pressure(x)
-    # inside the zone (r < 0.4) within 10 % of the exact peak (the reference's pressure error
-    # at 3e4 DOFs); outside it 0
-    assert np.abs(values - exact).max() < 0.1 * exact.max()
+    # inside the zone (r < 0.4) within 15 % of the exact peak: the nodal P2 pressure of a
+    # 3e4-DOF adaptive mesh, measured 11 % low at the centre (a vertex), 2 % and 15 % of the
+    # local value at the other two points; outside the zone exactly 0 (no reaction there)
+    assert np.abs(values - exact).max() < 0.15 * exact.max()
     assert values[-1] == 0.0
 
 
@@ -74,7 +77,8 @@ def test_the_two_recipes_differ_by_no_more_than_their_own_errors(reference):
     scene, ref = reference
     other = cache.load_or_build(scene, BUDGET, recipes_for(scene)[1])
     check = cross_check(ref, other)
-    # ||u_1 - u_2|| <= e_1 + e_2 (triangle inequality), with the vi's estimated error, which
-    # overestimates its true one (rate clipped at 1/4 on its stepwise levels)
-    assert check.energy_norm_difference * ref.norm <= ref.estimated_error + other.estimated_error
-    assert check.recipe == "vi-p2" and not check.passed  # 1e-7 in energy is P3's standard
+    # ||u_1 - u_2|| <= e_1 + e_2 (triangle inequality), each estimate within a factor 2 of
+    # its true error (test above), hence the factor 2
+    assert check.energy_norm_difference * ref.norm <= \
+        2 * (ref.estimated_error + other.estimated_error)
+    assert check.recipe == "nitsche-p2" and not check.passed  # 1e-7 in energy: P3's standard
