@@ -40,6 +40,17 @@ def test_a_matrix_that_is_not_positive_definite_is_refused(backend):
         backends.factorise_condensed(K, np.array([2]), backend)
 
 
+@pytest.mark.parametrize("backend", CONDENSING)
+def test_a_schur_block_too_large_for_the_memory_is_refused_before_the_backend(backend,
+                                                                               monkeypatch):
+    # 1000 contact DOFs need 3 x 8 MB; with 1 MiB "available" the back-end is never called
+    monkeypatch.setattr(backends.os, "sysconf", lambda name: 256 if "PAGES" in name else 4096)
+    K = sparse.identity(2000, format="csc")
+    with pytest.raises(backends.FactorisationError,
+                       match=r"dense Schur block of 1000 contact DOFs needs 0.0 GiB"):
+        backends.factorise_condensed(K, np.arange(1000), backend)
+
+
 @pytest.mark.parametrize("backend", backends.available_backends())
 def test_plain_factorisation_solves(qp, backend):
     b = qp.F - qp.B.T @ np.ones(qp.m)
