@@ -140,17 +140,19 @@ SURFACE_SAMPLES = np.array([[0, 1, 0, .5, .5, 0, 1 / 3], [0, 0, 1, 0, .5, .5, 1 
 
 def _surface_pressure(solution: DiscreteSolution):
     """On tetrahedra: -sigma_nn(u_h) at the P2 nodes and the centroid of every contact
-    triangle, cut to 0 where lambda_h is 0 and clipped at 0. The VI's own nodal P2 pressure
-    oscillates from node to node (a vertex function of a P2 triangle integrates to 0; on
-    hertz-3d at 2.9e5 DOFs it reads 0 .. 123 where Hertz gives 100.5), while the stress of the
-    same u_h follows Hertz to 0.4 % at the centre (docs/theory.md, section 14.6)."""
+    triangle, clipped at 0, and 0 on the triangles where lambda_h is 0 throughout. The VI's
+    own nodal P2 pressure oscillates from node to node (a vertex function of a P2 triangle
+    integrates to 0; on hertz-3d at 2.9e5 DOFs it reads 0 .. 123 where Hertz gives 100.5),
+    while the stress of the same u_h follows Hertz to 0.4 % at the centre (docs/theory.md,
+    section 14.6)."""
     trace, t = solution.trace, SURFACE_SAMPLES
     nq = t.shape[1]
     x, normal = trace.points(t).reshape(3, -1), np.repeat(trace.normal, nq, axis=1)
     grad = gradients_at(solution.elasticity.basis, solution.u, x, np.repeat(trace.element, nq))
     sigma = stress_tensor_from_gradient(grad, *solution.elasticity.lame)
     values = np.maximum(-np.einsum("in,ijn,jn->n", normal, sigma, normal), 0.0)
-    values[solution.pressure(t).ravel() <= 0] = 0.0
+    pressed = (solution.pressure(t) > 0).any(axis=1)  # per facet: the nodal one dips to 0
+    values[~np.repeat(pressed, nq)] = 0.0
     s, index = np.unique(trace.coordinates_at(t).reshape(2, -1).round(14), axis=1,
                          return_index=True)
     return s, values[index]
