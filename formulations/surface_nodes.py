@@ -9,13 +9,15 @@ smooth pressure has vertex reactions near 0 and any positive lumped weight there
 sub-triangle lumping A / 12, A / 4) turns them into vertex pressures near 0 -- lambda_h then
 oscillates and its error stalls (measured on free-boundary-3d: 1.44e-3 from 1e5 to 2.5e5 DOFs).
 So P2 solves the consistent boundary mass system M lambda = r (M_ij = int phi_i phi_j over
-Gamma_C), which reproduces any P2 pressure, and keeps lambda only at the nodes that carry a
-reaction (above ACTIVE_FRACTION of the largest), clipped at 0: M^-1 is dense, so the solve
-leaves small values of either sign at every node of Gamma_C, and positive ones far outside the
-contact zone made its measured zone twice the true one (free-boundary-3d: zone end 0.77 .. 0.88
-against 0.4; 0.42 .. 0.45 with the cut, and the contact force 0.5 % from the exact one at
-104 544 DOFs against 2.4 % without it; its L2 pressure error there is 4.0e-4 against 3.1e-4,
-the lobes having smoothed the edge facets). lambda_h is the P2 interpolant of those values,
+Gamma_C), which reproduces any P2 pressure, and keeps lambda only on the contact triangles with
+a node whose reaction pushes (above ACTIVE_FRACTION of the largest), clipped at 0: M^-1 is dense,
+so the solve leaves small values of either sign at every node of Gamma_C, and positive ones far
+outside the contact zone made its measured radius twice the true one (free-boundary-3d: zone end
+0.84, 0.88, 0.77 against 0.4 on three uniform levels; 0.70, 0.55, 0.46 with the cut, which
+leaves the zone overshooting by up to a triangle as P1's does, and the pressure error as it
+was). Cutting node by node instead puts 0 at the vertices inside the zone whose reaction is 0
+(a vertex function of a P2 triangle integrates to 0) and makes lambda_h oscillate: 4 x the
+pressure error on an adaptive sequence. lambda_h is the P2 interpolant of the kept values,
 clipped at 0. The lumped weights still weigh the nodal normals.
 """
 
@@ -86,7 +88,10 @@ def nodal_pressures(trace, nodes: TraceNodes, reaction: np.ndarray) -> np.ndarra
     mass = sparse.csc_matrix((values, (rows, cols)), shape=(m, m))
     # an interior-point solver leaves reactions of ~1e-9 relative everywhere: not contact
     pushes = reaction > ACTIVE_FRACTION * reaction.max(initial=0.0)
-    return np.where(pushes, np.maximum(spsolve(mass, reaction), 0.0), 0.0)
+    pressed = pushes[nodes.facet_rows].any(axis=1)  # facets with a node that pushes
+    kept = np.zeros(m, dtype=bool)
+    kept[nodes.facet_rows[pressed].ravel()] = True
+    return np.where(kept, np.maximum(spsolve(mass, reaction), 0.0), 0.0)
 
 
 def surface_pressure(values: np.ndarray, t: np.ndarray) -> np.ndarray:

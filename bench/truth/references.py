@@ -140,11 +140,9 @@ SURFACE_SAMPLES = np.array([[0, 1, 0, .5, .5, 0, 1 / 3], [0, 0, 1, 0, .5, .5, 1 
 
 def _surface_pressure(solution: DiscreteSolution):
     """On tetrahedra: -sigma_nn(u_h) at the P2 nodes and the centroid of every contact
-    triangle, clipped at 0, and 0 on the triangles where lambda_h is 0 throughout. The VI's
-    own nodal P2 pressure oscillates from node to node (a vertex function of a P2 triangle
-    integrates to 0; on hertz-3d at 2.9e5 DOFs it reads 0 .. 123 where Hertz gives 100.5),
-    while the stress of the same u_h follows Hertz to 0.4 % at the centre (docs/theory.md,
-    section 14.6)."""
+    triangle, clipped at 0, and 0 on the triangles where lambda_h is 0 throughout: the pressure
+    of the displacement itself, not one recovered from the VI's nodal reactions
+    (docs/theory.md, section 14.6)."""
     trace, t = solution.trace, SURFACE_SAMPLES
     nq = t.shape[1]
     x, normal = trace.points(t).reshape(3, -1), np.repeat(trace.normal, nq, axis=1)
