@@ -46,9 +46,9 @@ NAME_LISTS = {"scenes": scene_names, "formulations": formulation_names,
               "strategies": lambda: list(STRATEGIES)}
 SWEPT = ("scenes", "formulations")  # lists whose items may carry name:key=v1|v2 sweeps
 COMPARE_REFERENCE_DOFS = 200000  # the default comparison's reference budget
-# ... and in 3D, where the reference is P2 (docs/theory.md, section 14.6): measured, 231 258
-# and 289 800 DOFs on paper-3d and hertz-3d, error bars 0.96 % and 0.98 % of the energy norm,
-# about 3 minutes each; and 10 x compare's 20 000 DOFs, which a P2 run would require
+# ... and in 3D, where the reference is P2 (docs/theory.md, section 14.6): measured, 268 806
+# and 206 736 DOFs on paper-3d and hertz-3d, error bars 0.98 % and 1.47 % of the energy norm,
+# 117 s and 77 s; 10 x compare's 20 000 DOFs is what a P2 run would require
 COMPARE_REFERENCE_DOFS_3D = 300000
 
 
