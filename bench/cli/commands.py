@@ -29,7 +29,7 @@ from bench.hard import (
 from bench.hard.registry import HARD_CASES
 from bench.matrix import RunConfig, run
 from bench.matrix.plugins import FAILURES, load_plugins
-from bench.matrix.run import COMPARE_REFERENCE_DOFS, COMPARE_REFERENCE_DOFS_3D, RunRefused
+from bench.matrix.run import RunRefused, compare_reference_dofs
 from bench.matrix.scene_files import load_scene_files, scene_files_in
 from bench.matrix.store import ResultsError, read_results
 from bench.perf.scaling import SIZES, run_scaling, write_scaling
@@ -141,13 +141,6 @@ def hard_command(args) -> int:
     return 1 if wrong else 0
 
 
-def compare_reference_dofs(args) -> int:
-    """--reference-dofs, or the default budget of the references of the dimension."""
-    if args.reference_dofs is not None:
-        return args.reference_dofs
-    return COMPARE_REFERENCE_DOFS_3D if args.dim == 3 else COMPARE_REFERENCE_DOFS
-
-
 def compare_command(args) -> int:
     """The default comparison: every scene not tagged hard x every formulation x every
     estimator x {uniform, adaptive} with the active-set solver, then the hard cases into the
@@ -157,7 +150,8 @@ def compare_command(args) -> int:
                 and get_scene(n).dim == args.dim],
         formulations=formulation_names(), solvers=(FAST_SOLVER,),
         estimators=estimator_names(), strategies=("uniform", "adaptive"),
-        max_dofs=args.max_dofs, reference_dofs=compare_reference_dofs(args),
+        max_dofs=args.max_dofs,
+        reference_dofs=compare_reference_dofs(args.reference_dofs, args.dim),
         crosscheck_dofs=args.crosscheck_dofs, max_memory_gib=args.max_memory, out=args.out,
         overwrite=True, workers=args.workers, scheduler=args.scheduler, cache=args.cache,
         scene_files=tuple(args.scene_file), command=" ".join(["python -m bench", *args.argv]))

@@ -52,6 +52,14 @@ COMPARE_REFERENCE_DOFS = 200000  # the default comparison's reference budget
 COMPARE_REFERENCE_DOFS_3D = 300000
 
 
+def compare_reference_dofs(given: int | None, dim: int) -> int:
+    """The reference budget of compare: ``given`` (--reference-dofs), else the default of the
+    scenes' dimension."""
+    if given is not None:
+        return given
+    return COMPARE_REFERENCE_DOFS_3D if dim == 3 else COMPARE_REFERENCE_DOFS
+
+
 @dataclass(frozen=True)
 class RunConfig:
     """Everything that determines a run of the matrix (the options of ``python -m bench run``).

@@ -21,6 +21,7 @@ from scipy.spatial import cKDTree
 from skfem import Basis, MeshTri
 
 from bench.measure.locator_3d import TetLocator
+from bench.measure.walk import element_neighbours, walk
 from formulations.elasticity import vector_element
 from formulations.evaluation import gradients_at_reference, p1_gradients
 from formulations.p1_stiffness import barycentric_gradients
@@ -28,27 +29,6 @@ from formulations.p1_stiffness import barycentric_gradients
 CHUNK = 50_000  # points per block when evaluating: small temporaries are reused, not faulted in
 # afresh (measured at 10^6 DOFs against the P3 reference: 0.96-1.14 s against 1.14-1.30 s with
 # 250 000)
-MAX_WALK = 64  # walk steps before the remaining points go to matplotlib's trapezoid finder
-INSIDE = 1e-12  # barycentric tolerance for "inside"
-
-
-def _neighbours(mesh: MeshTri) -> np.ndarray:
-    """neighbours[k, e]: the element across the edge of e opposite its vertex k, -1 on the
-    boundary."""
-    f2t, t2f = mesh.f2t, mesh.t2f  # facet -> its (one or two) elements; element -> facets
-    out = np.full((3, mesh.t.shape[1]), -1)
-    elements = np.arange(mesh.t.shape[1])
-    for j in range(3):
-        facet = t2f[j]
-        other = np.where(f2t[0, facet] == elements, f2t[1, facet], f2t[0, facet])
-        vertices = mesh.facets[:, facet]
-        # the vertex of e not on facet j is the one this neighbour lies opposite to
-        for k in range(3):
-            opposite = (mesh.t[k] != vertices[0]) & (mesh.t[k] != vertices[1])
-            out[k, opposite] = other[opposite]
-    return out
-
-
 @dataclass(frozen=True, eq=False)
 class Locator:
     """Point location in one triangle mesh (module docstring)."""
@@ -67,7 +47,7 @@ class Locator:
 
     @functools.cached_property
     def neighbours(self) -> np.ndarray:
-        return _neighbours(self.mesh)
+        return element_neighbours(self.mesh)
 
     @functools.cached_property
     def tree(self) -> cKDTree:
@@ -80,26 +60,16 @@ class Locator:
         inv = self.inverse[:, :, cells]
         return np.array([inv[0, 0] * d[0] + inv[0, 1] * d[1], inv[1, 0] * d[0] + inv[1, 1] * d[1]])
 
+    def barycentric(self, x: np.ndarray, cells: np.ndarray) -> np.ndarray:
+        xi = self.reference_coordinates(x, cells)
+        return np.array([1.0 - xi[0] - xi[1], xi[0], xi[1]])
+
     def find(self, x: np.ndarray) -> np.ndarray:
         """The element containing each point of x (2, n); ValueError for a point outside."""
-        cells = self.tree.query(x.T, workers=-1)[1]  # all cores: the same answer, sooner
-        todo = np.arange(x.shape[1])
-        for _ in range(MAX_WALK):
-            xi = self.reference_coordinates(x[:, todo], cells[todo])
-            bary = np.array([1.0 - xi[0] - xi[1], xi[0], xi[1]])
-            worst = bary.argmin(axis=0)
-            outside = bary[worst, np.arange(todo.size)] < -INSIDE
-            step = self.neighbours[worst[outside], cells[todo[outside]]]
-            todo = todo[outside]
-            if todo.size == 0:
-                return cells
-            stuck = step < 0  # across the boundary: left to the exact finder below
-            cells[todo[~stuck]] = step[~stuck]
-            if stuck.all():
-                break
-        return self._finish(x, cells, todo)
+        return walk(self, x)
 
-    def _finish(self, x, cells, todo) -> np.ndarray:
+    def finish(self, x, cells, todo) -> np.ndarray:
+        """matplotlib's trapezoid finder for the points the walk left."""
         triangulation = Triangulation(self.mesh.p[0], self.mesh.p[1], self.mesh.t.T)
         found = triangulation.get_trifinder()(x[0, todo], x[1, todo])
         if (found < 0).any():

@@ -17,26 +17,9 @@ import numpy as np
 from scipy.spatial import cKDTree
 from skfem import MeshTet
 
-MAX_WALK = 64  # walk steps before the remaining points go to the nearest-centroid search
-NEAREST = 64  # elements tried per point by that search
-INSIDE = 1e-12  # barycentric tolerance for "inside"
+from bench.measure.walk import INSIDE, element_neighbours, walk
 
-
-def _neighbours(mesh: MeshTet) -> np.ndarray:
-    """neighbours[k, e]: the element across the face of e opposite its vertex k, -1 on the
-    boundary."""
-    f2t, t2f = mesh.f2t, mesh.t2f
-    out = np.full((4, mesh.t.shape[1]), -1)
-    elements = np.arange(mesh.t.shape[1])
-    for j in range(4):
-        facet = t2f[j]
-        other = np.where(f2t[0, facet] == elements, f2t[1, facet], f2t[0, facet])
-        on_face = mesh.facets[:, facet]  # (3, nE)
-        for k in range(4):  # vertex k of e is opposite face j when it is not on it
-            opposite = (mesh.t[k] != on_face[0]) & (mesh.t[k] != on_face[1]) & \
-                (mesh.t[k] != on_face[2])
-            out[k, opposite] = other[opposite]
-    return out
+NEAREST = 64  # elements tried per point for the points the walk left
 
 
 @dataclass(frozen=True, eq=False)
@@ -58,7 +41,7 @@ class TetLocator:
 
     @functools.cached_property
     def neighbours(self) -> np.ndarray:
-        return _neighbours(self.mesh)
+        return element_neighbours(self.mesh)
 
     @functools.cached_property
     def tree(self) -> cKDTree:
@@ -69,36 +52,22 @@ class TetLocator:
         ``cells``."""
         return np.einsum("rke,ke->re", self.inverse[:, :, cells], x - self.origin[:, cells])
 
-    def _barycentric(self, x: np.ndarray, cells: np.ndarray) -> np.ndarray:
+    def barycentric(self, x: np.ndarray, cells: np.ndarray) -> np.ndarray:
         xi = self.reference_coordinates(x, cells)
         return np.vstack([1.0 - xi.sum(axis=0), xi])
 
     def find(self, x: np.ndarray) -> np.ndarray:
         """The element containing each point of x (3, n); ValueError for a point outside."""
-        cells = self.tree.query(x.T, workers=-1)[1]
-        todo = np.arange(x.shape[1])
-        for _ in range(MAX_WALK):
-            bary = self._barycentric(x[:, todo], cells[todo])
-            worst = bary.argmin(axis=0)
-            outside = bary[worst, np.arange(todo.size)] < -INSIDE
-            step = self.neighbours[worst[outside], cells[todo[outside]]]
-            todo = todo[outside]
-            if todo.size == 0:
-                return cells
-            stuck = step < 0
-            cells[todo[~stuck]] = step[~stuck]
-            if stuck.all():
-                break
-        return self._finish(x, cells, todo)
+        return walk(self, x)
 
-    def _finish(self, x, cells, todo) -> np.ndarray:
+    def finish(self, x, cells, todo) -> np.ndarray:
         """The nearest centroids' elements for the points the walk left: the first that
         contains each point."""
         near = self.tree.query(x[:, todo].T, k=min(NEAREST, self.mesh.t.shape[1]))[1]
         near = near.reshape(todo.size, -1)
         placed = np.zeros(todo.size, dtype=bool)
         for column in near.T:
-            bary = self._barycentric(x[:, todo], column)
+            bary = self.barycentric(x[:, todo], column)
             inside = ~placed & (bary.min(axis=0) >= -INSIDE)
             cells[todo[inside]] = column[inside]
             placed |= inside

@@ -33,7 +33,7 @@ def test_every_point_is_found_in_a_tetrahedron_that_contains_it():
     locator = TetLocator.from_mesh(mesh)
     x = np.random.default_rng(1).uniform(-1, 1, (3, 2000))
     cells = locator.find(x)
-    bary = locator._barycentric(x, cells)
+    bary = locator.barycentric(x, cells)
     assert bary.min() > -1e-12  # the point lies in the cell, up to round-off
     with pytest.raises(ValueError, match="lies outside the mesh"):
         locator.find(np.array([[0.0], [0.0], [1.5]]))
@@ -44,7 +44,7 @@ def _interpolated_on(coarse, fine_sol):
     mesh, fine = coarse.elasticity.mesh, fine_sol.elasticity
     locator = TetLocator.from_mesh(mesh)
     cells = locator.find(fine.mesh.p)
-    bary = locator._barycentric(fine.mesh.p, cells)
+    bary = locator.barycentric(fine.mesh.p, cells)
     u = np.zeros(fine.basis.N)
     for c in range(3):
         nodal = coarse.u[coarse.elasticity.basis.nodal_dofs[c]]
