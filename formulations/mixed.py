@@ -27,9 +27,15 @@ from skfem import MeshTri
 
 from formulations.base import ContactQP, DiscreteSolution, QPSolution, Residuals
 from formulations.contact import contact_trace, gauss_legendre
+from formulations.contact_patches import (
+    free_normal_vertices,
+    patch_sizes,
+    patch_sum,
+    patches,
+)
 from formulations.discretisation import Discretisation, discrete_solution
 from formulations.elasticity import assemble_elasticity, check_order
-from formulations.evaluation import normal_trace_matrix
+from formulations.evaluation import drop_roundoff, normal_trace_matrix
 from formulations.kkt import count_active
 from formulations.registry import register_formulation
 from scenes import Scene
@@ -112,26 +118,20 @@ def segment_weights(trace, segment: np.ndarray, breaks: np.ndarray, degree: int,
                              shape=(m, nf * nq))
 
 
-def planar_only(scene=None, **_) -> str | None:
-    """Why ``mixed`` does not apply: its coarser multiplier mesh is a mesh of the contact
-    coordinate along a curve Gamma_C, which a 3D body's contact surface is not."""
-    if scene is not None and scene.dim != 2:
-        return ("mixed: the coarser multiplier mesh is built along a 1D Gamma_C; a multiplier "
-                "on patches of contact triangles (3D) is not implemented")
-    return None
-
-
 @register_formulation("mixed", "Haslinger's mixed method: multiplier of degree p - 1 "
                                "(piecewise constant for P1) on a coarser contact mesh, "
-                               "h/H <= 1/2 (seed paper, eq. (3)); 2D only",
-                      applies=planar_only)
+                               "h/H <= 1/2 (seed paper, eq. (3)); in 3D piecewise constant "
+                               "on vertex-star patches of contact triangles")
 def discretise(scene: Scene, mesh: MeshTri, h_over_H: float = 0.5, order: int = 1,
                multiplier_degree: int | None = None) -> Discretisation:
     """``h_over_H``: the largest allowed ratio of a facet to its multiplier segment. The
     paper's 1/2 (default) keeps the pair uniformly inf-sup stable; 1 (multiplier mesh = trace
     mesh) is not guaranteed to be (a hard case, see ``formulations.diagnostics``).
     ``multiplier_degree``: the polynomial degree q of lambda_H on each segment (default
-    p - 1, docs/theory.md, section 9)."""
+    p - 1, docs/theory.md, section 9). On tetrahedra (``discretise_surface``) h_over_H = 1/2
+    means star patches, 1 the contact triangles, and q is 0."""
+    if scene.dim == 3:
+        return discretise_surface(scene, mesh, h_over_H, order, multiplier_degree)
     if not (is_number(h_over_H) and 0.0 < h_over_H <= 1.0):
         raise ValueError(f"h_over_H={h_over_H!r} is not in (0, 1]")
     order = check_order(order)
@@ -178,3 +178,47 @@ def discretise(scene: Scene, mesh: MeshTri, h_over_H: float = 0.5, order: int = 
                           recover=recover, row_coordinate=row_coordinate,
                           multiplier_gram=gram)
 
+
+
+def discretise_surface(scene: Scene, mesh, h_over_H: float, order: int,
+                       multiplier_degree: int | None) -> Discretisation:
+    """The mixed method on tetrahedra (docs/theory.md, section 14.7): lambda_H piecewise
+    constant on the patches of ``formulations.contact_patches`` (star patches for
+    h_over_H = 1/2, the contact triangles for 1), whatever p: B_(P) j = int_P phi_j . n ds,
+    G_P = int_P g ds, and the multiplier of row P is lambda_H on P."""
+    if not (is_number(h_over_H) and h_over_H in (0.5, 1.0)):
+        raise ValueError(f"h_over_H={h_over_H!r} is not allowed on a 3D contact surface: 0.5 "
+                         f"(vertex-star patches) or 1 (the contact triangles)")
+    if multiplier_degree not in (None, 0):
+        raise ValueError(f"multiplier_degree={multiplier_degree!r} is not allowed on a 3D "
+                         f"contact surface: 0 (piecewise constant on patches)")
+    elasticity = assemble_elasticity(scene, mesh, check_order(order))
+    surface = contact_trace(scene, mesh)
+    admissible = free_normal_vertices(surface, elasticity.basis.nodal_dofs, elasticity.free)
+    patch = patches(surface, "star" if h_over_H < 1 else "triangle", admissible)
+    area, H = patch_sizes(surface, patch)
+    t, w = surface.rule(elasticity.order)  # phi_j . n has degree p on a flat triangle
+    weights = patch_sum(patch, t.shape[1]) @ sparse.diags(np.outer(surface.measure, w).ravel())
+    B = weights @ normal_trace_matrix(elasticity.basis, surface, t)
+    t, w = surface.rule(GAP_QUADRATURE_POINTS)
+    G = patch_sum(patch, t.shape[1]) @ (np.asarray(scene.gap(surface.points(t)))
+                                        * np.outer(surface.measure, w)).ravel()
+    qp = ContactQP(K=elasticity.K_free, F=elasticity.F[elasticity.free],
+                   B=drop_roundoff(B[:, elasticity.free].tocsr()), G=G, row_scale=area,
+                   objective_scale=float(scene.material.young_modulus))
+    centroid = np.array([np.bincount(patch, weights=c * surface.measure) / area
+                         for c in surface.coordinate.mean(axis=1)])
+
+    def recover(answer: QPSolution, residuals: Residuals, status: str,
+                reason: str) -> DiscreteSolution:
+        lam = np.maximum(answer.multipliers, 0.0)
+        return discrete_solution(
+            "mixed", elasticity, surface, answer, residuals, status, reason, u_free=answer.u,
+            pressure=lambda tt: np.repeat(lam[patch][:, None], np.shape(tt)[-1], axis=1),
+            multiplier_breaks=np.zeros(0), active_constraints=count_active(qp, answer.u, lam),
+            max_h_over_H=float(np.sqrt(surface.measure / area[patch]).max()),
+            details=MixedDetails(segment_of_facet=patch))
+
+    # sum_P H_P ||mu||_{0,P}^2 = H_P |P| mu_P^2 (in 2D H_S^2, as |S| = H_S)
+    return Discretisation(formulation="mixed", elasticity=elasticity, trace=surface, qp=qp,
+                          recover=recover, row_coordinate=centroid, multiplier_gram=H * area)

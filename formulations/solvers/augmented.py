@@ -16,6 +16,7 @@ from scipy import sparse
 from scipy.sparse.linalg import LinearOperator, onenormest, splu
 
 from formulations.base import STATUS_FAILED, STATUS_OK, ContactQP, SolverDiagnostics
+from formulations.solvers.lcp import SINGULAR
 
 VIOLATION_TOLERANCE = 1e-12  # relative to the displacement scale: round-off, not penetration
 
@@ -65,7 +66,10 @@ def solve_augmented(qp: ContactQP, active: np.ndarray, max_iter: int):
         B_A = B[rows]
         system = sparse.bmat([[K, B_A.T], [B_A, None]], format="csc")
         rhs = np.concatenate([F, G[rows]])
-        lu = splu(system)
+        try:
+            lu = splu(system)
+        except RuntimeError:  # "Factor is exactly singular": dependent active rows of B
+            return u, lam, iteration, STATUS_FAILED, SINGULAR, diagnostics(False)
         solution = lu.solve(rhs)
         solution += lu.solve(rhs - system @ solution)  # one step of iterative refinement
         u, lam = solution[:n], np.zeros(m)

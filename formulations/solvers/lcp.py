@@ -51,10 +51,21 @@ class LCPResult:
     active: np.ndarray
 
 
+SINGULAR = ("singular active block S_AA: the active rows of B are linearly dependent (the "
+            "multipliers are not unique)")
+
+
+class SingularActiveBlock(Exception):
+    """S_AA is singular: a multiplier space that is not inf-sup stable (B' has a kernel)."""
+
+
 def _solve_active(S, r, active):
     lam = np.zeros(r.size)
     if active.any():
-        lam[active] = linalg.solve(S[np.ix_(active, active)], r[active], assume_a="pos")
+        try:
+            lam[active] = linalg.solve(S[np.ix_(active, active)], r[active], assume_a="pos")
+        except linalg.LinAlgError as error:
+            raise SingularActiveBlock(SINGULAR) from error
     return lam, S @ lam - r
 
 
@@ -70,7 +81,11 @@ def pdas(S: np.ndarray, r: np.ndarray, active: np.ndarray, max_iter: int) -> LCP
             return LCPResult(lam, iteration - 1, STATUS_FAILED,
                              "active set cycles (a set repeated)", tuple(changes), True, active)
         seen.add(key)
-        lam, y = _solve_active(S, r, active)
+        try:
+            lam, y = _solve_active(S, r, active)
+        except SingularActiveBlock:
+            return LCPResult(lam, iteration, STATUS_FAILED, SINGULAR, tuple(changes), False,
+                             active)
         new_active = lam - c * y > 0
         changes.append(int((new_active != active).sum()))
         if changes[-1] == 0:
@@ -88,7 +103,11 @@ def least_index_pivoting(S: np.ndarray, r: np.ndarray, active: np.ndarray,
     lam = np.zeros(r.size)
     active = active.copy()
     for iteration in range(1, max_iter + 1):
-        lam, y = _solve_active(S, r, active)
+        try:
+            lam, y = _solve_active(S, r, active)
+        except SingularActiveBlock:
+            return LCPResult(lam, iteration, STATUS_FAILED, SINGULAR, tuple(changes), False,
+                             active)
         lam_tol = ROUNDOFF * max(np.abs(lam).max(initial=0.0), np.finfo(float).tiny)
         y_tol = ROUNDOFF * max(np.abs(r).max(initial=0.0), np.finfo(float).tiny)
         infeasible = np.flatnonzero(np.where(active, lam < -lam_tol, y < -y_tol))
