@@ -65,3 +65,28 @@ def test_an_exhausted_iteration_is_safeguarded_and_says_so(backend):
     expected = "least-index pivoting" if condenses(backend) else "reference fallback"
     assert answer.diagnostics.safeguard == expected
     assert (answer.backend == "clarabel") == (expected == "reference fallback")
+
+
+@pytest.mark.parametrize("backend", available_backends())
+def test_dependent_active_rows_are_a_reason_not_an_exception(backend):
+    # two identical constraint rows both active: B K^-1 B' (and the saddle-point matrix of
+    # the augmented route) is singular; the iteration says so and the reference answers
+    from scipy import sparse
+
+    from formulations.base import ContactQP
+    qp = ContactQP(K=sparse.identity(2, format="csr"), F=np.array([1.0, 1.0]),
+                   B=sparse.csr_matrix(np.array([[1.0, 0.0], [1.0, 0.0]])),
+                   G=np.array([0.5, 0.5]), row_scale=np.ones(2), objective_scale=1.0)
+    answer = solve_active_set(qp, warm_start=np.ones(2), backend=backend)
+    assert answer.status == "ok" and "linearly dependent" in answer.reason
+    assert answer.diagnostics.safeguard == "reference fallback"
+    # u = (0.5, 1): the first component stops at the obstacle (Clarabel's tolerance 1e-8)
+    assert answer.u == pytest.approx([0.5, 1.0], abs=1e-7)
+
+
+def test_pdas_reports_a_singular_active_block():
+    from formulations.solvers.lcp import SINGULAR
+    S, r = np.ones((2, 2)), np.ones(2)
+    for method in (pdas, least_index_pivoting):
+        result = method(S, r, np.array([True, True]), 10)
+        assert result.status == "failed" and result.reason == SINGULAR
