@@ -7,8 +7,9 @@ N^(-1/2) for P1, so that a few hundred thousand DOFs are far sharper than any P1
 Its own energy-norm error is estimated from the differences between its last levels
 (``bench.truth.error_bar``); ``reference_too_coarse`` flags rows whose error is not at least
 1/TOO_COARSE times larger. A second recipe (``CROSSCHECK``, P2) checks the first
-(``bench.truth.crosscheck``). On tetrahedra there is neither P3 nor the mixed method, so the
-references are P2: the variational inequality first, Nitsche's method as its cross-check
+(``bench.truth.crosscheck``). On tetrahedra there is no P3, and the mixed method's multiplier
+is piecewise constant whatever p (docs/theory.md, section 14.7), so the references are P2: the
+variational inequality first, Nitsche's method as its cross-check
 (``recipes_for``; docs/theory.md, section 14.6). The VI comes first because its condensed
 solve couples one DOF per contact node; Nitsche's couples every DOF of the tetrahedra on
 Gamma_C, whose dense Schur block outgrows the memory near 1.5e5 P2 DOFs.

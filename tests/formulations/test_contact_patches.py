@@ -67,7 +67,7 @@ def test_patch_sizes_and_the_triangle_patches():
 
 def test_star_patches_are_inf_sup_stable_and_the_triangles_are_not():
     # beta_h on paper-3d, P1, uniform levels 0..2 (300, 1944, 13 872 DOFs): measured 0.673,
-    # 0.404, 0.344 for star patches (then 0.334 at 104 544) and 0 for the triangles, whose
+    # 0.404, 0.344 for star patches (then 0.336 at 104 544) and 0 for the triangles, whose
     # multipliers outnumber the normal displacements (B' has a kernel: round-off only).
     # The floor 0.25 and the last ratio 0.8 leave room for round-off, not for a decay like h
     scene = get_scene("paper-3d")
