@@ -3,6 +3,7 @@ the patches themselves, the inf-sup constant of the stable and the unstable choi
 errors for options that do not exist in 3D (docs/theory.md, section 14.7)."""
 
 import re
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -10,6 +11,7 @@ import pytest
 from formulations import get_formulation, solve
 from formulations.contact import contact_trace
 from formulations.contact_patches import free_normal_vertices, patch_sizes, patches
+from formulations.contact_surface import triangle_rule
 from formulations.diagnostics import inf_sup_constant
 from formulations.elasticity import assemble_elasticity
 from scenes import get_scene
@@ -63,6 +65,27 @@ def test_patch_sizes_and_the_triangle_patches():
     # triangle joined no other patch; measured 0.41 at most on this mesh
     assert np.sqrt(surface.measure / area[patch]).max() <= 0.5
     assert np.array_equal(patches(surface, "triangle", admissible), np.arange(surface.size))
+
+
+@pytest.mark.parametrize("order", [1, 2])
+def test_B_integrates_normal_displacement_and_G_a_linear_gap_exactly(order):
+    # on a graded mesh: B u = int_P u . n over each patch for a field of degree p, and
+    # G_P = int_P g = |T| g(centroid) summed over its triangles for a linear g (round-off)
+    scene = replace(get_scene("paper-3d"), gap=lambda x: 0.3 * x[0] - 0.2 * x[1] + 0.05)
+    disc = get_formulation("mixed")(scene, graded_mesh(scene, steps=1), order=order)
+    surface, patch = disc.trace, star_patches_of(scene, disc.elasticity.mesh)[2]
+    x = disc.elasticity.basis.doflocs  # (3, N): every DOF's location
+    u = np.where(np.arange(x.shape[1]) % 3 == 2, x[0] ** order + 0.5 * x[1] - 0.1, 7.0)
+    # exact: n = (0, 0, -1) on the bottom face, so u . n = -(x^p + y / 2 - 1 / 10); the
+    # tangential components (7) must not count
+    t, w = triangle_rule(4)
+    points = surface.points(t)
+    exact = -np.bincount(patch, weights=((points[0] ** order + 0.5 * points[1] - 0.1)
+                                         * w).sum(axis=1) * surface.measure)
+    assert disc.qp.B @ u[disc.elasticity.free] == pytest.approx(exact, rel=1e-12, abs=1e-14)
+    centroid = surface.points(np.array([[1 / 3], [1 / 3]]))[:, :, 0]
+    expected_G = np.bincount(patch, weights=surface.measure * scene.gap(centroid))
+    assert disc.qp.G == pytest.approx(expected_G, rel=1e-12, abs=1e-14)
 
 
 def test_star_patches_are_inf_sup_stable_and_the_triangles_are_not():
