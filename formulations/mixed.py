@@ -14,6 +14,10 @@ the paper); on a graded trace the segments follow the grading. (Maximal dyadic p
 facets would not: on graded traces they stay as coarse as the coarsest facet around, and on the
 Hertz scene, whose contact zone is smaller than one initial facet, such a multiplier mesh lags
 the refinement by a dozen levels.)
+
+On tetrahedra (``discretise_surface``, docs/theory.md, section 14.7) lambda_H is piecewise
+constant on patches of contact triangles, each holding the whole star of a vertex
+(``formulations.contact_patches``), for P1 and P2 alike.
 """
 
 from __future__ import annotations
@@ -42,11 +46,13 @@ from scenes import Scene
 from scenes.base import is_integer, is_number
 
 GAP_QUADRATURE_POINTS = 6  # G_i = int g: g is smooth on each facet; 6 Gauss points is plenty
+GAP_RULE_DEGREE = 6  # the same on a contact triangle: a rule exact to degree 6
 
 
 @dataclass(frozen=True, eq=False)
 class MixedDetails:
-    """The mixed method's own arrays: the multiplier segment of every contact facet."""
+    """The mixed method's own arrays: the multiplier segment (3D: patch) of every contact
+    facet."""
 
     segment_of_facet: np.ndarray
 
@@ -179,7 +185,6 @@ def discretise(scene: Scene, mesh: MeshTri, h_over_H: float = 0.5, order: int = 
                           multiplier_gram=gram)
 
 
-
 def discretise_surface(scene: Scene, mesh, h_over_H: float, order: int,
                        multiplier_degree: int | None) -> Discretisation:
     """The mixed method on tetrahedra (docs/theory.md, section 14.7): lambda_H piecewise
@@ -200,7 +205,7 @@ def discretise_surface(scene: Scene, mesh, h_over_H: float, order: int,
     t, w = surface.rule(elasticity.order)  # phi_j . n has degree p on a flat triangle
     weights = patch_sum(patch, t.shape[1]) @ sparse.diags(np.outer(surface.measure, w).ravel())
     B = weights @ normal_trace_matrix(elasticity.basis, surface, t)
-    t, w = surface.rule(GAP_QUADRATURE_POINTS)
+    t, w = surface.rule(GAP_RULE_DEGREE)
     G = patch_sum(patch, t.shape[1]) @ (np.asarray(scene.gap(surface.points(t)))
                                         * np.outer(surface.measure, w)).ravel()
     qp = ContactQP(K=elasticity.K_free, F=elasticity.F[elasticity.free],
