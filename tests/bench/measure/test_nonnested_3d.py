@@ -69,6 +69,7 @@ def test_transfer_is_exact_on_nested_tetrahedral_meshes():
     assert energy_difference(second, first, lame) == pytest.approx(expected, rel=0.01)
 
 
+@pytest.mark.slow  # a P2 solve and a non-nested error on 1e5 quadrature points: about 16 s
 def test_error_against_a_p2_solution_is_the_exact_error_up_to_its_own():
     scene = get_scene("free-boundary-3d")
     judged, sharper = solved(scene, scene.mesh.refined(1)), solved(scene, scene.mesh.refined(2), 2)

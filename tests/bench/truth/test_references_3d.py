@@ -74,6 +74,7 @@ def test_the_pressure_is_interpolated_over_the_contact_plane(reference):
     assert values[-1] == 0.0
 
 
+@pytest.mark.slow  # builds a second 45 000-DOF P2 reference (Nitsche's): about 20 s
 def test_the_two_recipes_differ_by_no_more_than_their_own_errors(reference):
     scene, ref = reference
     other = cache.load_or_build(scene, BUDGET, recipes_for(scene)[1])
