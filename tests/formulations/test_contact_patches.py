@@ -111,15 +111,15 @@ def test_star_patches_stay_stable_on_a_graded_mesh():
     assert beta > 0.25
 
 
-def test_the_unstable_choice_is_solved_through_the_safeguard():
-    # triangle patches: the condensed B K^-1 B' is singular, the active-set iteration reports
-    # it and falls back to the reference solver; u is unique, so the energies agree (Clarabel's
-    # relative gap ~1e-8)
+def test_the_unstable_choice_still_gets_the_unique_displacement():
+    # triangle patches: the condensed B K^-1 B' is singular (measured: the active-set iteration
+    # meets a singular active block and hands the QP to the reference solver; whether round-off
+    # lets a Cholesky factor through first is not asserted); u is unique, so the energies agree
+    # (Clarabel's relative gap ~1e-8)
     scene = get_scene("paper-3d")
     disc = get_formulation("mixed")(scene, scene.mesh.refined(), h_over_H=1.0)
     fast, reference = solve(disc, "active-set"), solve(disc, "reference")
     assert fast.ok and reference.ok
-    assert fast.diagnostics.safeguard == "reference fallback"
     assert fast.energy == pytest.approx(reference.energy, rel=1e-7)
 
 
