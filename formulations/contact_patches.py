@@ -17,7 +17,6 @@ from __future__ import annotations
 import numpy as np
 from scipy import sparse
 
-PATCH_KINDS = ("star", "triangle")
 STAR_SEED = 0  # the tie-break permutation of the independent set (fixed: the patches of a
 # mesh are reproducible)
 MIN_STAR = 4  # triangles around a centre: h / H <= 1/2 for equal triangles (a corner's star of
@@ -82,7 +81,8 @@ def star_patches(surface, admissible: np.ndarray) -> np.ndarray:
 
 
 def patches(surface, kind: str, admissible: np.ndarray) -> np.ndarray:
-    """Patch index of every contact triangle for a ``kind`` in ``PATCH_KINDS``."""
+    """Patch index of every contact triangle: ``kind`` "star" (``star_patches``) or
+    "triangle" (each triangle its own patch)."""
     if kind == "triangle":
         return np.arange(surface.size)
     return star_patches(surface, admissible)

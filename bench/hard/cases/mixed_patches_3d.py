@@ -5,8 +5,8 @@
 from __future__ import annotations
 
 import pandas as pd
-from matplotlib.figure import Figure
 
+from bench.hard.cases.mixed_ratio import inf_sup_plot
 from bench.hard.registry import case_figure, hard_case
 from bench.hard.verdicts import solve_both
 from formulations.solvers.registry import FAST_SOLVER
@@ -44,16 +44,5 @@ def mixed_patches_3d() -> list[dict]:
                                 "ndofs for star patches and for the contact triangles (whose "
                                 "beta_h is 0: the linear axis shows it).")
 def patches_figure(rows: pd.DataFrame):
-    fast = rows[rows["solver"] == FAST_SOLVER]
-    if fast.empty:
-        return None
-    fig = Figure(figsize=(5.5, 4))
-    ax = fig.subplots()
-    for variant, group in fast.groupby("variant", sort=False):
-        ax.semilogx(group["ndofs"], group["inf_sup"], marker="o", label=variant)
-    ax.set(xlabel="ndofs", ylabel="beta_h", ylim=(-0.05, None),
-           title="mixed on paper-3d: discrete inf-sup constant beta_h")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=7)
-    fig.tight_layout()
-    return fig
+    return inf_sup_plot(rows, "mixed on paper-3d: discrete inf-sup constant beta_h",
+                        log_beta=False)
