@@ -11,9 +11,9 @@ import tomllib
 from pathlib import Path
 
 import numpy as np
-from skfem import MeshTri
 
 from scenes.base import Material, Scene, SceneError, is_integer, is_number
+from scenes.budget import tensor_mesh
 from scenes.expressions import Expression, ExpressionError
 from scenes.mesh_file import on_segments, read_mesh_file
 from scenes.registry import register_scene
@@ -56,8 +56,8 @@ def register_toml_scene(path: str | Path) -> str:
         return _scene(path, data, name, description, values, digest.hexdigest()[:16])
 
     factory.__signature__ = _signature(defaults)
-    factory()  # refuse a bad file now, not at the first solve
-    register_scene(name, description)(factory)
+    scene = factory()  # refuse a bad file now, not at the first solve
+    register_scene(name, description, tags=scene.tags, dim=scene.dim)(factory)
     return name
 
 
@@ -141,7 +141,7 @@ def _body(path: Path, geometry: dict):
         raise SceneError(f"{path}: [geometry] divisions={divisions!r} is not [nx, ny] of "
                          "integers >= 1")
     (x0, x1), (y0, y1) = box
-    mesh = MeshTri.init_tensor(np.linspace(x0, x1, divisions[0] + 1),
+    mesh = tensor_mesh(np.linspace(x0, x1, divisions[0] + 1),
                                np.linspace(y0, y1, divisions[1] + 1))
     tol = 1e-10 * max(x1 - x0, y1 - y0)
     sides = {"left": lambda x: np.abs(x[0] - x0) < tol, "right": lambda x: np.abs(x[0] - x1) < tol,

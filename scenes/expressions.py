@@ -35,6 +35,35 @@ class ExpressionError(ValueError):
     """A text that is not an expression of the allowed vocabulary."""
 
 
+MAX_LENGTH = 2000  # characters of one expression: a gap or a load is a formula, not a program
+MAX_NESTING = 50  # levels of parentheses
+MAX_DEPTH = 200  # nested operations: evaluation recurses once per level
+
+
+def _depth(tree: ast.AST) -> int:
+    """The depth of a syntax tree, found without recursion."""
+    deepest, stack = 0, [(tree, 1)]
+    while stack:
+        node, depth = stack.pop()
+        deepest = max(deepest, depth)
+        stack.extend((child, depth + 1) for child in ast.iter_child_nodes(node))
+    return deepest
+
+
+def _nesting(text: str) -> int:
+    """The deepest nesting of parentheses in ``text``."""
+    depth = deepest = 0
+    for char in text:
+        depth += (char == "(") - (char == ")")
+        deepest = max(deepest, depth)
+    return deepest
+
+
+def _shown(text: str) -> str:
+    """``text`` as a message shows it: repr, cut to 60 characters."""
+    return repr(text) if len(text) <= 60 else repr(text[:57] + "...")
+
+
 class Expression:
     """A parsed expression; ``Expression(text, names)(points)`` evaluates it at points of shape
     (2, ...) and returns an array of shape (...)."""
@@ -46,11 +75,22 @@ class Expression:
         if not isinstance(text, str | int | float) or isinstance(text, bool):
             raise ExpressionError(f"{where}={text!r} is not an expression of x and y (a string "
                                   "or a number)")
+        text = str(text)
+        if len(text) > MAX_LENGTH or _nesting(text) > MAX_NESTING:
+            raise ExpressionError(f"{where}={_shown(text)} is too long or too deeply nested "
+                                  f"(allowed: at most {MAX_LENGTH} characters and "
+                                  f"{MAX_NESTING} levels of parentheses)")
         try:
-            self.tree = ast.parse(str(text), mode="eval").body
+            self.tree = ast.parse(text, mode="eval").body
+            if _depth(self.tree) > MAX_DEPTH:
+                raise RecursionError  # evaluating it would recurse this deep
+            self._check(self.tree)
         except SyntaxError as error:
-            raise ExpressionError(f"{where}={text!r} does not parse: {error.msg}") from None
-        self._check(self.tree)
+            raise ExpressionError(f"{where}={_shown(text)} does not parse: {error.msg}") \
+                from None
+        except (RecursionError, MemoryError):  # chains of operators nest without parentheses
+            raise ExpressionError(f"{where}={_shown(text)} is too deeply nested (allowed: at "
+                                  f"most {MAX_DEPTH} nested operations)") from None
 
     def _refuse(self, node, what: str):
         raise ExpressionError(f"{self.where}={self.text!r}: {what} is not allowed (allowed: "

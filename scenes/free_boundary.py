@@ -22,9 +22,9 @@ that differentiates u numerically.
 from __future__ import annotations
 
 import numpy as np
-from skfem import MeshTri
 
 from scenes.base import ExactSolution, Material, Scene
+from scenes.budget import tensor_mesh
 from scenes.registry import register_scene
 
 _TOL = 1e-10
@@ -35,7 +35,8 @@ def _phi(y):
 
 
 @register_scene("free-boundary", "exact elastic Signorini solution on the unit square with the "
-                                 "contact zone |x| < a ending inside Gamma_C (manufactured)")
+                                 "contact zone |x| < a ending inside Gamma_C (manufactured)",
+                tags=("exact",), dim=2)
 def free_boundary(young_modulus: float = 1.0, poisson_ratio: float = 0.3, plane: str = "strain",
                   push: float = 0.01, half_width: float = 0.4, gap_curvature: float = 0.1,
                   initial_divisions: int = 4) -> Scene:
@@ -81,7 +82,7 @@ def free_boundary(young_modulus: float = 1.0, poisson_ratio: float = 0.3, plane:
     return Scene(
         name="free-boundary",
         description="manufactured exact Signorini solution, contact zone |x| < a inside Gamma_C",
-        mesh=MeshTri.init_tensor(grid, grid), material=material,
+        mesh=tensor_mesh(grid, grid), material=material,
         is_dirichlet=lambda x: np.abs(x[1] - 1.0) < _TOL,
         is_contact=lambda x: np.abs(x[1] + 1.0) < _TOL,
         gap=lambda x: -c + k * np.clip(np.abs(x[0]) - a, 0.0, None) ** 2,

@@ -23,9 +23,9 @@ Manufactured: a test differentiates u numerically against every formula here.
 from __future__ import annotations
 
 import numpy as np
-from skfem import MeshTet
 
 from scenes.base import ExactSolution, Material, Scene, SceneError, is_integer
+from scenes.budget import tensor_mesh
 from scenes.free_boundary import _phi
 from scenes.registry import register_scene
 
@@ -41,7 +41,8 @@ def side_normals(x: np.ndarray) -> np.ndarray:
 
 
 @register_scene("free-boundary-3d", "exact 3D Signorini solution on the cube (-1,1)^3 with the "
-                                    "contact zone a disc r < a inside Gamma_C (manufactured)")
+                                    "contact zone a disc r < a inside Gamma_C (manufactured)",
+                tags=("exact", "3d"), dim=3)
 def free_boundary_3d(young_modulus: float = 1.0, poisson_ratio: float = 0.3, push: float = 0.01,
                      half_width: float = 0.4, gap_curvature: float = 0.1,
                      initial_divisions: int = 4) -> Scene:
@@ -95,7 +96,7 @@ def free_boundary_3d(young_modulus: float = 1.0, poisson_ratio: float = 0.3, pus
     return Scene(
         name="free-boundary-3d",
         description="manufactured exact 3D Signorini solution, contact zone the disc r < a",
-        mesh=MeshTet.init_tensor(grid, grid, grid), material=material,
+        mesh=tensor_mesh(grid, grid, grid), material=material,
         is_dirichlet=lambda x: np.abs(x[2] - 1.0) < _TOL,
         is_contact=lambda x: np.abs(x[2] + 1.0) < _TOL,
         gap=lambda x: -c + k * np.clip(np.hypot(x[0], x[1]) - a, 0.0, None) ** 2,

@@ -9,9 +9,9 @@ out of the default comparison (``python -m bench compare``) and exercised by tes
 from __future__ import annotations
 
 import numpy as np
-from skfem import MeshTri
 
 from scenes.base import Material, Scene
+from scenes.budget import tensor_mesh
 from scenes.paper import paper_gap
 from scenes.registry import register_scene
 
@@ -23,7 +23,7 @@ def _block(name, description, gap, *, width=2.0, height=2.0, nx=4, ny=4, poisson
            is_dirichlet=None, parameters=None) -> Scene:
     xs = np.linspace(-width / 2, width / 2, nx + 1)
     ys = np.linspace(-height / 2, height / 2, ny + 1) if ys is None else ys
-    return Scene(name=name, description=description, mesh=MeshTri.init_tensor(xs, ys),
+    return Scene(name=name, description=description, mesh=tensor_mesh(xs, ys),
                  material=Material(young_modulus, poisson_ratio, plane),
                  is_dirichlet=is_dirichlet or (lambda x: np.abs(x[1] - height / 2) < _TOL),
                  is_contact=lambda x: np.abs(x[1] + height / 2) < _TOL,
@@ -32,21 +32,24 @@ def _block(name, description, gap, *, width=2.0, height=2.0, nx=4, ny=4, poisson
 
 
 @register_scene("no-contact", "hard: a body pulled down by its weight, the obstacle 1.0 away "
-                              "(nothing touches)")
+                              "(nothing touches)",
+                tags=("hard",), dim=2)
 def no_contact() -> Scene:
     return _block("no-contact", "gap 1.0, body force (0, -1000)",
                   lambda x: np.full(x.shape[1:], 1.0),
                   body_force=lambda x: np.array([0.0 * x[0], -1000.0 + 0.0 * x[0]]))
 
 
-@register_scene("full-contact", "hard: a flat obstacle pushes the whole of Gamma_C up by 0.01")
+@register_scene("full-contact", "hard: a flat obstacle pushes the whole of Gamma_C up by 0.01",
+                tags=("hard",), dim=2)
 def full_contact() -> Scene:
     return _block("full-contact", "flat obstacle, g = -0.01 on all of Gamma_C",
                   lambda x: np.full(x.shape[1:], -0.01))
 
 
 @register_scene("incompressible", "hard: the paper's obstacle on a nearly incompressible body "
-                                  "(plane strain, nu = 0.4999; P1 locking)")
+                                  "(plane strain, nu = 0.4999; P1 locking)",
+                tags=("hard",), dim=2)
 def incompressible(poisson_ratio: float = 0.4999) -> Scene:
     return _block("incompressible", f"paper geometry, plane strain, nu = {poisson_ratio}",
                   paper_gap,
@@ -54,12 +57,14 @@ def incompressible(poisson_ratio: float = 0.4999) -> Scene:
                   parameters={"poisson_ratio": poisson_ratio})
 
 
-@register_scene("wedge", "hard: an obstacle with a kink, g = 0.5 |x| - 0.05")
+@register_scene("wedge", "hard: an obstacle with a kink, g = 0.5 |x| - 0.05",
+                tags=("hard",), dim=2)
 def wedge() -> Scene:
     return _block("wedge", "wedge obstacle g = 0.5|x| - 0.05", lambda x: 0.5 * np.abs(x[0]) - 0.05)
 
 
-@register_scene("thin", "hard: a 50:1 strip pressed by a parabola (thin body, long elements)")
+@register_scene("thin", "hard: a 50:1 strip pressed by a parabola (thin body, long elements)",
+                tags=("hard",), dim=2)
 def thin() -> Scene:
     return _block("thin", "strip (-1,1) x (-0.02,0.02), g = x^2 - 0.001",
                   lambda x: x[0] ** 2 - 0.001, height=0.04, nx=50, ny=1)
@@ -67,7 +72,8 @@ def thin() -> Scene:
 
 @register_scene("grazing", "hard: a block hanging under its weight (nu = 0) just touching a flat "
                            "obstacle: u_n = g and p = 0 on all of Gamma_C (no strict "
-                           "complementarity)")
+                           "complementarity)",
+                tags=("hard",), dim=2)
 def grazing(density: float = 1000.0) -> Scene:
     """With nu = 0 and traction-free sides the hanging block is one-dimensional:
     sigma_yy = rho (y + 1), u_y = rho ((y + 1)^2 - 4) / (2E), so the bottom moves down by
@@ -85,7 +91,8 @@ def grazing(density: float = 1000.0) -> Scene:
 
 
 @register_scene("traction", "hard: load-driven contact: a cantilever (clamped left side) "
-                            "pressed by a traction on its top onto a flat obstacle 0.002 below")
+                            "pressed by a traction on its top onto a flat obstacle 0.002 below",
+                tags=("hard",), dim=2)
 def traction(pressure: float = 400.0) -> Scene:
     """No obstacle penetrates the initial configuration (g = 0.002 > 0): contact is made by
     the load alone, near the free end, and the contact zone ends at the corner (1, -1)."""
@@ -99,14 +106,16 @@ def traction(pressure: float = 400.0) -> Scene:
 
 
 @register_scene("corner", "hard: a tilted flat obstacle pushes the left end up; the contact "
-                          "zone ends at the corner (-1, -1) of the domain")
+                          "zone ends at the corner (-1, -1) of the domain",
+                tags=("hard",), dim=2)
 def corner() -> Scene:
     return _block("corner", "tilted flat obstacle g = 0.02 (x + 0.2)",
                   lambda x: 0.02 * (x[0] + 0.2))
 
 
 @register_scene("graded", "hard: the paper's obstacle on a strongly graded initial mesh "
-                          "(geometric layers towards Gamma_C, aspect ratios up to ~130)")
+                          "(geometric layers towards Gamma_C, aspect ratios up to ~130)",
+                tags=("hard",), dim=2)
 def graded(ratio: float = 0.5, layers: int = 9) -> Scene:
     """y-spacing shrinks by ``ratio`` towards the contact edge: with the defaults the bottom
     layer is 2 ratio^(layers-1) / sum_k ratio^k = 0.0039 thin against elements 0.5 wide

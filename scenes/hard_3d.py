@@ -7,9 +7,9 @@ fewer uniform refinements (``bench.hard.cases.scenes.hard_level``)."""
 from __future__ import annotations
 
 import numpy as np
-from skfem import MeshTet
 
 from scenes.base import Material, Scene
+from scenes.budget import tensor_mesh
 from scenes.paper_3d import ball_gap
 from scenes.registry import register_scene
 
@@ -20,7 +20,7 @@ def _box(name, description, gap, *, width=2.0, height=2.0, n=4, nz=4, poisson_ra
          young_modulus=70000.0, body_force=None, parameters=None) -> Scene:
     xs = np.linspace(-width / 2, width / 2, n + 1)
     zs = np.linspace(-height / 2, height / 2, nz + 1)
-    return Scene(name=name, description=description, mesh=MeshTet.init_tensor(xs, xs, zs),
+    return Scene(name=name, description=description, mesh=tensor_mesh(xs, xs, zs),
                  material=Material(young_modulus, poisson_ratio, "strain"),
                  is_dirichlet=lambda x: np.abs(x[2] - height / 2) < _TOL,
                  is_contact=lambda x: np.abs(x[2] + height / 2) < _TOL,
@@ -29,21 +29,24 @@ def _box(name, description, gap, *, width=2.0, height=2.0, n=4, nz=4, poisson_ra
 
 
 @register_scene("thin-3d", "hard: a 50:1 plate pressed by a paraboloid (thin body, flat "
-                           "elements)")
+                           "elements)",
+                tags=("hard", "3d"), dim=3)
 def thin_3d() -> Scene:
     return _box("thin-3d", "plate (-1,1)^2 x (-0.02,0.02), g = r^2 - 0.01",
                 lambda x: x[0] ** 2 + x[1] ** 2 - 0.01, height=0.04, n=8, nz=1)
 
 
 @register_scene("incompressible-3d", "hard: paper-3d's ball on a nearly incompressible body "
-                                     "(nu = 0.4999; P1 locking)")
+                                     "(nu = 0.4999; P1 locking)",
+                tags=("hard", "3d"), dim=3)
 def incompressible_3d(poisson_ratio: float = 0.4999) -> Scene:
     return _box("incompressible-3d", f"paper-3d geometry, nu = {poisson_ratio}", ball_gap,
                 poisson_ratio=poisson_ratio, parameters={"poisson_ratio": poisson_ratio})
 
 
 @register_scene("grazing-3d", "hard: a block hanging under its weight (nu = 0) just touching a "
-                              "flat obstacle: u_n = g and p = 0 on all of Gamma_C")
+                              "flat obstacle: u_n = g and p = 0 on all of Gamma_C",
+                tags=("hard", "3d"), dim=3)
 def grazing_3d(density: float = 1000.0) -> Scene:
     """The 2D ``grazing`` scene's one-dimensional solution holds in 3D too (nu = 0,
     traction-free sides): sigma_zz = rho (z + 1), u_z = rho ((z + 1)^2 - 4) / (2 E), the bottom

@@ -17,9 +17,9 @@ which is why the comparison is made at the computed force P.
 from __future__ import annotations
 
 import numpy as np
-from skfem import MeshTri
 
 from scenes.base import ContactPrediction, Material, Scene, SceneError, is_integer
+from scenes.budget import tensor_mesh
 from scenes.corners import Corner
 from scenes.registry import register_scene
 
@@ -44,7 +44,8 @@ def hertz_contact(young_modulus: float, poisson_ratio: float, radius: float,
 
 
 @register_scene("hertz", "Hertz line contact: a block pressed by a rigid parabola of radius R "
-                         "(half-space model), plane strain; closed-form width and peak pressure")
+                         "(half-space model), plane strain; closed-form width and peak pressure",
+                tags=("exact", "hertz"), dim=2)
 def hertz(young_modulus: float = 1000.0, poisson_ratio: float = 0.3, radius: float = 1.0,
           approach: float = 0.005, half_size: float = 2.0, initial_divisions: int = 16) -> Scene:
     if not (is_integer(initial_divisions) and initial_divisions >= 2
@@ -57,7 +58,7 @@ def hertz(young_modulus: float = 1000.0, poisson_ratio: float = 0.3, radius: flo
     return Scene(
         name="hertz",
         description="block (-W,W)x(-D,0) pressed up by the parabola y = x^2/(2R) - delta - D",
-        mesh=MeshTri.init_tensor(xs, ys), material=Material(young_modulus, poisson_ratio,
+        mesh=tensor_mesh(xs, ys), material=Material(young_modulus, poisson_ratio,
                                                             "strain"),
         is_dirichlet=lambda x: np.abs(x[1]) < _TOL,
         is_contact=lambda x: np.abs(x[1] + D) < _TOL,

@@ -15,9 +15,9 @@ half-space assumption's own cost is measured in the README's 3D section.
 from __future__ import annotations
 
 import numpy as np
-from skfem import MeshTet
 
 from scenes.base import ContactPrediction, Material, Scene, SceneError, is_integer
+from scenes.budget import tensor_mesh
 from scenes.registry import register_scene
 
 _TOL = 1e-10
@@ -34,7 +34,8 @@ def hertz_sphere(young_modulus: float, poisson_ratio: float, radius: float,
 
 
 @register_scene("hertz-3d", "Hertz contact of a sphere: a block pressed by a rigid paraboloid "
-                            "of radius R (half-space model); closed-form radius and peak pressure")
+                            "of radius R (half-space model); closed-form radius and peak pressure",
+                tags=("exact", "hertz", "3d"), dim=3)
 def hertz_3d(young_modulus: float = 1000.0, poisson_ratio: float = 0.3, radius: float = 1.0,
              approach: float = 0.02, half_size: float = 2.0, initial_divisions: int = 8) -> Scene:
     if not (is_integer(initial_divisions) and initial_divisions >= 2
@@ -46,7 +47,7 @@ def hertz_3d(young_modulus: float = 1000.0, poisson_ratio: float = 0.3, radius: 
     return Scene(
         name="hertz-3d",
         description="block (-W,W)^2x(-D,0) pressed up by the paraboloid z = r^2/(2R) - delta - D",
-        mesh=MeshTet.init_tensor(xs, xs, zs),
+        mesh=tensor_mesh(xs, xs, zs),
         material=Material(young_modulus, poisson_ratio, "strain"),
         is_dirichlet=lambda x: np.abs(x[2]) < _TOL,
         is_contact=lambda x: np.abs(x[2] + D) < _TOL,

@@ -7,6 +7,7 @@ new facet midpoints on the segments of the initial mesh, so the predicate holds 
 
 from __future__ import annotations
 
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -25,30 +26,59 @@ class MeshFile:
     groups: dict[str, np.ndarray]
 
 
+READ_CELLS = ("triangle", "line", "vertex")  # the body, its boundary groups, named points
+
+
 def read_mesh_file(path: str | Path, where: str = "mesh") -> MeshFile:
-    """Triangles and named line groups of ``path``; SceneError (one line) when the file does not
-    read, holds no triangles, or its line groups carry no names."""
+    """Triangles and named line groups of ``path``, read exactly or refused: SceneError (one
+    line) when the file does not read, holds no triangles or cells of another type, is not
+    flat in the x-y plane, has a degenerate triangle or boundary lines off the body, or its
+    line groups carry no names. Clockwise triangles are turned counter-clockwise; nodes of no
+    cell at all are left out with a note on standard error."""
     import meshio  # only scenes from files need it
 
+    flag = f"{where}={str(path)!r}"
     try:
         data = meshio.read(path)
     except Exception as error:  # meshio raises many types; the user needs the file and reason
-        raise SceneError(f"{where}={str(path)!r} does not read as a mesh: "
-                         f"{type(error).__name__}: {error}") from None
-    triangles = [block.data for block in data.cells if block.type == "triangle"]
-    if not triangles:
-        raise SceneError(f"{where}={str(path)!r} holds no triangles (2D meshes of 3-node "
-                         "triangles are read)")
-    t = np.concatenate(triangles)
+        raise SceneError(f"{flag} does not read as a mesh: {type(error).__name__}: "
+                         f"{error}") from None
+    _check_cells(data, flag)
+    points = np.asarray(data.points, dtype=float)
+    if points.shape[1] == 3 and np.any(points[:, 2] != points[0, 2]):
+        raise SceneError(f"{flag} is not a 2D mesh: its z coordinates range over "
+                         f"[{points[:, 2].min():g}, {points[:, 2].max():g}] (a flat mesh in a "
+                         "plane z = const is read)")
+    t = np.concatenate([block.data for block in data.cells if block.type == "triangle"])
     used, t = np.unique(t, return_inverse=True)
-    t = t.reshape(-1, 3)
-    p = np.asarray(data.points, dtype=float)[used, :2]
-    return MeshFile(_counter_clockwise(p, t), _line_groups(data, path, where))
+    others = np.concatenate([np.ravel(b.data) for b in data.cells if b.type != "triangle"]
+                            or [np.zeros(0, dtype=int)])
+    if np.setdiff1d(others, used).size:
+        raise SceneError(f"{flag} has boundary lines or points on nodes of no triangle; "
+                         "every named curve must lie on the body's edges")
+    if used.size < len(points):
+        print(f"note: {flag}: {len(points) - used.size} nodes belong to no cell and are left "
+              "out", file=sys.stderr)
+    mesh = _counter_clockwise(points[used, :2], t.reshape(-1, 3), flag)
+    return MeshFile(mesh, _line_groups(data, path, where))
 
 
-def _counter_clockwise(p: np.ndarray, t: np.ndarray) -> MeshTri:
+def _check_cells(data, flag: str) -> None:
+    if not any(block.type == "triangle" for block in data.cells):
+        raise SceneError(f"{flag} holds no triangles (2D meshes of 3-node triangles are read)")
+    other = sorted({block.type for block in data.cells} - set(READ_CELLS))
+    if other:
+        raise SceneError(f"{flag} holds cells of type {', '.join(other)}; only 3-node "
+                         f"triangles are read (with lines and points for the named groups)")
+
+
+def _counter_clockwise(p: np.ndarray, t: np.ndarray, flag: str) -> MeshTri:
     a, b, c = p[t[:, 0]], p[t[:, 1]], p[t[:, 2]]
     area = (b - a)[:, 0] * (c - a)[:, 1] - (b - a)[:, 1] * (c - a)[:, 0]
+    scale = np.ptp(p, axis=0).prod()
+    if np.any(np.abs(area) <= 1e-12 * scale):  # relative to the body's bounding box
+        raise SceneError(f"{flag} has {int(np.sum(np.abs(area) <= 1e-12 * scale))} degenerate "
+                         "triangles (zero area)")
     t = np.where((area < 0)[:, None], t[:, [0, 2, 1]], t)
     return MeshTri(p.T.copy(), t.T.copy())
 

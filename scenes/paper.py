@@ -8,9 +8,9 @@ y = sqrt(1 - x^2) - 1.85 gives the linearised gap g(x) = 0.85 - sqrt(1 - x^2) al
 from __future__ import annotations
 
 import numpy as np
-from skfem import MeshTri
 
 from scenes.base import Material, Scene, SceneError, is_integer
+from scenes.budget import tensor_mesh
 from scenes.corners import Corner
 from scenes.registry import register_scene
 
@@ -23,13 +23,14 @@ def paper_gap(x: np.ndarray) -> np.ndarray:
 
 
 @register_scene("paper", "Schroeder's square pressed up by a circular obstacle "
-                         "(seed paper, section 5)")
+                         "(seed paper, section 5)",
+                tags=("paper",), dim=2)
 def paper(young_modulus: float = 70000.0, poisson_ratio: float = 0.33, plane: str = "stress",
           initial_divisions: int = 4) -> Scene:
     if not (is_integer(initial_divisions) and initial_divisions >= 2):
         raise SceneError(f"initial_divisions={initial_divisions!r} is not an integer >= 2")
     grid = np.linspace(-1.0, 1.0, int(initial_divisions) + 1)
-    mesh = MeshTri.init_tensor(grid, grid)
+    mesh = tensor_mesh(grid, grid)
     return Scene(
         name="paper",
         description="Omega=(-1,1)^2 clamped on top, pressed up by the obstacle "

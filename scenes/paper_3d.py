@@ -9,9 +9,9 @@ linearised gap g(x, y) = 0.85 - sqrt(1 - r^2) along n = (0, 0, -1), r^2 = x^2 + 
 from __future__ import annotations
 
 import numpy as np
-from skfem import MeshTet
 
 from scenes.base import Material, Scene, SceneError, is_integer
+from scenes.budget import tensor_mesh
 from scenes.registry import register_scene
 
 _TOL = 1e-10
@@ -23,7 +23,8 @@ def ball_gap(x: np.ndarray) -> np.ndarray:
 
 
 @register_scene("paper-3d", "the seed paper's scene in 3D: the cube (-1,1)^3 clamped on top, "
-                            "pressed up by a ball")
+                            "pressed up by a ball",
+                tags=("paper", "3d"), dim=3)
 def paper_3d(young_modulus: float = 70000.0, poisson_ratio: float = 0.33,
              initial_divisions: int = 4) -> Scene:
     if not (is_integer(initial_divisions) and initial_divisions >= 2):
@@ -33,7 +34,7 @@ def paper_3d(young_modulus: float = 70000.0, poisson_ratio: float = 0.33,
         name="paper-3d",
         description="Omega=(-1,1)^3 clamped on top, pressed up by the ball of radius 1 centred "
                     "at (0, 0, -1.85)",
-        mesh=MeshTet.init_tensor(grid, grid, grid),
+        mesh=tensor_mesh(grid, grid, grid),
         material=Material(young_modulus, poisson_ratio, "strain"),
         is_dirichlet=lambda x: np.abs(x[2] - 1.0) < _TOL,
         is_contact=lambda x: np.abs(x[2] + 1.0) < _TOL,

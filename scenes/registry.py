@@ -8,7 +8,10 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
+from dataclasses import dataclass
 from typing import Any
+
+from scenes.base import SceneError
 
 BUILT_IN = "built-in"
 _ORIGINS = [BUILT_IN]  # where registrations come from now (a stack: files, plugins)
@@ -32,59 +35,102 @@ def unregister_origin(origin: str) -> None:
             registry.unregister(name)
 
 
+def broken_units() -> list[tuple[str, Broken]]:
+    """Every unit left out because it failed to load or build: (kind, Broken)."""
+    return [(registry.kind, broken) for registry in REGISTRIES for broken in registry.broken()]
+
+
+@dataclass(frozen=True)
+class Entry:
+    """One registration: the object, its one line of description, where it came from, the
+    optional ``applies(**context)`` check and what is known of it without building it
+    (``tags``, ``dim``: None when the registration does not say)."""
+
+    item: Any
+    description: str
+    origin: str
+    applies: Callable[..., str | None] | None = None
+    tags: tuple[str, ...] = ()
+    dim: int | None = None
+
+
+@dataclass(frozen=True)
+class Broken:
+    """A unit, file or plugin that failed to load or build: named once, left out."""
+
+    name: str
+    origin: str
+    reason: str
+
+
 class Registry:
-    """Name -> object with one line of description and its origin (``built-in``, a scene file,
-    a plugin); unknown names list the valid ones."""
+    """Name -> ``Entry`` (the object, one line of description, its origin ``built-in``, a scene
+    file or a plugin, and its metadata); unknown names list the valid ones, and broken ones
+    say why they are broken."""
 
     def __init__(self, kind: str):
         self.kind = kind
-        self._items: dict[str, tuple[Any, str]] = {}
-        self._applies: dict[str, Callable[..., str | None]] = {}
-        self._origins: dict[str, str] = {}
+        self._entries: dict[str, Entry] = {}
+        self._broken: dict[str, Broken] = {}
         REGISTRIES.append(self)
 
     def register(self, name: str, description: str,
-                 applies: Callable[..., str | None] | None = None) -> Callable[[Any], Any]:
+                 applies: Callable[..., str | None] | None = None, *,
+                 tags: tuple[str, ...] = (), dim: int | None = None) -> Callable[[Any], Any]:
         """``applies(**context)`` (optional) returns why ``name`` cannot be combined with the
-        context (e.g. scene=..., formulation=...), or None when it can."""
+        context (e.g. scene=..., formulation=...), or None when it can; ``tags`` and ``dim``
+        are what a command may know of the unit without building it."""
         def decorate(item: Any) -> Any:
-            if name in self._items:
+            if name in self._entries:
                 raise ValueError(f"{self.kind} {name!r} is already registered")
-            self._items[name] = (item, description)
-            self._origins[name] = _ORIGINS[-1]
-            if applies is not None:
-                self._applies[name] = applies
+            self._entries[name] = Entry(item, description, _ORIGINS[-1], applies,
+                                        tuple(tags), dim)
+            self._broken.pop(name, None)
             return item
 
         return decorate
 
     def unregister(self, name: str) -> None:
-        self._items.pop(name, None)
-        self._applies.pop(name, None)
-        self._origins.pop(name, None)
+        self._entries.pop(name, None)
+        self._broken.pop(name, None)
+
+    def mark_broken(self, name: str, reason: str, origin: str | None = None) -> None:
+        """Leave ``name`` out (unregistered if it was) and remember why, for ``list`` and for
+        the error of a command that asks for it."""
+        entry = self._entries.pop(name, None)
+        where = origin or (entry.origin if entry is not None else _ORIGINS[-1])
+        self._broken[name] = Broken(name, where, reason)
+
+    def broken(self) -> list[Broken]:
+        return [self._broken[name] for name in sorted(self._broken)]
+
+    def entry(self, name: str) -> Entry:
+        self.get(name)
+        return self._entries[name]
 
     def origin(self, name: str) -> str:
         """Where ``name`` was registered: ``built-in``, ``file PATH`` or ``plugin DIST``."""
-        self.get(name)
-        return self._origins[name]
+        return self.entry(name).origin
 
     def why_not(self, name: str, **context) -> str | None:
         """The reason ``name`` does not apply to ``context``, or None."""
-        self.get(name)
-        check = self._applies.get(name)
+        check = self.entry(name).applies
         return check(**context) if check is not None else None
 
     def names(self) -> list[str]:
-        return sorted(self._items)
+        return sorted(self._entries)
 
     def descriptions(self) -> dict[str, str]:
-        return {name: self._items[name][1] for name in self.names()}
+        return {name: self._entries[name].description for name in self.names()}
 
     def get(self, name: str) -> Any:
-        if name not in self._items:
+        if name in self._broken:
+            broken = self._broken[name]
+            raise KeyError(f"{self.kind} {name!r} is broken ({broken.origin}): {broken.reason}")
+        if name not in self._entries:
             raise KeyError(f"unknown {self.kind} {name!r}; valid {self.kind}s: "
                            f"{', '.join(self.names())}")
-        return self._items[name][0]
+        return self._entries[name].item
 
 
 SCENES = Registry("scene")
@@ -94,5 +140,26 @@ scene_descriptions = SCENES.descriptions
 
 
 def get_scene(name: str, **parameters):
-    """Build the scene ``name`` from its factory with the given parameters."""
-    return SCENES.get(name)(**parameters)
+    """Build the scene ``name`` from its factory with the given parameters; a scene whose
+    registration declares its dimension or tags must build with them (SceneError)."""
+    scene = SCENES.get(name)(**parameters)
+    entry = SCENES.entry(name)
+    declared = getattr(scene, "dim", entry.dim)
+    if entry.dim is not None and declared != entry.dim:
+        raise SceneError(f"scene {name!r} is registered with dim={entry.dim} but builds a "
+                         f"{declared}D mesh")
+    missing = set(entry.tags) - set(getattr(scene, "tags", entry.tags))
+    if missing:
+        raise SceneError(f"scene {name!r} is registered with tags {sorted(entry.tags)} but "
+                         f"builds one without {sorted(missing)}")
+    return scene
+
+
+def scene_tags(name: str) -> tuple[str, ...]:
+    """The tags a scene's registration declares (nothing is built)."""
+    return SCENES.entry(name).tags
+
+
+def scene_dim(name: str) -> int | None:
+    """The dimension a scene's registration declares, None if it does not (nothing built)."""
+    return SCENES.entry(name).dim

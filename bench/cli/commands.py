@@ -13,7 +13,7 @@ import pandas as pd
 
 from bench.cli.compare_block import check_readme, write_compare_block
 from bench.cli.diff import diff_command
-from bench.cli.guards import InputError, check_output_folders
+from bench.cli.guards import InputError, check_compare_out, check_output_folders
 from bench.cli.parser import build_parser
 from bench.cli.progress import Progress
 from bench.cli.study import study_command
@@ -30,7 +30,7 @@ from bench.hard.registry import HARD_CASES
 from bench.matrix import RunConfig, run
 from bench.matrix.plugins import FAILURES, load_plugins
 from bench.matrix.run import RunRefused, compare_reference_dofs
-from bench.matrix.scene_files import load_scene_files, scene_files_in
+from bench.matrix.scene_files import FILE_FAILURES, load_scene_files, scene_files_in
 from bench.matrix.store import ResultsError, read_results
 from bench.perf.scaling import SIZES, run_scaling, write_scaling
 from bench.perf.scaling_3d import SIZES_3D, run_scaling_3d, write_scaling_3d
@@ -48,7 +48,7 @@ from formulations.solvers.backends import check_backend
 from formulations.solvers.backends.base import REGISTRY as BACKENDS
 from formulations.solvers.registry import FAST_SOLVER, SOLVERS, SYSTEM_SOLVERS
 from scenes import get_scene, scene_descriptions, scene_names
-from scenes.registry import BUILT_IN, SCENES
+from scenes.registry import BUILT_IN, SCENES, broken_units, scene_dim
 
 SUMMARY_COLUMNS = ["level", "ndofs", "energy", "contact_force", "active_constraints", "eta",
                    "eta_0", "eta_geometric", "eta_complementarity", "energy_error",
@@ -81,6 +81,11 @@ def list_command(args) -> int:
     for failure in FAILURES:
         print(f"plugin {failure.distribution!r} skipped (entry point {failure.name!r} in "
               f"{failure.group}): {failure.reason}")
+    for broken in FILE_FAILURES.values():
+        print(f"scene file {broken.name!r} broken, left out: {broken.reason}")
+    for kind, broken in broken_units():
+        if broken.origin not in {f"file {f.name}" for f in FILE_FAILURES.values()}:
+            print(f"{kind} {broken.name!r} broken, left out ({broken.origin}): {broken.reason}")
     return 0
 
 
@@ -141,13 +146,35 @@ def hard_command(args) -> int:
     return 1 if wrong else 0
 
 
+def compared_scenes(dim: int) -> list[str]:
+    """The scenes of ``compare``: every scene not tagged hard of dimension ``dim``. A scene
+    whose registration does not declare its dimension is built to learn it; one that fails
+    to build is named once on stderr and left out."""
+    names = []
+    for name in scene_names():
+        if name in hard_scene_names():
+            continue
+        known = scene_dim(name)
+        if known is None:
+            try:
+                known = get_scene(name).dim
+            except Exception as error:  # a user's scene: name it, leave it out, go on
+                SCENES.mark_broken(name, f"{type(error).__name__}: {error}")
+                print(f"warning: scene {name!r} fails to build and is left out: "
+                      f"{type(error).__name__}: {error}", file=sys.stderr)
+                continue
+        if known == dim:
+            names.append(name)
+    return names
+
+
 def compare_command(args) -> int:
     """The default comparison: every scene not tagged hard x every formulation x every
     estimator x {uniform, adaptive} with the active-set solver, then the hard cases into the
     same folder, then the report."""
+    check_compare_out(args.out, args.overwrite)
     config = configured(
-        scenes=[n for n in scene_names() if n not in hard_scene_names()
-                and get_scene(n).dim == args.dim],
+        scenes=compared_scenes(args.dim),
         formulations=formulation_names(), solvers=(FAST_SOLVER,),
         estimators=estimator_names(), strategies=("uniform", "adaptive"),
         max_dofs=args.max_dofs,
@@ -278,8 +305,8 @@ def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     load_plugins()  # before the parser too: its lists include the plugins' units
     try:  # before the parser: its lists of valid scenes include the files' scenes
-        load_scene_files(scene_files_in(argv))
-    except ValueError as error:
+        load_scene_files(scene_files_in(argv))  # a file that fails is named and left out
+    except ValueError as error:  # a path that is not a scene file
         print(f"error: {error}", file=sys.stderr)
         return 2
     args = build_parser().parse_args(argv)

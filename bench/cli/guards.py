@@ -3,6 +3,7 @@ instead of a traceback for what a user can get wrong."""
 
 from __future__ import annotations
 
+import json
 import tempfile
 from pathlib import Path
 
@@ -41,3 +42,25 @@ def check_output_folders(command: str, args) -> None:
     for option in OUTPUT_OPTIONS.get(command, ()):
         check_output_folder(getattr(args, option), option)
 
+
+
+def written_by(folder: Path, command: str) -> bool:
+    """Whether every run recorded in ``folder/run.json`` was ``python -m bench COMMAND``."""
+    try:
+        record = json.loads((folder / "run.json").read_text())
+        runs = [record, *record.get("earlier", [])]
+        return all(str(r.get("command", "")).split()[3:4] == [command] for r in runs)
+    except (OSError, ValueError, AttributeError, TypeError):
+        return False
+
+
+def check_compare_out(out: str | Path, overwrite: bool) -> None:
+    """``compare`` replaces the results of its folder: refuse a non-empty folder that it did
+    not write itself, unless ``--overwrite`` (InputError, before anything is touched)."""
+    folder = Path(out)
+    if overwrite or not folder.is_dir() or written_by(folder, "compare"):
+        return
+    if any(p.name != ".lock" for p in folder.iterdir()):
+        raise InputError(f"--out={str(out)!r} holds files that compare did not write (it "
+                         "replaces the results of its folder); give a new or empty folder, "
+                         "or --overwrite to replace them")

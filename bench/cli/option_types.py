@@ -13,10 +13,12 @@ from bench.perf.sequence import SEQUENCES
 from formulations.elasticity import ORDERS
 
 
-def name_list(kind: str, valid: list[str], plural: str | None = None, sweep: bool = False):
+def name_list(kind: str, valid: list[str], plural: str | None = None, sweep: bool = False,
+              broken: dict[str, str] | None = None):
     """A comma-separated list of names from ``valid`` (``kind``: what one name is); a name
     given twice is kept once, with a note on standard error. With ``sweep`` an item may carry
-    parameters, ``name:key=v1|v2:other=w`` (``bench.matrix.spec.parse_item``)."""
+    parameters, ``name:key=v1|v2:other=w`` (``bench.matrix.spec.parse_item``); ``broken``:
+    why a name that failed to load is left out, said when it is asked for."""
     def parse(text: str) -> list[str]:
         names = [name.strip() for name in text.split(",") if name.strip()]
         if sweep:
@@ -26,6 +28,10 @@ def name_list(kind: str, valid: list[str], plural: str | None = None, sweep: boo
                 except ValueError as error:
                     raise argparse.ArgumentTypeError(str(error)) from None
         unknown = [name for name in names if name.split(":")[0] not in valid]
+        left_out = [f"{kind} {name!r} is broken: {(broken or {})[name]}"
+                    for name in unknown if name in (broken or {})]
+        if left_out:
+            raise argparse.ArgumentTypeError("; ".join(left_out))
         if not names or unknown:
             raise argparse.ArgumentTypeError(
                 f"unknown {kind} {', '.join(map(repr, unknown)) or repr(text)}; "

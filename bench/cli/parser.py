@@ -30,6 +30,14 @@ from formulations.elasticity import ORDERS
 from formulations.solvers.backends import backend_names
 from formulations.solvers.registry import REFERENCE_SOLVER
 from scenes import scene_names
+from scenes.registry import SCENES
+
+COMPARE_OUT = "results-compare"  # compare's own folder: never the one run writes by default
+
+
+def broken_scenes() -> dict[str, str]:
+    """Why each scene that failed to load is left out (its origin and error)."""
+    return {b.name: f"{b.origin}: {b.reason}" for b in SCENES.broken()}
 
 
 def _scene_file_option(parser) -> None:
@@ -66,7 +74,8 @@ def _run_parser(sub) -> None:
                          "write results.parquet and results.csv",
                          description="Run every combination of the given comma-separated "
                          "lists and write one row per level to OUT/results.{parquet,csv}.")
-    run.add_argument("--scene", type=name_list("scene", scene_names(), sweep=True),
+    run.add_argument("--scene", type=name_list("scene", scene_names(), sweep=True,
+                                               broken=broken_scenes()),
                      default=["paper"],
                      help=f"scene(s), comma-separated; one of: {', '.join(scene_names())} "
                           "(default: paper); sweep parameters with name:key=v1|v2, e.g. "
@@ -218,7 +227,13 @@ def _compare_parser(sub) -> None:
     compare.add_argument("--dim", type=int, choices=(2, 3), default=2,
                          help="the scenes' dimension (default: 2); 3 runs the tetrahedral "
                               "scenes only, errors against exact solutions or P2 references")
-    compare.add_argument("--out", default="results", help="results folder (default: results)")
+    compare.add_argument("--out", default=COMPARE_OUT,
+                         help=f"results folder, its own: a non-empty folder that compare did "
+                              f"not write is refused without --overwrite (default: "
+                              f"{COMPARE_OUT})")
+    compare.add_argument("--overwrite", action="store_true",
+                         help="replace the results of a folder that compare did not write "
+                              "(kept until the new run has finished a sequence)")
     compare.add_argument("--reports", default="reports", help="report folder (default: reports)")
     compare.add_argument("--readme", default=None,
                          help="also replace the figures between the compare markers of this "

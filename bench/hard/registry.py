@@ -8,8 +8,8 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from scenes import get_scene, scene_descriptions, scene_names
-from scenes.registry import Registry
+from scenes import scene_descriptions, scene_names
+from scenes.registry import Registry, scene_tags
 
 HARD_CASES = Registry("hard case")
 hard_case = HARD_CASES.register
@@ -37,7 +37,8 @@ def case_figure(case: str, caption: str):
 
 
 def hard_scene_names() -> list[str]:
-    return [name for name in scene_names() if HARD_TAG in get_scene(name).tags]
+    """The scenes whose registration declares the ``hard`` tag (none is built to ask)."""
+    return [name for name in scene_names() if HARD_TAG in scene_tags(name)]
 
 
 def hard_case_names() -> list[str]:

@@ -8,6 +8,7 @@ from __future__ import annotations
 import os
 import re
 import shutil
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -96,8 +97,15 @@ def element_error_density(scene, sol, n_elements: int) -> np.ndarray:
 
 
 def load_artifact(path: str | Path) -> dict | None:
+    """The fields of an artifact; None if it is missing, or damaged (then named in one line on
+    standard error, and left out: nothing is drawn or exported from it)."""
     path = Path(path)
     if not path.exists():
         return None
-    with np.load(path) as data:
-        return {key: data[key] for key in data.files}
+    try:
+        with np.load(path) as data:
+            return {key: data[key] for key in data.files}
+    except Exception as error:  # a truncated zip, a bad header: numpy raises several types
+        print(f"warning: {path} is unreadable ({type(error).__name__}: {error}) and is left "
+              "out; delete it, or rerun its sequence to write it again", file=sys.stderr)
+        return None

@@ -13,6 +13,7 @@ from bench.matrix.store import ResultsError, read_results
 COMPARED = ("energy", "contact_force", "eta", "eta_0", "energy_error", "pressure_error",
             "effectivity_index")
 MESH = ("ndofs", "n_elements")  # a level's mesh is taken to agree when both do
+REQUIRED = ("sequence_key", "status", "level")
 IDENTITY = ("scene", "formulation", "estimator", "strategy", "order")
 
 
@@ -56,6 +57,10 @@ def diff_results(old_folder, new_folder) -> pd.DataFrame:
         table = read_results(folder)
         if table is None:
             raise ResultsError(f"results folder {str(folder)!r} has no results")
+        missing = [c for c in (*REQUIRED, *IDENTITY, *MESH) if c not in table.columns]
+        if missing:
+            raise ResultsError(f"results folder {str(folder)!r} is of another schema: no "
+                               f"column {', '.join(missing)}; rerun it with this version")
         tables.append(table[(table["status"] == "ok") & (table["level"] >= 0)])
     old, new = tables
     rows = []

@@ -8,8 +8,8 @@ cache, which must be shared storage for a remote cluster (``--cache``)."""
 
 from __future__ import annotations
 
+import asyncio
 import os
-import socket
 from dataclasses import replace
 from pathlib import Path
 from urllib.parse import urlsplit
@@ -48,17 +48,33 @@ def scheduler_endpoint(address: str) -> tuple[str, int]:
 
 
 def check_scheduler(address: str, timeout: float = SCHEDULER_TIMEOUT) -> None:
-    """Refuse (SchedulerError) an address where nothing accepts a connection within
-    ``timeout`` seconds, before any work starts."""
-    host, port = scheduler_endpoint(address)
+    """Refuse (SchedulerError) an address where no Dask scheduler completes a Dask handshake
+    (its ``identity``) within ``timeout`` seconds, before any work starts: a port that
+    accepts and never answers, or answers in another protocol, is refused too."""
+    scheduler_endpoint(address)
     try:
-        socket.create_connection((host, port), timeout=timeout).close()
-    except OSError as error:
-        reason = "timed out" if isinstance(error, TimeoutError) else (
-            error.strerror or type(error).__name__)
+        identity = asyncio.run(asyncio.wait_for(_identity(address, timeout), timeout))
+    except (OSError, TimeoutError, ValueError, TypeError) as error:
+        reason = "no answer" if isinstance(error, TimeoutError) \
+            else f"{type(error).__name__}: {error}"
         raise SchedulerError(f"scheduler={address!r}: no Dask scheduler answered ({reason}; "
                              f"waited at most {timeout:g} s); expected the address of a "
                              f"running scheduler, {EXPECTED_ADDRESS}") from None
+    if not isinstance(identity, dict) or identity.get("type") != "Scheduler":
+        kind = identity.get("type") if isinstance(identity, dict) else type(identity).__name__
+        raise SchedulerError(f"scheduler={address!r} answers as {kind!r}, not as a Dask "
+                             f"scheduler; expected {EXPECTED_ADDRESS}")
+
+
+async def _identity(address: str, timeout: float):
+    """The ``identity`` of the Dask server at ``address`` (a Dask handshake)."""
+    from distributed.core import rpc
+
+    server = rpc(address, timeout=timeout)
+    try:
+        return await server.identity()
+    finally:
+        await server.close_rpc()
 
 
 def sequence_task(spec: SequenceSpec, out: str, run: dict, cache: str | None,

@@ -9,9 +9,9 @@ group of what it registers::
 
 Importing the module registers its units with the public API (``register_formulation``, ...);
 they are then recorded with the origin ``plugin DIST`` (``python -m bench list`` shows it).
-A plugin that fails to import is named on stderr and skipped, whatever it registered before
-failing is undone, and the run goes on. Every process that builds scenes loads the plugins
-once (the driver, and each Dask task before its sequence).
+A plugin that fails to import (or calls ``sys.exit``) is named on stderr and skipped,
+whatever it registered before failing is undone, and the run goes on. Every process that
+builds scenes loads the plugins once (the driver, and each Dask task before its sequence).
 """
 
 from __future__ import annotations
@@ -57,7 +57,8 @@ def load_plugins(report=None) -> list[PluginFailure]:
             try:
                 with registering_as(origin):
                     point.load()
-            except Exception as error:  # a third party's code: name it, skip it, go on
+            except (Exception, SystemExit) as error:  # a third party's code, even sys.exit:
+                # name it, skip it, go on
                 unregister_origin(origin)
                 broken.add(distribution)
                 failure = PluginFailure(group, point.name, distribution,

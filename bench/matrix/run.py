@@ -13,6 +13,7 @@ import os
 import sys
 from collections.abc import Callable
 from dataclasses import dataclass, fields
+from pathlib import Path
 
 import pandas as pd
 
@@ -30,12 +31,13 @@ from bench.matrix.spec import (
     parse_item,
 )
 from bench.matrix.store import ResultStore
-from bench.sequence.loop import STRATEGIES, LevelResult, LoopConfig
+from bench.sequence.loop import STRATEGIES, LevelResult, LoopConfig, memory_refusal
 from bench.sequence.rows import COLUMNS, ResultRow
 from bench.truth import truth_for
+from bench.truth.cache import check_cache_folder
 from estimators import estimator_names, guaranteed_estimators
 from formulations import STATUS_FAILED, formulation_names, solver_names
-from formulations.elasticity import ORDERS, check_order
+from formulations.elasticity import ORDERS, check_order, count_free_dofs, why_no_element
 from formulations.solvers.backends import check_backend
 from formulations.solvers.registry import REFERENCE_SOLVER
 from scenes import scene_names
@@ -169,17 +171,37 @@ class RunRefused(ValueError):
     that cannot judge the runs (the message says which)."""
 
 
-def prepare_truths(specs: list[SequenceSpec], out, crosscheck: bool = False) -> dict:
+def prepare_truths(specs: list[SequenceSpec], crosscheck: bool = False,
+                   max_memory_gib: float | None = None) -> dict:
     """Every truth the specs need, built (or loaded) before any sequence runs, so that a bad
-    scene parameter or formulation option, or a reference that cannot judge the runs, is
-    refused first (RunRefused)."""
+    scene parameter or formulation option, a starting mesh over the budgets, or a reference
+    that cannot judge the runs, is refused first (RunRefused). Nothing is written."""
     try:
-        return _truths(specs, out, crosscheck)
+        return _truths(specs, crosscheck, max_memory_gib)
     except ValueError as error:  # SceneError, TruthError, unknown parameters
         raise RunRefused(str(error)) from None
 
 
-def _truths(specs: list[SequenceSpec], out, crosscheck: bool) -> dict:
+def check_level_zero(spec: SequenceSpec, scene, max_memory_gib: float | None) -> None:
+    """Refuse (ValueError) a sequence whose starting mesh is already over its DOF budget or
+    would not fit in memory: the budgets count from level 0."""
+    if why_no_element(spec.order, scene.dim) is not None:
+        return  # a skipped row, nothing is built
+    ndofs = count_free_dofs(scene, scene.mesh, spec.order)
+    where = f"scene {spec.scene!r}" + (f" ({spec.labels['scene_parameters']})"
+                                       if spec.scene_parameters else "")
+    if ndofs > spec.max_dofs:
+        raise ValueError(f"{where} starts with {ndofs:,} DOFs at P{spec.order}, over "
+                         f"max_dofs={spec.max_dofs:,}; give a coarser starting mesh or "
+                         f"max_dofs >= {ndofs:,}")
+    refusal = memory_refusal(0, ndofs, spec.solver, spec.loop_config(max_memory_gib),
+                             scene.dim)
+    if refusal is not None:
+        raise ValueError(f"{where}: {refusal}; give a coarser starting mesh or a larger "
+                         "max_memory_gib")
+
+
+def _truths(specs: list[SequenceSpec], crosscheck: bool, max_memory_gib) -> dict:
     judged = {}  # per truth: the largest budget and order it judges, and a spec to build it
     scenes, checked = {}, set()
     for spec in specs:
@@ -189,6 +211,7 @@ def _truths(specs: list[SequenceSpec], out, crosscheck: bool) -> dict:
             scenes[scene_key] = build_scene(spec)
         option_key = (scene_key, spec.formulation, spec.formulation_options, spec.order)
         if option_key not in checked:
+            check_level_zero(spec, scenes[scene_key], max_memory_gib)
             check_formulation_options(spec, scenes[scene_key])
             checked.add(option_key)
         dofs, order, first = judged.get(truth_name(spec), (0, 0, spec))
@@ -197,7 +220,6 @@ def _truths(specs: list[SequenceSpec], out, crosscheck: bool) -> dict:
     for name, (dofs, order, spec) in judged.items():
         truths[name] = truth_for(scenes[spec.scene, spec.scene_parameters],
                                  spec.reference_dofs, dofs, order, crosscheck)
-        write_truth_summary(out, name, truths[name])
         if truths[name] is None:
             print(f"note: scene {spec.scene!r} has no exact solution and no reference budget "
                   "was given, so its errors and effectivity indices are not measured (NaN); "
@@ -208,40 +230,80 @@ def _truths(specs: list[SequenceSpec], out, crosscheck: bool) -> dict:
     return truths
 
 
+def check_before_running(config: RunConfig, specs: list[SequenceSpec]) -> dict:
+    """Everything a run needs, checked before its folder is touched: the cache folder, the
+    scheduler, every scene, option and starting mesh, and the truths (RunRefused). The
+    truths, by name."""
+    try:
+        if config.cache is not None:
+            check_cache_folder(config.cache)
+        if config.scheduler:
+            check_scheduler(config.scheduler)
+    except (SchedulerError, ValueError) as error:
+        raise RunRefused(str(error)) from None
+    return prepare_truths(specs, config.reference_crosscheck, config.max_memory_gib)
+
+
 def run(config: RunConfig, on_level: Callable[[LevelResult], None] | None = None,
         on_sequence: Callable[[SequenceSpec, str], None] | None = None) -> RunResult:
     """Run every sequence of ``config`` into ``config.out``: sequences/ (a partition per
     sequence), results.{parquet,csv}, run.json, truth.json, artifacts/ and rates.{csv,md}.
-    Raises RunRefused before any sequence runs for a bad parameter or an untrustworthy
-    reference."""
+    Raises RunRefused, with the folder untouched, for a bad parameter, a starting mesh over
+    the budgets or an untrustworthy reference. With ``overwrite`` the earlier results are
+    deleted only once a sequence of this run has finished, and kept if it fails before."""
+    specs = config.specs()
+    truths = check_before_running(config, specs)
     if config.cache is not None:
         os.environ["SIGNORINI_BENCH_CACHE"] = str(config.cache)
     store = ResultStore(config.out, overwrite=config.overwrite)
-    specs = config.specs()
+    try:
+        rows, reused = _run_into(store, config, specs, truths, on_level, on_sequence)
+    except BaseException:  # a crash, Ctrl-C: the results moved aside come back
+        store.restore_previous()
+        raise
+    store.keep_new()
+    table = store.consolidate()
+    write_rates(table, store.out)  # every sequence in the folder, earlier runs' too
+    keys = {s.key for s in specs}
+    table = table[table["sequence_key"].isin(keys)].reindex(columns=COLUMNS)
+    return RunResult(rows, table.reset_index(drop=True), store, reused)
+
+
+def _run_into(store: ResultStore, config: RunConfig, specs, truths, on_level, on_sequence):
+    """The sequences of ``specs`` not finished in ``store`` yet: (rows, reused keys)."""
     finished = store.finished_keys()
     todo = [s for s in specs if s.key not in finished]
     reused = tuple(s.key for s in specs if s.key in finished)
     identity = new_run_identity()
-    if config.scheduler:
-        try:
-            check_scheduler(config.scheduler)
-        except SchedulerError as error:
-            raise RunRefused(str(error)) from None
-    # every spec, reused ones too: truth.json then describes the whole table
-    truths = prepare_truths(specs, store.out, config.reference_crosscheck)
-    (store.out / "run.json").write_text(json.dumps(
-        {"command": config.command, "configuration": config.record(),
-         "run_id": identity["run_id"], "reused": list(reused), "numerics": numerics()},
-        indent=1, default=str))
+    for name, truth in truths.items():  # truth.json then describes the whole table
+        write_truth_summary(store.out, name, truth)
+    write_run_record(store.out, config, identity["run_id"], reused)
+
+    def sequence_done(spec: SequenceSpec, end: str) -> None:
+        store.keep_new()  # a sequence of this run finished: the old results may go
+        if on_sequence is not None:
+            on_sequence(spec, end)
+
     if config.workers or config.scheduler:
         from bench.matrix.distributed import run_on_dask
 
-        rows = run_on_dask(todo, store, identity, config, on_sequence)
+        rows = run_on_dask(todo, store, identity, config, sequence_done)
     else:
         rows = run_specs(todo, store, identity, on_level, truths, config.max_memory_gib,
-                         on_sequence)
-    table = store.consolidate()
-    keys = {s.key for s in specs}
-    table = table[table["sequence_key"].isin(keys)].reindex(columns=COLUMNS)
-    write_rates(table, store.out)
-    return RunResult(rows, table.reset_index(drop=True), store, reused)
+                         sequence_done)
+    return rows, reused
+
+
+def write_run_record(out: Path, config: RunConfig, run_id: str, reused) -> None:
+    """run.json: this run's command, configuration and numerics, and under ``earlier`` those
+    of every earlier run into the same folder (so a folder of several runs says so)."""
+    path = Path(out) / "run.json"
+    earlier = []
+    try:
+        previous = json.loads(path.read_text())
+        earlier = previous.pop("earlier", []) + [previous]
+    except (OSError, ValueError, AttributeError):
+        pass  # none, or damaged: this run's record replaces it
+    record = {"command": config.command, "configuration": config.record(), "run_id": run_id,
+              "reused": list(reused), "numerics": numerics(), "earlier": earlier}
+    path.write_text(json.dumps(record, indent=1, default=str))

@@ -15,7 +15,8 @@ from bench.sequence.loop import LoopConfig
 from formulations import get_formulation
 from formulations.elasticity import why_no_element
 from formulations.registry import FORMULATIONS
-from scenes import get_scene
+from scenes import SceneError, get_scene
+from scenes.budget import vertex_budget
 from scenes.registry import SCENES
 
 SPEC_VERSION = 3  # bump when the rows of an unchanged spec would change (3: P3 references)
@@ -127,9 +128,16 @@ def check_parameters(kind: str, name: str, pairs, function) -> None:
 
 
 def build_scene(spec: SequenceSpec):
-    """The spec's scene, its parameters checked by name here and by value by the scene."""
+    """The spec's scene, its parameters checked by name here and by value by the scene, its
+    starting mesh within the spec's DOF budget (``scenes.budget``)."""
     check_parameters("scene", spec.scene, spec.scene_parameters, SCENES.get(spec.scene))
-    return get_scene(spec.scene, **dict(spec.scene_parameters))
+    try:
+        with vertex_budget(spec.max_dofs):
+            return get_scene(spec.scene, **dict(spec.scene_parameters))
+    except SceneError as error:
+        where = label(spec.scene_parameters)
+        raise SceneError(f"scene {spec.scene!r}{f' ({where})' if where else ''}: {error}") \
+            from None
 
 
 def check_formulation_options(spec: SequenceSpec, scene=None) -> None:

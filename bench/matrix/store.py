@@ -15,15 +15,19 @@ from __future__ import annotations
 import fcntl
 import hashlib
 import io
+import json
 import os
 import shutil
 import sys
+import time
 from contextlib import contextmanager
 from pathlib import Path
 
 import pandas as pd
 
 from bench.sequence.rows import COLUMNS, FINISHED, ResultRow, with_labels
+
+MANIFEST = "results.sha256"  # checksums of the partitions and tables at consolidation
 
 
 class ResultsError(ValueError):
@@ -59,19 +63,21 @@ def read_results(folder: str | Path) -> pd.DataFrame | None:
 
 
 def _rebuilt_if_stale(folder: Path) -> pd.DataFrame:
-    """The consolidated table of ``folder``'s partitions; the tables on disk are rewritten
-    from them if they are missing, unreadable or differ in their rows."""
+    """The consolidated table of ``folder``'s partitions. The tables on disk are trusted only
+    when the checksums recorded at their consolidation (``results.sha256``) still match every
+    partition and both tables; else both are rewritten from the partitions."""
     parquet, csv = folder / "results.parquet", folder / "results.csv"
     table = partition_table(folder / "sequences")
+    why = None
     try:
-        on_disk = read_snapshot(parquet)
-        csv_rows = len(pd.read_csv(csv, usecols=["sequence_key"]))
-        why = None if len(on_disk) == len(table) == csv_rows and \
-            set(on_disk["sequence_key"]) == set(table["sequence_key"]) else \
-            f"{parquet} or {csv.name} holds other rows than the partitions"
-    except Exception as error:  # missing or damaged: pyarrow and pandas raise several types
-        why = f"{parquet} or {csv.name} is missing or unreadable " \
-              f"({type(error).__name__}: {error})"
+        recorded = json.loads((folder / MANIFEST).read_text())
+        if recorded != checksums(folder):
+            why = f"{parquet.name} or {csv.name} holds other rows than the partitions"
+        else:
+            on_disk = read_snapshot(parquet)
+    except Exception as error:  # missing or damaged: json, pyarrow raise several types
+        why = f"{parquet} or {csv.name} (or its checksums {MANIFEST}) is missing or " \
+              f"unreadable ({type(error).__name__}: {error})"
     if why is None:
         return on_disk
     store = ResultStore(folder)
@@ -81,13 +87,58 @@ def _rebuilt_if_stale(folder: Path) -> pd.DataFrame:
     return table
 
 
+def checksums(folder: Path, tables: bool = True) -> dict[str, str]:
+    """SHA-256 of every partition and (``tables``) of both tables of ``folder`` ('' for a
+    missing file)."""
+    paths = sorted((folder / "sequences").glob("*.parquet"))
+    if tables:
+        paths += [folder / "results.parquet", folder / "results.csv"]
+    return {str(p.relative_to(folder)): hashlib.sha256(p.read_bytes()).hexdigest()
+            if p.exists() else "" for p in paths}
+
+
 def partition_table(partitions: Path) -> pd.DataFrame:
-    """Every row of the partitions ``partitions/*.parquet``, with every column."""
-    frames = [read_snapshot(path) for path in sorted(partitions.glob("*.parquet"))]
-    frames = [f for f in frames if len(f)]
+    """Every row of the partitions ``partitions/*.parquet``, with every column; a damaged
+    partition is restored from the folder's tables or set aside (``read_partition``)."""
+    frames = [read_partition(path) for path in sorted(partitions.glob("*.parquet"))]
+    frames = [f for f in frames if f is not None and len(f)]
     if not frames:
         return pd.DataFrame(columns=COLUMNS)
     return with_labels(pd.concat(frames, ignore_index=True).reindex(columns=COLUMNS))
+
+
+def read_partition(path: Path) -> pd.DataFrame | None:
+    """The rows of one partition. A damaged one is rewritten from the rows of its sequence in
+    the folder's tables when they hold them, else renamed ``*.damaged`` (its sequence is then
+    rerun by the next run); either way one line on standard error says so."""
+    try:
+        return read_snapshot(path)
+    except Exception as error:  # pyarrow raises several types for a damaged file
+        why = f"{path} is unreadable ({type(error).__name__}: {error})"
+    rows = _table_rows(path.parent.parent, path.stem)
+    if rows is not None and len(rows):
+        atomic_write(with_labels(rows.reindex(columns=COLUMNS)), path, "parquet")
+        print(f"note: {why}; restored its {len(rows)} rows from the folder's results table",
+              file=sys.stderr)
+        return read_snapshot(path)
+    damaged = path.with_name(path.name + ".damaged")
+    os.replace(path, damaged)
+    print(f"warning: {why}, and the folder's tables do not hold its rows; set aside as "
+          f"{damaged.name}: the next run reruns its sequence (delete the file when done)",
+          file=sys.stderr)
+    return None
+
+
+def _table_rows(folder: Path, key: str) -> pd.DataFrame | None:
+    """The rows of sequence ``key`` in ``folder``'s parquet table, else its CSV mirror."""
+    for path, read in ((folder / "results.parquet", read_snapshot),
+                       (folder / "results.csv", pd.read_csv)):
+        try:
+            table = read(path)
+            return table[table["sequence_key"].astype(str) == key]
+        except Exception:  # missing or damaged too: try the next, else nothing to restore
+            continue
+    return None
 
 
 def read_snapshot(path: Path) -> pd.DataFrame:
@@ -137,25 +188,73 @@ class SequenceWriter:
 
 
 class ResultStore:
+    """The store of one output folder. With ``overwrite`` the earlier results are moved aside
+    (``.previous-*``), not deleted: ``keep_new`` deletes them once the new run has finished a
+    sequence, ``restore_previous`` puts them back when it fails before that."""
+
+    PREVIOUS = ".previous-"  # prefix of the folder that holds results moved aside
+    MOVED = ("results.parquet", "results.csv", "rates.csv", "rates.md", "sequences")
+
     def __init__(self, out: str | Path, overwrite: bool = False):
         self.out = Path(out)
         self.out.mkdir(parents=True, exist_ok=True)
         self.csv, self.parquet = self.out / "results.csv", self.out / "results.parquet"
         self.partitions = self.out / "sequences"
+        self.previous: Path | None = None
         with folder_lock(self.out):
+            self._note_leftovers()
             if overwrite:
-                for path in (self.csv, self.parquet):
-                    path.unlink(missing_ok=True)
-                shutil.rmtree(self.partitions, ignore_errors=True)
+                self._move_aside()
             self.partitions.mkdir(exist_ok=True)
             self._adopt_tables()
         self.writers: dict[str, SequenceWriter] = {}
 
+    def _note_leftovers(self) -> None:
+        for folder in sorted(self.out.glob(f"{self.PREVIOUS}*")):
+            print(f"note: {folder} holds results that an earlier --overwrite run moved aside "
+                  "and did not finish replacing; move its files back into "
+                  f"{self.out} to keep them, or delete it", file=sys.stderr)
+
+    def _move_aside(self) -> None:
+        present = [name for name in self.MOVED if (self.out / name).exists()]
+        if not present:
+            return
+        self.previous = self.out / f"{self.PREVIOUS}{os.getpid()}-{time.time_ns()}"
+        self.previous.mkdir()
+        for name in present:
+            os.replace(self.out / name, self.previous / name)
+
+    def keep_new(self) -> None:
+        """The new run has finished a sequence: the results moved aside are deleted."""
+        if self.previous is not None:
+            shutil.rmtree(self.previous, ignore_errors=True)
+            self.previous = None
+
+    def restore_previous(self) -> None:
+        """The new run failed before finishing a sequence: the results moved aside come back
+        (the new run's own partitions, rows it finished, are kept beside them)."""
+        if self.previous is None:
+            return
+        with folder_lock(self.out):
+            self.partitions.mkdir(exist_ok=True)
+            for path in sorted(self.previous.glob("sequences/*.parquet")):
+                if not (self.partitions / path.name).exists():
+                    os.replace(path, self.partitions / path.name)
+            for name in ("rates.csv", "rates.md"):
+                if (self.previous / name).exists() and not (self.out / name).exists():
+                    os.replace(self.previous / name, self.out / name)
+            if not (self.previous / "sequences").exists():  # tables of an older version
+                self._adopt(read_results(self.previous))
+            shutil.rmtree(self.previous, ignore_errors=True)
+            self.previous = None
+        self.consolidate()
+
     def _adopt_tables(self) -> None:
         """Tables without partitions (an older version wrote them) become one partition."""
-        if any(self.partitions.glob("*.parquet")):
-            return
-        previous = read_results(self.out)
+        if not any(self.partitions.glob("*.parquet")):
+            self._adopt(read_results(self.out))
+
+    def _adopt(self, previous: pd.DataFrame | None) -> None:
         if previous is not None and len(previous):
             digest = hashlib.sha256(previous.to_csv().encode()).hexdigest()[:12]
             frame = with_labels(previous.reindex(columns=COLUMNS))
@@ -185,9 +284,17 @@ class ResultStore:
     def consolidate(self) -> pd.DataFrame:
         """results.parquet and results.csv from every partition (under the folder's lock)."""
         with folder_lock(self.out):
+            # partitions' checksums first: one that a worker replaces meanwhile then fails
+            # them, and the tables are rebuilt when next read (never trusted while stale)
+            before = checksums(self.out, tables=False)
             table = self.table().sort_values(["run_id"], kind="stable")
             atomic_write(table, self.parquet, "parquet")
             atomic_write(table, self.csv, "csv")
+            written = {**before, **{path.name: hashlib.sha256(path.read_bytes()).hexdigest()
+                                    for path in (self.parquet, self.csv)}}
+            manifest = self.out / f".{MANIFEST}.{os.getpid()}.tmp"
+            manifest.write_text(json.dumps(written, indent=1))
+            os.replace(manifest, self.out / MANIFEST)
         return table
 
     def finished_keys(self) -> set[str]:

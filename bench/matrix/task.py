@@ -3,6 +3,7 @@ why it ended. The same function runs in-process and on a Dask worker."""
 
 from __future__ import annotations
 
+import sys
 import traceback
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -97,8 +98,13 @@ def run_spec(spec: SequenceSpec, run: dict, out, truth_of: Callable[[Scene], obj
             publish_last_level(out, last.row)
         return end
     except Exception as error:  # recorded, never silent: the row carries type and message
-        record(whole_sequence_row(names, STATUS_FAILED, f"{type(error).__name__}: {error}"))
-        traceback.print_exc()
+        reason = f"{type(error).__name__}: {error}"
+        record(whole_sequence_row(names, STATUS_FAILED, reason))
+        if isinstance(error, ValueError):  # bad input (a SceneError...): its one line says it
+            print(f"error: {spec.scene}/{spec.formulation}/{spec.solver}/{spec.estimator}/"
+                  f"{spec.strategy}: {reason} (a failed row records it)", file=sys.stderr)
+        else:  # a fault of the code: its traceback is what finds it
+            traceback.print_exc()
         return STATUS_FAILED
 
 

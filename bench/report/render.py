@@ -146,7 +146,10 @@ def hard_verdicts(results: Path | None) -> str:
 def _load_scene_files(run_info: dict) -> None:
     """The run's scene files, so that its scenes get their pictures; a file that is gone or no
     longer loads only costs the picture (the section says so)."""
-    for file in run_info.get("configuration", {}).get("scene_files", []):
+    runs = [run_info, *run_info.get("earlier", [])]
+    files = dict.fromkeys(f for run in runs for f in run.get("configuration", {})
+                          .get("scene_files", []))
+    for file in files:
         try:
             load_scene_files([file])
         except ValueError as error:

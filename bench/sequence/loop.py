@@ -156,7 +156,12 @@ def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
     t_refine, previous = 0.0, None
     for level in range(config.max_levels):
         ndofs = count_free_dofs(scene, mesh, config.order)  # budgets: before any assembly
-        if level > 0 and ndofs > config.max_dofs:
+        if ndofs > config.max_dofs:  # the starting mesh counts too: a failed row says so
+            if level == 0:
+                yield LevelResult(ResultRow(
+                    **ident, level=0, ndofs=ndofs, n_elements=mesh.t.shape[1],
+                    status=STATUS_FAILED, reason=f"budget: the starting mesh has {ndofs} DOFs, "
+                    f"over max_dofs={config.max_dofs}"), None, None)
             return "budget"
         refusal = memory_refusal(level, ndofs, solver, config, scene.dim)
         if refusal is not None:

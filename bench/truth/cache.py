@@ -25,6 +25,26 @@ def cache_folder() -> Path:
     return Path(os.environ.get("SIGNORINI_BENCH_CACHE", ".cache/references"))
 
 
+def check_cache_folder(folder: str | Path) -> Path:
+    """The cache folder ``folder``, created if needed and proved writable; ValueError (one
+    line naming the value) for a file or a folder that cannot be written, before any
+    reference is built."""
+    flag = f"cache={str(folder)!r}"
+    path = Path(folder).expanduser()
+    if path.exists() and not path.is_dir():
+        raise ValueError(f"{flag} is a file, not a folder; give a folder for the cached "
+                         "references")
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+        probe = path / f".write-test-{os.getpid()}"
+        probe.write_bytes(b"")
+        probe.unlink()
+    except OSError as error:
+        raise ValueError(f"{flag} cannot be written: {error.strerror or type(error).__name__}"
+                         "; give a writable folder") from None
+    return path
+
+
 def _digest(path: Path) -> str:
     return hashlib.sha256(path.read_bytes()).hexdigest()
 

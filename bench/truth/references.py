@@ -207,6 +207,11 @@ def reference_levels(scene, max_dofs: int, recipe: Recipe):
         except FactorisationError as error:  # e.g. a dense block too large for the memory
             raise TruthError(f"reference for scene {scene.name!r}: a level beyond the last "
                              f"one built failed: {error}; lower --reference-dofs") from None
+        if result.solution is None and result.row.level == 0 and \
+                result.row.reason.startswith("budget"):
+            raise TruthError(f"reference_dofs={max_dofs} leaves the {scene.name!r} reference "
+                             f"not even one level (its starting mesh has {result.row.ndofs} "
+                             f"DOFs at P{recipe.order}); give a larger budget")
         if result.row.status != STATUS_OK:
             raise TruthError(f"reference for scene {scene.name!r}: level {result.row.level} "
                              f"failed: {result.row.reason}")

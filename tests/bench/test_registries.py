@@ -29,7 +29,8 @@ NEW_ESTIMATOR, NEW_CASE = "residual-copy", "constant-case"
 def registered():
     register_formulation(NEW_FORMULATION, "the mixed method with h/H = 1/4")(
         functools.partial(mixed.discretise, h_over_H=0.25))
-    register_scene(NEW_SCENE, "hard: a flat obstacle presses a square up by 0.01")(
+    register_scene(NEW_SCENE, "hard: a flat obstacle presses a square up by 0.01",
+                   tags=("hard",), dim=2)(
         lambda: replace(square_scene(lambda x: np.full(x.shape[1:], -0.01), name=NEW_SCENE),
                         tags=("hard",)))
     register_estimator(NEW_ESTIMATOR, "the residual estimator again")(residual.estimate)

@@ -35,15 +35,22 @@ def test_python_and_toml_scene_files_reach_the_dask_workers(tmp_path):
     assert sorted(r.ndofs for r in result.rows) == [72, 136, 272, 528]
 
 
-def test_a_broken_scene_file_is_refused_in_one_line(tmp_path, capsys):
+def test_a_broken_scene_file_is_named_once_and_left_out(tmp_path, capsys):
     broken = tmp_path / "broken.py"
     broken.write_text("raise RuntimeError('no such obstacle')\n")
-    assert main(["run", "--scene-file", str(broken), "--out", str(tmp_path / "r")]) == 2
-    err = capsys.readouterr().err
-    assert f"--scene-file={str(broken)!r} failed to import: RuntimeError: no such obstacle" \
-        in err and "Traceback" not in err
-    assert main(["run", "--scene-file", str(tmp_path / "missing.txt")]) == 2
+    assert main(["list", "--scene-file", str(broken)]) == 0
+    captured = capsys.readouterr()
+    assert captured.err.count(f"--scene-file={str(broken)!r} failed to load and is left out: "
+                              "RuntimeError: no such obstacle") == 1
+    assert "Traceback" not in captured.err
+    assert f"scene file {str(broken)!r} broken, left out" in captured.out
+    assert "  paper " in captured.out  # every other scene is still there
+    wrong = tmp_path / "scene.txt"
+    wrong.write_text("")
+    assert main(["run", "--scene-file", str(wrong)]) == 2
     assert "is not a Python file" in capsys.readouterr().err
+    assert main(["run", "--scene-file", str(tmp_path / "missing.py")]) == 2
+    assert "does not exist" in capsys.readouterr().err
 
 
 def test_a_changed_scene_file_changes_the_sequence_keys(tmp_path):
