@@ -22,18 +22,27 @@ from scenes.base import SceneError
 
 _LIMIT: ContextVar[tuple[int, str] | None] = ContextVar("vertex_budget", default=None)
 SLACK = 1000  # vertices allowed beyond the DOF budget: a mesh this small costs nothing
+# a scene file's scene is built once when the file loads, before any run's budget is known
+LOAD_VERTICES = 2_000_000
 
 
 @contextmanager
-def vertex_budget(max_dofs: int | None, option: str = "max_dofs") -> Iterator[None]:
-    """Inside the block a starting mesh may have at most ``max_dofs + SLACK`` vertices: every
-    vertex carries at least one free DOF per direction except on the clamped part, so a mesh
-    with more could never fit ``max_dofs`` (``option`` names the budget in the refusal)."""
-    token = _LIMIT.set(None if max_dofs is None else (int(max_dofs) + SLACK, option))
+def vertex_budget(max_vertices: int | None, budget: str) -> Iterator[None]:
+    """Inside the block a starting mesh may have at most ``max_vertices`` vertices (None: no
+    limit); ``budget`` names what sets it in the refusal, e.g. "max_dofs=300"."""
+    token = _LIMIT.set(None if max_vertices is None else (int(max_vertices), budget))
     try:
         yield
     finally:
         _LIMIT.reset(token)
+
+
+def dof_budget(max_dofs: int | None, option: str = "max_dofs"):
+    """``vertex_budget`` of a DOF budget: every vertex off the clamped part carries at least
+    one free DOF per direction, so a mesh of more than ``max_dofs + SLACK`` vertices could
+    never fit ``max_dofs``."""
+    return vertex_budget(None if max_dofs is None else int(max_dofs) + SLACK,
+                         f"{option}={max_dofs}")
 
 
 def check_vertex_count(vertices: int, what: str) -> None:
@@ -41,8 +50,8 @@ def check_vertex_count(vertices: int, what: str) -> None:
     limit = _LIMIT.get()
     if limit is not None and vertices > limit[0]:
         raise SceneError(f"the starting mesh ({what}) would have {vertices:,} vertices, more "
-                         f"than {limit[1]}={limit[0] - SLACK:,} DOFs allow (at most "
-                         f"{limit[0]:,}); give fewer divisions or a larger {limit[1]}")
+                         f"than {limit[1]} allows (at most {limit[0]:,}); give fewer "
+                         "divisions or a larger budget")
 
 
 def tensor_mesh(*grids: np.ndarray) -> Mesh:

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from scenes.base import Material, Scene, SceneError, is_integer, is_number
-from scenes.budget import tensor_mesh
+from scenes.budget import LOAD_VERTICES, tensor_mesh, vertex_budget
 from scenes.expressions import Expression, ExpressionError
 from scenes.mesh_file import on_segments, read_mesh_file
 from scenes.registry import register_scene
@@ -56,7 +56,8 @@ def register_toml_scene(path: str | Path) -> str:
         return _scene(path, data, name, description, values, digest.hexdigest()[:16])
 
     factory.__signature__ = _signature(defaults)
-    scene = factory()  # refuse a bad file now, not at the first solve
+    with vertex_budget(LOAD_VERTICES, "a scene file's check on loading"):
+        scene = factory()  # refuse a bad file now, not at the first solve
     register_scene(name, description, tags=scene.tags, dim=scene.dim)(factory)
     return name
 

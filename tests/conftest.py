@@ -52,3 +52,31 @@ def free_scene():
     return square_scene(lambda x: np.full(x.shape[1:], 1.0), young_modulus=1000.0,
                         poisson_ratio=0.3,
                         body_force=lambda x: np.array([0.0 * x[0], -1.0 + 0.0 * x[0]]))
+
+
+@pytest.fixture(scope="session")
+def finished_run(tmp_path_factory):
+    """A results folder of two finished sequences (free-boundary, vi and mixed, active set, up
+    to 300 DOFs), made once; tests take copies (``results_copy``)."""
+    from bench.cli import main
+
+    out = tmp_path_factory.mktemp("finished") / "results"
+    assert main(["run", "--scene", "free-boundary", "--formulation", "vi,mixed", "--solver",
+                 "active-set", "--max-dofs", "300", "--out", str(out)]) == 0
+    return out
+
+
+@pytest.fixture
+def results_copy(finished_run, tmp_path):
+    """A private copy of ``finished_run``."""
+    import shutil
+
+    return shutil.copytree(finished_run, tmp_path / "results")
+
+
+def folder_bytes(folder) -> dict:
+    """Every file under ``folder`` (but its lock) by relative path, with its bytes."""
+    from pathlib import Path
+
+    return {str(p.relative_to(folder)): p.read_bytes() for p in sorted(Path(folder).rglob("*"))
+            if p.is_file() and p.name != ".lock"}

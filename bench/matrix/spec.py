@@ -16,7 +16,7 @@ from formulations import get_formulation
 from formulations.elasticity import why_no_element
 from formulations.registry import FORMULATIONS
 from scenes import SceneError, get_scene
-from scenes.budget import vertex_budget
+from scenes.budget import dof_budget
 from scenes.registry import SCENES
 
 SPEC_VERSION = 3  # bump when the rows of an unchanged spec would change (3: P3 references)
@@ -132,7 +132,7 @@ def build_scene(spec: SequenceSpec):
     starting mesh within the spec's DOF budget (``scenes.budget``)."""
     check_parameters("scene", spec.scene, spec.scene_parameters, SCENES.get(spec.scene))
     try:
-        with vertex_budget(spec.max_dofs):
+        with dof_budget(spec.max_dofs):
             return get_scene(spec.scene, **dict(spec.scene_parameters))
     except SceneError as error:
         where = label(spec.scene_parameters)
