@@ -8,15 +8,16 @@ y = depth - x^2 / 8 (gap g = y_body - y_obstacle = x^2 / 8 - depth along n = (0,
 """
 
 import numpy as np
-from skfem import MeshTri
 
 from scenes import register_scene
 from scenes.base import Material, Scene
+from scenes.budget import tensor_mesh
 
 
-@register_scene("wide-block", "example scene file: a 4 x 1 block pressed up by a parabolic bump")
+@register_scene("wide-block", "example scene file: a 4 x 1 block pressed up by a parabolic bump",
+                dim=2)
 def wide_block(young_modulus: float = 1000.0, depth: float = 0.01) -> Scene:
-    mesh = MeshTri.init_tensor(np.linspace(-2.0, 2.0, 17), np.linspace(0.0, 1.0, 5))
+    mesh = tensor_mesh(np.linspace(-2.0, 2.0, 17), np.linspace(0.0, 1.0, 5))
     return Scene(
         name="wide-block",
         description="4 x 1 block clamped on top, pressed up by the bump y = depth - x^2 / 8",
