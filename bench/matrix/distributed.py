@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import asyncio
 import os
+import socket
 from dataclasses import replace
 from pathlib import Path
 from urllib.parse import urlsplit
@@ -51,8 +52,9 @@ def check_scheduler(address: str, timeout: float = SCHEDULER_TIMEOUT) -> None:
     """Refuse (SchedulerError) an address where no Dask scheduler completes a Dask handshake
     (its ``identity``) within ``timeout`` seconds, before any work starts: a port that
     accepts and never answers, or answers in another protocol, is refused too."""
-    scheduler_endpoint(address)
-    try:
+    host, port = scheduler_endpoint(address)
+    try:  # a refused connection fails at once (Dask's own connect retries until the timeout)
+        socket.create_connection((host, port), timeout=timeout).close()
         identity = asyncio.run(asyncio.wait_for(_identity(address, timeout), timeout))
     except Exception as error:  # a peer speaking another protocol fails in many ways
         reason = "no answer" if isinstance(error, TimeoutError) \
