@@ -6,6 +6,7 @@ import pytest
 from bench.cli import main
 from bench.sequence.loop import LoopConfig, run_sequence
 from scenes import get_scene
+from scenes.registry import SCENES
 
 TOML_SCENE = """name = "huge-block"
 [geometry]
@@ -44,9 +45,11 @@ def test_a_toml_scene_with_a_huge_grid_is_left_out_when_it_loads(tmp_path, capsy
     assert "400,040,001 vertices" in capsys.readouterr().err
     path = tmp_path / "large.toml"
     path.write_text(TOML_SCENE.format(n=20).replace("huge-block", "large-block"))
-    # it loads, but starts over a small budget
-    assert main(["run", "--scene-file", str(path), "--scene", "large-block", "--max-dofs", "300",
-                 "--out", str(tmp_path / "r")]) == 2
+    try:  # it loads, but starts over a small budget
+        assert main(["run", "--scene-file", str(path), "--scene", "large-block", "--max-dofs",
+                     "300", "--out", str(tmp_path / "r")]) == 2
+    finally:
+        SCENES.unregister("large-block")
     assert "over max_dofs=300" in capsys.readouterr().err
 
 
