@@ -77,7 +77,7 @@ class QuadHierarchy:
         """The leaves as a scikit-fem mesh on the vertices they use (hanging nodes included;
         ``vertex_numbers`` maps its vertices back to the hierarchy's)."""
         used, local = self.leaf_vertices()
-        return MeshQuad(self.p[:, used], local)
+        return MeshQuad(np.ascontiguousarray(self.p[:, used]), np.ascontiguousarray(local))
 
     def leaf_vertices(self) -> tuple[np.ndarray, np.ndarray]:
         """The hierarchy's vertices the leaves use, and the leaves renumbered on them."""

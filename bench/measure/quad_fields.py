@@ -1,0 +1,48 @@
+"""The gradient of a Q1 or Q2 field on a quadrilateral mesh as a ``GradientField`` on triangles,
+so that its error against a reference on another mesh is measured by the same
+``energy_difference`` as every triangle field (docs/theory.md, section 15).
+
+Each cell is split along its diagonal v0-v2 into two triangles. On a parallelogram the bilinear
+map is affine, so the gradient of a Q_p field is, on each half, a polynomial of degree at most
+2p - 1 in x (Q1: linear; Q2: cubic): it is sampled at the lattice of that degree on the half
+and stored exactly, as ``GradientField.from_solution`` does for P_p. On a cell that is not a
+parallelogram the stored polynomial interpolates the gradient at the lattice points.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from skfem import Basis, MeshTri
+
+from bench.measure.fields import GradientField, Locator, _lattice, _powers
+
+# the halves of the reference square [0, 1]^2: corners (v0, v1, v2) and (v0, v2, v3)
+HALVES = (np.array([[0.0, 1.0, 1.0], [0.0, 0.0, 1.0]]),
+          np.array([[0.0, 1.0, 0.0], [0.0, 1.0, 1.0]]))
+
+
+def quad_gradient_field(basis: Basis, u: np.ndarray) -> GradientField:
+    """grad u of the cell-DOF vector ``u`` of a vector Q_p ``basis`` on triangles: triangle
+    2k is the half (v0, v1, v2) of cell k, triangle 2k + 1 the half (v0, v2, v3)."""
+    mesh = basis.mesh
+    degree = 2 * _order(basis) - 1
+    nodes = _lattice(degree, 2)  # (2, k) in the reference triangle
+    values = []
+    for half in HALVES:
+        square = half[:, :1] + (half[:, 1:2] - half[:, :1]) * nodes[0] \
+            + (half[:, 2:3] - half[:, :1]) * nodes[1]
+        sampled = Basis(mesh, basis.elem, quadrature=(square, np.full(square.shape[1], 1.0)))
+        values.append(sampled.interpolate(u).grad)  # (2, 2, nE, k)
+    grad = np.stack(values, axis=3).reshape(2, 2, -1, nodes.shape[1])  # cell-major halves
+    solve = np.linalg.inv(_powers(nodes, degree).T)
+    coefficients = np.einsum("mk,ijek->ijme", solve, grad)
+    t = mesh.t
+    triangles = np.stack([t[[0, 1, 2]], t[[0, 2, 3]]], axis=2).reshape(3, -1)
+    # unsorted: the coefficients are in the reference coordinates of this vertex order
+    halves = MeshTri(np.ascontiguousarray(mesh.p), triangles, sort_t=False)
+    return GradientField(Locator.from_mesh(halves), degree, coefficients)
+
+
+def _order(basis: Basis) -> int:
+    """p of a vector Q_p basis (its scalar element's degree in each variable)."""
+    return 1 if basis.elem.elem.facet_dofs == 0 else 2
