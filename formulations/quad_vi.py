@@ -43,16 +43,24 @@ class QuadContactSolution:
         return float(self.reactions.sum())
 
 
+def contact_edges(scene: Scene, elasticity: QuadElasticity):
+    """The leaf facets on Gamma_C, their end points a, b (2, n) and outer normals of length
+    |b - a| (2, n)."""
+    mesh = elasticity.basis.mesh
+    facets = boundary_facets_of(scene.is_contact, mesh, elasticity.boundary)
+    a, b = mesh.p[:, mesh.facets[0, facets]], mesh.p[:, mesh.facets[1, facets]]
+    normal = np.array([(b - a)[1], -(b - a)[0]])
+    inward = mesh.p[:, mesh.t[:, mesh.f2t[0, facets]]].mean(axis=1) - a
+    normal *= np.where((normal * inward).sum(axis=0) > 0, -1.0, 1.0)
+    return facets, a, b, normal
+
+
 def contact_rows(scene: Scene, elasticity: QuadElasticity) -> tuple[sparse.csr_matrix,
                                                                       np.ndarray]:
     """B (one row per contact node, over the cell DOFs) and the gap at the nodes. A node's
     normal is the length-weighted mean of its facets' outer normals."""
     basis, mesh = elasticity.basis, elasticity.basis.mesh
-    facets = boundary_facets_of(scene.is_contact, mesh, elasticity.boundary)
-    a, b = mesh.p[:, mesh.facets[0, facets]], mesh.p[:, mesh.facets[1, facets]]
-    normal = np.array([(b - a)[1], -(b - a)[0]])
-    inward = mesh.p[:, mesh.t[:, mesh.f2t[0, facets]]].mean(axis=1) - a
-    normal *= np.where((normal * inward).sum(axis=0) > 0, -1.0, 1.0)  # outward, length |ab|
+    facets, a, b, normal = contact_edges(scene, elasticity)
     vertices, rows = np.unique(mesh.facets[:, facets], return_inverse=True)
     vertex_normal = np.array([np.bincount(rows.ravel(), np.tile(c, 2), vertices.size)
                               for c in normal])

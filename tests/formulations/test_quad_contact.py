@@ -1,10 +1,12 @@
-"""The VI on quadrilaterals (Q1, Q2, hanging nodes included): a rigid flat pressing the body
-up is reproduced exactly, and the fast active-set solve agrees with Clarabel."""
+"""Contact on quadrilaterals (Q1, Q2, hanging nodes included), the VI and the seed's mixed
+method with lambda_H one and two levels coarser: a rigid flat pressing the body up is
+reproduced exactly, and the fast active-set solve agrees with Clarabel."""
 
 import numpy as np
 import pytest
 
 from conftest import square_scene
+from formulations.quad_mixed import coarse_edges, solve_quad_mixed
 from formulations.quad_vi import solve_quad_vi
 from scenes import get_scene
 from scenes.quad_hierarchy import QuadHierarchy
@@ -15,11 +17,17 @@ def hierarchy_with_hanging_nodes() -> QuadHierarchy:
         .refined([0, 5]).refined([1])
 
 
+SOLVES = {"vi": solve_quad_vi,
+          "mixed": solve_quad_mixed,
+          "mixed-two-up": lambda *a, **k: solve_quad_mixed(*a, levels_up=2, **k)}
+
+
+@pytest.mark.parametrize("method", SOLVES)
 @pytest.mark.parametrize("order", [1, 2])
-def test_a_flat_push_is_reproduced(compression_scene, order):
+def test_a_flat_push_is_reproduced(compression_scene, order, method):
     """u = (0, delta (1 - y) / 2), pressure E delta / 2 on all of Gamma_C (conftest): linear,
     so in Q1 and Q2; energy 1/2 (E delta^2 / 4) |Omega| = 0.05, force 10."""
-    solution = solve_quad_vi(compression_scene, hierarchy_with_hanging_nodes(), order)
+    solution = SOLVES[method](compression_scene, hierarchy_with_hanging_nodes(), order)
     assert solution.status == "ok"
     assert solution.energy == pytest.approx(0.05, rel=1e-12)  # round-off of a direct solve
     assert solution.contact_force == pytest.approx(10.0, rel=1e-12)
@@ -28,14 +36,15 @@ def test_a_flat_push_is_reproduced(compression_scene, order):
     assert np.allclose(uy, 0.005 * (1 - basis.mesh.p[1]), atol=1e-14)
 
 
+@pytest.mark.parametrize("method", SOLVES)
 @pytest.mark.parametrize("order", [1, 2])
-def test_the_fast_solve_agrees_with_the_reference_solver(order):
+def test_the_fast_solve_agrees_with_the_reference_solver(order, method):
     scene = get_scene("paper")
     hierarchy = QuadHierarchy.from_tensor(np.linspace(-1, 1, 9), np.linspace(-1, 1, 9))
     hierarchy = hierarchy.refined(np.arange(8))  # the bottom row: hanging nodes above it
     assert hierarchy.hanging()[0].size > 0
-    fast = solve_quad_vi(scene, hierarchy, order, "active-set")
-    judge = solve_quad_vi(scene, hierarchy, order, "reference")
+    fast = SOLVES[method](scene, hierarchy, order, solver="active-set")
+    judge = SOLVES[method](scene, hierarchy, order, solver="reference")
     # Clarabel's interior point stops at a relative gap of about 1e-8
     assert fast.energy == pytest.approx(judge.energy, rel=1e-7)
     assert fast.contact_force == pytest.approx(judge.contact_force, rel=1e-6)
@@ -51,3 +60,19 @@ def test_an_empty_contact_zone_is_a_free_solve(free_scene):
 def test_a_scene_without_contact_rows_is_not_confused_with_one(compression_scene):
     lifted = square_scene(lambda x: np.full(x.shape[1:], 1.0))
     assert solve_quad_vi(lifted, hierarchy_with_hanging_nodes(), 1).contact_force == 0.0
+
+
+def test_the_multiplier_mesh_is_a_coarser_level_of_the_hierarchy():
+    """On a uniform mesh of 8 x 8 leaves, the bottom edge's 8 leaf edges form 4 coarse edges
+    one level up (h/H = 1/2) and 2 two levels up (h/H = 1/4), each of consecutive edges."""
+    hierarchy = QuadHierarchy.from_tensor(np.linspace(-1, 1, 3), np.linspace(-1, 1, 3))
+    hierarchy = hierarchy.refined().refined()
+    mesh = hierarchy.mesh()
+    bottom = mesh.boundary_facets()[np.isclose(
+        mesh.p[1, mesh.facets[:, mesh.boundary_facets()]].mean(axis=0), -1.0)]
+    order = np.argsort(mesh.p[0, mesh.facets[:, bottom]].mean(axis=0))
+    normal = np.tile([[0.0], [-1.0]], bottom.size)
+    for up, size in ((1, 2), (2, 4)):
+        group = coarse_edges(hierarchy, mesh.f2t[0, bottom], normal, up)[order]
+        assert np.array_equal(group, np.repeat(group[::size], size))
+        assert np.unique(group).size == 8 // size

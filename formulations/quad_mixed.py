@@ -1,0 +1,82 @@
+"""The seed's mixed method on a quadrilateral hierarchy: Q1 or Q2 displacements, the contact
+pressure lambda_H >= 0 piecewise constant on the edges of a coarser level of the same
+hierarchy along Gamma_C (the seed's T_CH; docs/theory.md, sections 3 and 15).
+
+A coarse edge is the Gamma_C edge of a leaf's ancestor ``levels_up`` levels above it; it holds
+the leaf edges below it (two for one level up on a uniform mesh: h/H = 1/2; four for two).
+Row g of B is int_{E_g} u_h . n ds (Newton-Cotes on each leaf edge, exact for Q1 and Q2
+traces), G_g = int_{E_g} g ds (Gauss-Legendre). B' mu = sum_g mu_g int_{E_g} phi . n ds, so the
+multiplier of row g is lambda_H on E_g itself, and mu_g |E_g| the force on E_g.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy import sparse
+
+from formulations.base import ContactQP
+from formulations.contact import gauss_legendre
+from formulations.quad_elasticity import assemble_quad_elasticity
+from formulations.quad_vi import QuadContactSolution, contact_edges
+from formulations.solvers.registry import FAST_SOLVER, SOLVERS
+from scenes import Scene
+from scenes.quad_hierarchy import QuadHierarchy
+
+SIMPSON = np.array([1 / 6, 2 / 3, 1 / 6])  # int of the Q2 trace's nodal functions / |edge|
+
+
+def coarse_edges(hierarchy: QuadHierarchy, cells: np.ndarray, normal: np.ndarray,
+                 levels_up: int) -> np.ndarray:
+    """The coarse edge (a group number) of each leaf edge: its cell's ancestor ``levels_up``
+    levels above (a root has none above), and the side the edge faces."""
+    ancestor = hierarchy.leaves[cells]
+    for _ in range(levels_up):
+        ancestor = np.where(hierarchy.parent[ancestor] >= 0, hierarchy.parent[ancestor],
+                            ancestor)
+    side = np.argmax(np.abs(normal), axis=0) * 2 + (normal.max(axis=0) > -normal.min(axis=0))
+    return np.unique(ancestor * 4 + side, return_inverse=True)[1]
+
+
+def solve_quad_mixed(scene: Scene, hierarchy: QuadHierarchy, order: int = 1,
+                     levels_up: int = 1, solver: str = FAST_SOLVER,
+                     **options) -> QuadContactSolution:
+    """The mixed method with lambda_H on the coarse edges ``levels_up`` levels above the
+    leaves; the reactions of the solution are the forces lambda_H |E_g| on the coarse
+    edges."""
+    elasticity = assemble_quad_elasticity(scene, hierarchy, order)
+    basis, mesh = elasticity.basis, elasticity.basis.mesh
+    facets, a, b, normal = contact_edges(scene, elasticity)
+    group = coarse_edges(hierarchy, mesh.f2t[0, facets], normal, levels_up)
+    length = np.linalg.norm(b - a, axis=0)
+    unit = normal / length
+    weights = [np.full(2, 0.5)] if order == 1 else [SIMPSON[[0, 2]], SIMPSON[1:2]]
+    dofs = [mesh.facets[:, facets]] if order == 1 else [mesh.facets[:, facets],
+                                                        facets[None, :]]
+    rows, cols, values = [], [], []
+    for w, nodes, kind in zip(weights, dofs, ("nodal", "facet"), strict=False):
+        table = basis.nodal_dofs if kind == "nodal" else basis.facet_dofs
+        for k in range(nodes.shape[0]):
+            for c in range(2):
+                rows.append(group)
+                cols.append(table[c, nodes[k]])
+                values.append(w[k] * length * unit[c])
+    m = group.max() + 1
+    B = sparse.csr_matrix((np.concatenate(values), (np.concatenate(rows),
+                                                   np.concatenate(cols))), shape=(m, basis.N))
+    t, w = gauss_legendre(4)
+    points = a[:, :, None] + (b - a)[:, :, None] * t
+    G = np.bincount(group, (np.asarray(scene.gap(points)) * w).sum(axis=1) * length, m)
+    H = np.bincount(group, length, m)
+    free = elasticity.free
+    qp = ContactQP(K=elasticity.K[free][:, free].tocsr(), F=elasticity.F[free],
+                   B=(B @ elasticity.P)[:, free].tocsr(), G=G, row_scale=H,
+                   objective_scale=float(scene.material.young_modulus))
+    answer = SOLVERS.get(solver)(qp, **options)
+    if answer.u is None or answer.multipliers is None or not np.all(np.isfinite(answer.u)):
+        return QuadContactSolution(elasticity, np.full(basis.N, np.nan), np.full(m, np.nan),
+                                   float("nan"), "failed",
+                                   f"{answer.status}: {answer.reason or 'no solution'}")
+    energy = float(0.5 * answer.u @ (qp.K @ answer.u) - qp.F @ answer.u)
+    forces = np.maximum(answer.multipliers, 0.0) * H  # lambda_H |E_g|
+    return QuadContactSolution(elasticity, elasticity.expand(answer.u), forces, energy,
+                               answer.status, answer.reason)
