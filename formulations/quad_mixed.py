@@ -17,12 +17,10 @@ from scipy import sparse
 from formulations.base import ContactQP
 from formulations.contact import gauss_legendre
 from formulations.quad_elasticity import assemble_quad_elasticity
-from formulations.quad_vi import QuadContactSolution, contact_edges
+from formulations.quad_vi import SIMPSON, QuadContactSolution, contact_edges, failed
 from formulations.solvers.registry import FAST_SOLVER, SOLVERS
 from scenes import Scene
 from scenes.quad_hierarchy import QuadHierarchy
-
-SIMPSON = np.array([1 / 6, 2 / 3, 1 / 6])  # int of the Q2 trace's nodal functions / |edge|
 
 
 def coarse_edges(hierarchy: QuadHierarchy, cells: np.ndarray, normal: np.ndarray,
@@ -45,10 +43,10 @@ def solve_quad_mixed(scene: Scene, hierarchy: QuadHierarchy, order: int = 1,
     edges."""
     elasticity = assemble_quad_elasticity(scene, hierarchy, order)
     basis, mesh = elasticity.basis, elasticity.basis.mesh
-    facets, a, b, normal = contact_edges(scene, elasticity)
-    group = coarse_edges(hierarchy, mesh.f2t[0, facets], normal, levels_up)
-    length = np.linalg.norm(b - a, axis=0)
-    unit = normal / length
+    edges = contact_edges(scene, elasticity)
+    facets, a, b, length = edges.facets, edges.a, edges.b, edges.length
+    group = coarse_edges(hierarchy, edges.cells, edges.normal, levels_up)
+    unit = edges.normal
     weights = [np.full(2, 0.5)] if order == 1 else [SIMPSON[[0, 2]], SIMPSON[1:2]]
     dofs = [mesh.facets[:, facets]] if order == 1 else [mesh.facets[:, facets],
                                                         facets[None, :]]
@@ -73,10 +71,8 @@ def solve_quad_mixed(scene: Scene, hierarchy: QuadHierarchy, order: int = 1,
                    objective_scale=float(scene.material.young_modulus))
     answer = SOLVERS.get(solver)(qp, **options)
     if answer.u is None or answer.multipliers is None or not np.all(np.isfinite(answer.u)):
-        return QuadContactSolution(elasticity, np.full(basis.N, np.nan), np.full(m, np.nan),
-                                   float("nan"), "failed",
-                                   f"{answer.status}: {answer.reason or 'no solution'}")
+        return failed(elasticity, edges, m, answer, 1)
     energy = float(0.5 * answer.u @ (qp.K @ answer.u) - qp.F @ answer.u)
-    forces = np.maximum(answer.multipliers, 0.0) * H  # lambda_H |E_g|
-    return QuadContactSolution(elasticity, elasticity.expand(answer.u), forces, energy,
-                               answer.status, answer.reason)
+    pressure = np.maximum(answer.multipliers, 0.0)  # lambda_H on each coarse edge
+    return QuadContactSolution(elasticity, elasticity.expand(answer.u), pressure * H, energy,
+                               answer.status, answer.reason, edges, pressure[group][:, None])

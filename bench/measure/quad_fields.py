@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 from skfem import Basis, MeshTri
 
-from bench.measure.fields import GradientField, Locator, _lattice, _powers
+from bench.measure.fields import GradientField, Locator, _lattice, _powers, monomials
 
 # the halves of the reference square [0, 1]^2: corners (v0, v1, v2) and (v0, v2, v3)
 HALVES = (np.array([[0.0, 1.0, 1.0], [0.0, 0.0, 1.0]]),
@@ -46,3 +46,25 @@ def quad_gradient_field(basis: Basis, u: np.ndarray) -> GradientField:
 def _order(basis: Basis) -> int:
     """p of a vector Q_p basis (its scalar element's degree in each variable)."""
     return 1 if basis.elem.elem.facet_dofs == 0 else 2
+
+
+def gradient_derivatives_at(field: GradientField, x: np.ndarray,
+                            cells: np.ndarray) -> np.ndarray:
+    """d/dx_k of grad u (2, 2, 2, n) at points x (2, n) of the triangles ``cells`` of
+    ``field``: its polynomials differentiated exactly, through each triangle's inverse map."""
+    xi = field.locator.reference_coordinates(x, cells)
+    exponents = monomials(field.degree)
+    derivatives = []
+    for r in range(2):  # d/dxi_r of every monomial
+        rows = []
+        for exponent in exponents:
+            power = list(exponent)
+            factor = power[r]
+            power[r] = max(power[r] - 1, 0)
+            rows.append(factor * xi[0] ** power[0] * xi[1] ** power[1])
+        derivatives.append(np.array(rows))  # (M, n)
+    coefficients = field.coefficients[:, :, :, cells]  # (2, 2, M, n)
+    inverse = field.locator.inverse[:, :, cells]  # (r, k, n)
+    by_reference = np.array([np.einsum("ijmn,mn->ijn", coefficients, d)
+                             for d in derivatives])  # (r, 2, 2, n)
+    return np.einsum("rijn,rkn->ijkn", by_reference, inverse)
