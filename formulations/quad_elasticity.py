@@ -38,6 +38,7 @@ class QuadElasticity:
     F: np.ndarray
     free: np.ndarray
     boundary: np.ndarray  # the facets of the leaf mesh on the body's boundary
+    clamped: np.ndarray  # those on Gamma_D
     order: int = 1
 
     @property
@@ -105,4 +106,4 @@ def assemble_quad_elasticity(scene: Scene, hierarchy: QuadHierarchy,
     return QuadElasticity(hierarchy=hierarchy, basis=basis, lame=(lam, mu), P=P,
                           K=(P.T @ K_cells @ P).tocsr(), F=P.T @ F_cells,
                           free=np.flatnonzero(~conforming_fixed), boundary=boundary,
-                          order=order)
+                          clamped=clamped, order=order)

@@ -58,7 +58,7 @@ def solve_quad_mixed(scene: Scene, hierarchy: QuadHierarchy, order: int = 1,
                 rows.append(group)
                 cols.append(table[c, nodes[k]])
                 values.append(w[k] * length * unit[c])
-    m = group.max() + 1
+    m = int(group.max()) + 1 if group.size else 0
     B = sparse.csr_matrix((np.concatenate(values), (np.concatenate(rows),
                                                    np.concatenate(cols))), shape=(m, basis.N))
     t, w = gauss_legendre(4)

@@ -1,0 +1,194 @@
+"""The seed's residual estimator on a quadrilateral hierarchy with hanging nodes: the terms of
+``estimators.residual`` (the paper's (8) with eta_0 of its section 5) for Q1 and Q2 solutions
+of ``formulations.quad_vi`` and ``formulations.quad_mixed`` (docs/theory.md, section 15).
+
+eta_0^2 = (1/E) sum_T ( (h_T/p)^2 ||f + div sigma(u_h)||_T^2 + sum_{e in E_T} (h_e/p) R_e^2 ).
+An edge with a hanging node is measured on each of its halves, the fine cell against the
+coarse one across it: R_e = 1/2 ||[sigma_n(u_h)]||_e on interior edges and halves,
+||sigma_n(u_h) - q||_e on Gamma_N, ||sigma_nn(u_h) + lambda_h||_e + ||sigma_nt(u_h)||_e on
+Gamma_C. The contact terms: E ||w||_0 ||w||_1 and |(lambda_h, w)| with w = (g - u_hn)_-.
+The stress is evaluated from the exact gradient polynomials of ``formulations.quad_evaluation``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from skfem import Basis, ElementQuad0
+
+from estimators.base import Estimate
+from formulations.contact import gauss_legendre
+from formulations.elasticity import stress_tensor_from_gradient
+from formulations.quad_evaluation import QuadGradient
+
+EDGE_POINTS = 4  # Gauss points per edge: exact for the jumps of Q1 and Q2 stresses
+CONTACT_POINTS = 10  # w has kinks where u_hn crosses g (as estimators.contact_terms)
+
+
+def cell_diameters(mesh) -> np.ndarray:
+    """The longer diagonal of each quadrilateral."""
+    p = mesh.p[:, mesh.t]
+    return np.maximum(np.linalg.norm(p[:, 2] - p[:, 0], axis=0),
+                      np.linalg.norm(p[:, 3] - p[:, 1], axis=0))
+
+
+class QuadStress:
+    """sigma(u_h) and div sigma(u_h) of a quadrilateral solution at points of given cells."""
+
+    def __init__(self, solution):
+        elasticity = solution.elasticity
+        self.field = QuadGradient.from_solution(elasticity.basis, solution.u, elasticity.order)
+        self.lame = elasticity.lame
+
+    def gradient(self, x: np.ndarray, cells: np.ndarray) -> np.ndarray:
+        return self.field.at(x, cells)
+
+    def sigma(self, x: np.ndarray, cells: np.ndarray) -> np.ndarray:
+        return stress_tensor_from_gradient(self.gradient(x, cells), *self.lame)
+
+    def divergence(self, x: np.ndarray, cells: np.ndarray) -> np.ndarray:
+        dgrad = self.field.derivatives_at(x, cells)  # d_k (grad u)_ij
+        lam, mu = self.lame
+        strain = 0.5 * (dgrad + np.swapaxes(dgrad, 0, 1))  # d_k eps_ij
+        d_trace = dgrad[0, 0] + dgrad[1, 1]  # d_k tr(eps)
+        return np.array([2 * mu * (strain[i, 0, 0] + strain[i, 1, 1]) + lam * d_trace[i]
+                         for i in range(2)])
+
+
+def element_residuals(scene, solution, stress: QuadStress) -> np.ndarray:
+    """(h_T/p)^2 ||f + div sigma(u_h)||_T^2 per cell."""
+    mesh, order = solution.elasticity.basis.mesh, solution.elasticity.order
+    basis = Basis(mesh, ElementQuad0(), intorder=2 * order + 1)
+    x = np.asarray(basis.global_coordinates())  # (2, nE, nq)
+    cells = np.repeat(np.arange(mesh.t.shape[1]), x.shape[2])
+    residual = stress.divergence(x.reshape(2, -1), cells).reshape(x.shape)
+    if scene.body_force is not None:
+        residual = residual + scene.body_force(x)
+    norm2 = ((residual**2).sum(axis=0) * basis.dx).sum(axis=1)
+    return (cell_diameters(mesh) / order) ** 2 * norm2
+
+
+def edge_pairs(solution) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Every interior edge piece: end points a, b (2, n) and the cells on either side. The
+    conforming interior edges, and both halves of every edge with a hanging node (its fine
+    cell, the coarse cell across)."""
+    mesh = solution.elasticity.basis.mesh
+    hierarchy = solution.elasticity.hierarchy
+    interior = np.flatnonzero(mesh.f2t[1] >= 0)
+    a, b = mesh.facets[:, interior]
+    first, second = mesh.f2t[:, interior]
+    used, _ = hierarchy.leaf_vertices()
+    node, ends_a, ends_b = (np.searchsorted(used, v) for v in hierarchy.hanging())
+    if node.size:
+        keys = mesh.facets[0] * mesh.p.shape[1] + mesh.facets[1]
+        order = np.argsort(keys)
+
+        def owner(u, v):  # the (only) cell of the leaf facet (u, v)
+            key = np.minimum(u, v) * mesh.p.shape[1] + np.maximum(u, v)
+            return mesh.f2t[0, order[np.searchsorted(keys[order], key)]]
+
+        coarse = owner(ends_a, ends_b)
+        a = np.concatenate([a, ends_a, node])
+        b = np.concatenate([b, node, ends_b])
+        first = np.concatenate([first, owner(ends_a, node), owner(node, ends_b)])
+        second = np.concatenate([second, coarse, coarse])
+    return mesh.p[:, a], mesh.p[:, b], first, second
+
+
+def jump_residuals(solution, stress: QuadStress) -> np.ndarray:
+    """(h_e/p) (1/2 ||[sigma_n]||_e)^2 to both cells of every interior edge piece."""
+    order = solution.elasticity.order
+    n_cells = solution.elasticity.basis.mesh.t.shape[1]
+    a, b, first, second = edge_pairs(solution)
+    t, w = gauss_legendre(EDGE_POINTS)
+    x = (a[:, :, None] + (b - a)[:, :, None] * t).reshape(2, -1)
+    h = np.linalg.norm(b - a, axis=0)
+    n = np.repeat(np.array([(b - a)[1], -(b - a)[0]]) / h, t.size, axis=1)
+    jump = (stress.sigma(x, np.repeat(first, t.size))
+            - stress.sigma(x, np.repeat(second, t.size)))
+    jn = np.einsum("ijn,jn->in", jump, n)
+    norm2 = ((jn**2).sum(axis=0).reshape(-1, t.size) * w).sum(axis=1) * h
+    share = h / order * 0.25 * norm2
+    return np.bincount(first, share, n_cells) + np.bincount(second, share, n_cells)
+
+
+def boundary_residuals(scene, solution, stress: QuadStress) -> np.ndarray:
+    """(h_e/p) R_e^2 on the Neumann and the contact edges."""
+    elasticity = solution.elasticity
+    mesh, order, n_cells = elasticity.basis.mesh, elasticity.order, elasticity.basis.mesh.t.shape[1]
+    out = np.zeros(n_cells)
+    t, w = gauss_legendre(EDGE_POINTS)
+    edges = solution.edges
+    taken = np.union1d(edges.facets, elasticity.clamped)
+    neumann = np.setdiff1d(elasticity.boundary, taken)
+    if neumann.size:
+        cells = mesh.f2t[0, neumann]
+        a, b = mesh.p[:, mesh.facets[0, neumann]], mesh.p[:, mesh.facets[1, neumann]]
+        h = np.linalg.norm(b - a, axis=0)
+        inward = mesh.p[:, mesh.t[:, cells]].mean(axis=1) - a
+        n = np.array([(b - a)[1], -(b - a)[0]]) / h
+        n *= np.where((n * inward).sum(axis=0) > 0, -1.0, 1.0)
+        x = a[:, :, None] + (b - a)[:, :, None] * t
+        sn = np.einsum("ijn,jn->in", stress.sigma(x.reshape(2, -1), np.repeat(cells, t.size)),
+                       np.repeat(n, t.size, axis=1)).reshape(2, -1, t.size)
+        if scene.traction is not None:
+            sn = sn - scene.traction(x)
+        out += np.bincount(cells, h / order * ((sn**2).sum(axis=0) * w).sum(axis=1) * h,
+                           n_cells)
+    if edges.facets.size:
+        x = edges.points(t).reshape(2, -1)
+        normal = np.repeat(edges.normal, t.size, axis=1)
+        sn = np.einsum("ijn,jn->in", stress.sigma(x, np.repeat(edges.cells, t.size)), normal)
+        snn = np.einsum("in,in->n", sn, normal).reshape(-1, t.size)
+        snt2 = ((sn - snn.ravel() * normal) ** 2).sum(axis=0).reshape(-1, t.size)
+        r_e = (np.sqrt((((snn + solution.pressure(t)) ** 2) * w).sum(axis=1) * edges.length)
+               + np.sqrt((snt2 * w).sum(axis=1) * edges.length))
+        out += np.bincount(edges.cells, edges.length / order * r_e**2, n_cells)
+    return out
+
+
+def contact_terms(scene, solution, stress: QuadStress) -> tuple[float, float, np.ndarray]:
+    """E ||w||_0 ||w||_1, |(lambda_h, w)| and their shares per cell, w = (g - u_hn)_-."""
+    edges, basis = solution.edges, solution.elasticity.basis
+    n_cells = basis.mesh.t.shape[1]
+    if edges.facets.size == 0:
+        return 0.0, 0.0, np.zeros(n_cells)
+    t, w = gauss_legendre(CONTACT_POINTS)
+    x = edges.points(t)  # (2, n, nq)
+    values = (basis.probes(x.reshape(2, -1)) @ solution.u).reshape(2, -1)
+    normal = np.repeat(edges.normal, t.size, axis=1)
+    u_n = (values * normal).sum(axis=0).reshape(-1, t.size)
+    d = np.asarray(scene.gap(x)) - u_n
+    penetrating = d < 0
+    grad = stress.gradient(x.reshape(2, -1), np.repeat(edges.cells, t.size))
+    tangent = np.repeat((edges.b - edges.a) / edges.length, t.size, axis=1)
+    step = 1e-6 * edges.length[None, :, None] * (edges.b - edges.a)[:, :, None] \
+        / edges.length[None, :, None]
+    dg = (np.asarray(scene.gap(x + step)) - np.asarray(scene.gap(x - step))) \
+        / (2e-6 * edges.length[:, None])
+    du = np.einsum("in,ijn,jn->n", normal, grad, tangent).reshape(-1, t.size)
+    wval = np.where(penetrating, d, 0.0)
+    dw = np.where(penetrating, dg - du, 0.0)
+    l2 = (wval**2 * w).sum(axis=1) * edges.length
+    h1 = l2 + (dw**2 * w).sum(axis=1) * edges.length
+    young = float(scene.material.young_modulus)
+    geometric = young * float(np.sqrt(l2.sum() * h1.sum()))
+    local = np.sqrt(l2 * h1)
+    if local.sum() > 0:
+        local *= geometric / local.sum()
+    complementarity = np.abs((solution.pressure(t) * wval * w).sum(axis=1) * edges.length)
+    shares = np.bincount(edges.cells, local + complementarity, n_cells)
+    return geometric, float(complementarity.sum()), shares
+
+
+def quad_residual_estimate(scene, solution) -> Estimate:
+    """eta of the paper's (8) for a quadrilateral contact solution, per-cell indicators."""
+    stress = QuadStress(solution)
+    volume = (element_residuals(scene, solution, stress) + jump_residuals(solution, stress)
+              + boundary_residuals(scene, solution, stress)) / float(scene.material.young_modulus)
+    geometric, complementarity, shares = contact_terms(scene, solution, stress)
+    eta_0 = float(np.sqrt(volume.sum()))
+    return Estimate(estimator="residual", eta=float(np.sqrt(eta_0**2 + geometric
+                                                            + complementarity)),
+                    eta_0=eta_0, eta_geometric=float(np.sqrt(geometric)),
+                    eta_complementarity=float(np.sqrt(complementarity)),
+                    indicators=volume + shares)

@@ -1,0 +1,81 @@
+"""grad u_h of a Q1 or Q2 field at any points of given cells, and its derivatives, exactly
+(docs/theory.md, section 15).
+
+On a parallelogram the map x = v0 + A xi from the reference square is affine, so each
+component of grad u_h is, in xi, a polynomial of degree at most p in each variable (Q_p with
+one degree lost in the direction of differentiation). It is stored per cell by its values at
+the (p + 1)^2 tensor lattice (a Vandermonde solve) and evaluated or differentiated anywhere.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from skfem import Basis
+
+# tolerance of the parallelogram check, relative to the cell's size
+PARALLELOGRAM_TOLERANCE = 1e-10
+
+
+def tensor_exponents(degree: int) -> np.ndarray:
+    """Exponents (2, M) of xi^a eta^b with a, b <= degree."""
+    a, b = np.meshgrid(np.arange(degree + 1), np.arange(degree + 1), indexing="ij")
+    return np.array([a.ravel(), b.ravel()])
+
+
+def monomial_values(xi: np.ndarray, exponents: np.ndarray, derivative: int | None = None):
+    """xi^a eta^b (M, n) at reference points xi (2, n), or its derivative along xi_r."""
+    if derivative is None:
+        return xi[0][None] ** exponents[0][:, None] * xi[1][None] ** exponents[1][:, None]
+    power = exponents.copy()
+    factor = power[derivative].astype(float)
+    power[derivative] = np.maximum(power[derivative] - 1, 0)
+    return factor[:, None] * monomial_values(xi, power)
+
+
+@dataclass(frozen=True, eq=False)
+class QuadGradient:
+    """grad u_h per cell: ``coefficients`` (2, 2, M, nE) of the monomials ``exponents`` in the
+    reference coordinates of each cell (origin v0, ``inverse`` of A)."""
+
+    origin: np.ndarray
+    inverse: np.ndarray
+    exponents: np.ndarray
+    coefficients: np.ndarray
+
+    @classmethod
+    def from_solution(cls, basis: Basis, u: np.ndarray, degree: int) -> QuadGradient:
+        """The gradient of the cell-DOF vector ``u`` of a vector Q_degree ``basis``."""
+        p = basis.mesh.p[:, basis.mesh.t]  # (2, 4, nE)
+        A = np.array([p[:, 1] - p[:, 0], p[:, 3] - p[:, 0]]).transpose(1, 0, 2)  # (2, 2, nE)
+        size = np.linalg.norm(A, axis=(0, 1))
+        if np.any(np.linalg.norm(p[:, 0] + A[:, 0] + A[:, 1] - p[:, 2], axis=0)
+                  > PARALLELOGRAM_TOLERANCE * size):
+            raise ValueError("the quadrilaterals are not all parallelograms: their gradients "
+                             "are not polynomials in x")
+        exponents = tensor_exponents(degree)
+        lattice = exponents / max(degree, 1)  # (2, M) in the reference square
+        sampled = Basis(basis.mesh, basis.elem, quadrature=(lattice, np.ones(lattice.shape[1])))
+        values = sampled.interpolate(u).grad  # (2, 2, nE, M)
+        solve = np.linalg.inv(monomial_values(lattice, exponents).T)
+        coefficients = np.einsum("mk,ijek->ijme", solve, values)
+        inverse = np.linalg.inv(A.transpose(2, 0, 1)).transpose(1, 2, 0)  # rows: d xi_r / dx
+        return cls(p[:, 0], inverse, exponents, coefficients)
+
+    def reference(self, x: np.ndarray, cells: np.ndarray) -> np.ndarray:
+        return np.einsum("rkn,kn->rn", self.inverse[:, :, cells], x - self.origin[:, cells])
+
+    def at(self, x: np.ndarray, cells: np.ndarray) -> np.ndarray:
+        """grad u_h (2, 2, n) at points x (2, n) of ``cells``."""
+        values = monomial_values(self.reference(x, cells), self.exponents)
+        return np.einsum("ijmn,mn->ijn", self.coefficients[:, :, :, cells], values)
+
+    def derivatives_at(self, x: np.ndarray, cells: np.ndarray) -> np.ndarray:
+        """d/dx_k (grad u_h)_ij (2, 2, 2, n) at points x of ``cells``."""
+        xi = self.reference(x, cells)
+        coefficients = self.coefficients[:, :, :, cells]
+        by_reference = np.array([np.einsum("ijmn,mn->ijn", coefficients,
+                                           monomial_values(xi, self.exponents, r))
+                                 for r in range(2)])  # (r, 2, 2, n)
+        return np.einsum("rijn,rkn->ijkn", by_reference, self.inverse[:, :, cells])
