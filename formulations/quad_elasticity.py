@@ -18,6 +18,7 @@ from skfem.helpers import dot
 from skfem.models.elasticity import linear_elasticity
 
 from formulations.hanging_nodes import prolongation
+from formulations.quad_load import quad_body_load
 from scenes import Scene
 from scenes.quad_hierarchy import QuadHierarchy, edge_keys
 
@@ -70,6 +71,17 @@ def boundary_facets_of(predicate, mesh, boundary: np.ndarray) -> np.ndarray:
     return boundary[np.asarray(predicate(mid), dtype=bool)]
 
 
+def count_quad_dofs(scene: Scene, hierarchy: QuadHierarchy, order: int = 1) -> int:
+    """The unknowns ``assemble_quad_elasticity`` would give, without assembling K: two per
+    conforming Lagrange node off Gamma_D (a hanging node and the DOFs inside the halves of
+    its edge are not unknowns)."""
+    mesh = hierarchy.mesh()
+    basis = Basis(mesh, ElementVector(QUAD_ELEMENTS[order]()), intorder=1)
+    _, kept = prolongation(hierarchy, basis)
+    clamped = boundary_facets_of(scene.is_dirichlet, mesh, body_boundary(hierarchy, mesh))
+    return int(kept.size - np.unique(basis.get_dofs(clamped).all()).size)
+
+
 def assemble_quad_elasticity(scene: Scene, hierarchy: QuadHierarchy,
                              order: int = 1) -> QuadElasticity:
     """P' K P and P' F for Q_order displacements on the leaves of ``hierarchy``, with the
@@ -83,12 +95,8 @@ def assemble_quad_elasticity(scene: Scene, hierarchy: QuadHierarchy,
     P, _ = prolongation(hierarchy, basis)
     K_cells = asm(linear_elasticity(lam, mu), basis)
     F_cells = np.zeros(basis.N)
-    if scene.body_force is not None:  # the basis's rule, of order 2p + 1
-        @LinearForm
-        def body(v, w):
-            return dot(scene.body_force(w.x), v)
-
-        F_cells += asm(body, basis)
+    if scene.body_force is not None:  # the basis's rule, refined where f jumps
+        F_cells += quad_body_load(scene.body_force, basis)
     boundary = body_boundary(hierarchy, mesh)
     clamped = boundary_facets_of(scene.is_dirichlet, mesh, boundary)
     loaded = np.setdiff1d(boundary, np.union1d(

@@ -1,0 +1,143 @@
+"""The seed's own discretisation, measured: Q1/Q2 on hierarchical quadrilateral meshes (uniform
+and adaptive with hanging nodes), the VI and the mixed method with lambda_H one or two levels
+coarser, the seed's residual estimator, errors against exact solutions or the P3 references
+(docs/theory.md, section 15). ``python -m bench study --cell quad`` runs it.
+
+A scene runs on quadrilaterals when its starting mesh is a tensor grid (every built-in 2D
+scene): the grid's lines give the root cells, so no second scene definition is needed.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import asdict, dataclass
+
+import numpy as np
+import pandas as pd
+from skfem import Basis, ElementQuad0
+
+from bench.measure.discretisation_error import energy_density
+from bench.measure.fields import GradientField
+from bench.measure.nonnested import energy_difference
+from bench.measure.quad_fields import quad_gradient_field
+from bench.sequence.marking import mark
+from estimators.quad_residual import quad_residual_estimate
+from formulations.quad_elasticity import count_quad_dofs
+from formulations.quad_mixed import solve_quad_mixed
+from formulations.quad_vi import solve_quad_vi
+from scenes import get_scene
+from scenes.quad_hierarchy import QuadHierarchy
+
+# the quadrilateral methods: name -> (solve, keyword arguments)
+METHODS = {"vi": (solve_quad_vi, {}), "mixed": (solve_quad_mixed, {"levels_up": 1}),
+           "mixed-H4": (solve_quad_mixed, {"levels_up": 2})}
+EXACT_ORDER = 8  # quadrature of the exact error: f of free-boundary jumps inside cells
+
+
+@dataclass(frozen=True)
+class QuadRow:
+    """One level of a quadrilateral sequence."""
+
+    scene: str
+    method: str
+    order: int
+    strategy: str
+    level: int
+    ndofs: int
+    hanging_nodes: int
+    eta: float
+    eta_0: float
+    energy_error: float
+    effectivity_index: float
+    contact_force: float
+    energy: float
+    t_solve: float
+    t_estimate: float
+    status: str
+
+
+def tensor_grid(scene) -> tuple[np.ndarray, np.ndarray]:
+    """The grid lines of a scene whose starting mesh is a tensor grid of triangles; ValueError
+    for any other mesh."""
+    p = scene.mesh.p
+    xs, ys = np.unique(p[0]), np.unique(p[1])
+    if scene.dim != 2 or xs.size * ys.size != p.shape[1]:
+        raise ValueError(f"scene {scene.name!r}: its starting mesh is not a tensor grid, so it "
+                         "has no quadrilateral version")
+    return xs, ys
+
+
+def exact_error(scene, solution) -> float:
+    """||u - u_h|| against the scene's exact solution, by quadrature on the cells."""
+    elasticity = solution.elasticity
+    basis = Basis(elasticity.basis.mesh, ElementQuad0(), intorder=EXACT_ORDER)
+    x = np.asarray(basis.global_coordinates())
+    quadrature = Basis(elasticity.basis.mesh, elasticity.basis.elem, intorder=EXACT_ORDER)
+    grad = quadrature.interpolate(solution.u).grad - scene.exact.gradient(x)
+    return float(np.sqrt((energy_density(grad, *elasticity.lame) * basis.dx).sum()))
+
+
+def judge(scene, reference: GradientField | None):
+    """error(solution): exact for a scene with an exact solution, else against ``reference``
+    (None: not measured)."""
+    if scene.exact is not None:
+        return lambda solution: exact_error(scene, solution)
+    if reference is None:
+        return lambda solution: float("nan")
+    return lambda solution: energy_difference(
+        quad_gradient_field(solution.elasticity.basis, solution.u), reference,
+        solution.elasticity.lame)
+
+
+def quad_sequence(scene_name: str, method: str, order: int, strategy: str, max_dofs: int,
+                  reference: GradientField | None = None, theta: float = 0.5) -> list[QuadRow]:
+    """Solve, estimate, mark (Doerfler) and refine on quadrilaterals until the next level
+    would pass ``max_dofs``."""
+    scene = get_scene(scene_name)
+    hierarchy = QuadHierarchy.from_tensor(*tensor_grid(scene))
+    solve, options = METHODS[method]
+    error_of, rows = judge(scene, reference), []
+    for level in range(60):
+        if count_quad_dofs(scene, hierarchy, order) > max_dofs:  # before anything is built
+            break
+        start = time.perf_counter()
+        solution = solve(scene, hierarchy, order, **options)
+        t_solve = time.perf_counter() - start
+        start = time.perf_counter()
+        estimate = quad_residual_estimate(scene, solution)
+        t_estimate = time.perf_counter() - start
+        error = error_of(solution)
+        rows.append(QuadRow(scene_name, method, order, strategy, level,
+                            solution.elasticity.ndofs, hierarchy.hanging()[0].size,
+                            estimate.eta, estimate.eta_0, error, estimate.eta / error,
+                            solution.contact_force, solution.energy, t_solve, t_estimate,
+                            solution.status))
+        if solution.status == "failed":
+            break
+        if strategy == "uniform":
+            hierarchy = hierarchy.refined()
+        else:
+            hierarchy = hierarchy.refined(mark(estimate.indicators, "doerfler", theta))
+    return rows
+
+
+def slopes(table: pd.DataFrame, column: str, last: int = 4) -> pd.DataFrame:
+    """Per sequence, the slope of log(column) against log(ndofs) over its last ``last``
+    levels (np.polyfit), and over all levels."""
+    out = []
+    keys = ["scene", "method", "order", "strategy"]
+    for key, group in table.groupby(keys, sort=False):
+        group = group[np.isfinite(group[column]) & (group[column] > 0)]
+        if len(group) < 3:
+            continue
+        x, y = np.log(group["ndofs"].to_numpy(float)), np.log(group[column].to_numpy(float))
+        tail = slice(-min(last, len(group)), None)
+        out.append(dict(zip(keys, key, strict=True), levels=len(group),
+                        dofs=f"{group['ndofs'].iloc[0]}..{group['ndofs'].iloc[-1]}",
+                        slope_all=np.polyfit(x, y, 1)[0],
+                        slope_last=np.polyfit(x[tail], y[tail], 1)[0]))
+    return pd.DataFrame(out)
+
+
+def as_frame(rows: list[QuadRow]) -> pd.DataFrame:
+    return pd.DataFrame([asdict(r) for r in rows])
