@@ -7,6 +7,7 @@ import dataclasses
 from bench.cli import option_types as options
 from bench.cli.guards import InputError
 from bench.study import QUICK, StudyConfig, run_study
+from bench.study.quads import QuadStudy, run_quad_study, write_quad_report
 from bench.study.run import report_study
 from scenes import scene_names
 
@@ -42,6 +43,12 @@ def add_study_parser(sub) -> None:
                        help=f"adaptive sequences run in parallel on a local Dask cluster of "
                             f"this many processes; uniform ones one at a time "
                             f"(default: {DEFAULTS.workers})")
+    study.add_argument("--cell", choices=("tri", "quad"), default="tri",
+                       help="tri (default): the matrix's formulations on triangles; quad: the "
+                            "seed's own discretisation, Q1 (Q2 with --order 2) on hierarchical "
+                            "quadrilateral meshes with hanging nodes, vi and the mixed method "
+                            "with lambda_H one and two levels coarser, the seed's residual "
+                            "estimator (REPORT/quads.md)")
     study.add_argument("--quick", action="store_true",
                        help="the reduced study of the default tests: paper, uniform to 9000 "
                             "and adaptive to 5000 DOFs, in this process")
@@ -54,7 +61,35 @@ def add_study_parser(sub) -> None:
                        help=f"report folder (default: {DEFAULTS.report})")
 
 
+def quad_study_command(args) -> int:
+    """``study --cell quad``: the quadrilateral sequences and their report."""
+    orders = tuple(o for o in args.order if o in (1, 2))
+    if len(orders) < len(args.order):
+        raise InputError(f"--order={','.join(map(str, args.order))}: quadrilaterals run "
+                         "orders 1 and 2")
+    study = QuadStudy(scenes=tuple(args.scene), orders=orders,
+                      uniform_max_dofs=9000 if args.quick else args.uniform_max_dofs,
+                      adaptive_max_dofs=5000 if args.quick else args.adaptive_max_dofs,
+                      reference_dofs=args.reference_dofs)
+
+    def show(rows):
+        last = rows[-1]
+        print(f"{last.scene}/{last.method}/Q{last.order}/{last.strategy}: {len(rows)} "
+              f"levels to {last.ndofs} DOFs, error {last.energy_error:.4g}, eta "
+              f"{last.eta:.4g}", flush=True)
+
+    try:
+        table = run_quad_study(study, show)
+    except ValueError as error:
+        raise InputError(str(error)) from None
+    report = write_quad_report(table, args.report, " ".join(["python -m bench", *args.argv]))
+    print(f"{len(table)} levels; wrote {report}")
+    return 0
+
+
 def study_command(args) -> int:
+    if args.cell == "quad":
+        return quad_study_command(args)
     base = QUICK if args.quick else StudyConfig(
         scenes=tuple(args.scene), orders=tuple(args.order),
         uniform_max_dofs=args.uniform_max_dofs, adaptive_max_dofs=args.adaptive_max_dofs,

@@ -141,3 +141,70 @@ def slopes(table: pd.DataFrame, column: str, last: int = 4) -> pd.DataFrame:
 
 def as_frame(rows: list[QuadRow]) -> pd.DataFrame:
     return pd.DataFrame([asdict(r) for r in rows])
+
+
+@dataclass(frozen=True)
+class QuadStudy:
+    """What ``python -m bench study --cell quad`` runs: every scene x method x order x
+    strategy on quadrilaterals, to the budgets, errors against exact solutions or the cached
+    P3 references of ``reference_dofs`` DOFs."""
+
+    scenes: tuple[str, ...] = ("paper", "free-boundary", "hertz")
+    methods: tuple[str, ...] = tuple(METHODS)
+    orders: tuple[int, ...] = (1,)
+    strategies: tuple[str, ...] = ("uniform", "adaptive")
+    uniform_max_dofs: int = 2_100_000
+    adaptive_max_dofs: int = 1_000_000
+    reference_dofs: int | None = 200_000
+
+
+def reference_field(scene_name: str, reference_dofs: int | None) -> GradientField | None:
+    """The P3 reference of a scene without an exact solution, from the cache (built if
+    missing); None without a budget or for a scene with an exact solution."""
+    scene = get_scene(scene_name)
+    if scene.exact is not None or reference_dofs is None:
+        return None
+    from bench.truth.cache import load_or_build  # only studies against references need it
+
+    reference = load_or_build(scene, reference_dofs)
+    return GradientField.from_dofs(reference.mesh, reference.order, reference.u)
+
+
+def run_quad_study(study: QuadStudy, on_sequence=None) -> pd.DataFrame:
+    """Every sequence of ``study``; ``on_sequence(rows)`` after each."""
+    rows = []
+    for scene in study.scenes:
+        reference = reference_field(scene, study.reference_dofs)
+        for method in study.methods:
+            for order in study.orders:
+                for strategy in study.strategies:
+                    budget = (study.uniform_max_dofs if strategy == "uniform"
+                              else study.adaptive_max_dofs)
+                    sequence = quad_sequence(scene, method, order, strategy, budget,
+                                             reference)
+                    rows += sequence
+                    if on_sequence is not None:
+                        on_sequence(sequence)
+    return as_frame(rows)
+
+
+def write_quad_report(table: pd.DataFrame, folder, command: str = "") -> str:
+    """REPORT/quads.md (the slopes of error and eta, and every level) and quads.csv."""
+    from pathlib import Path
+
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    table.to_csv(folder / "quads.csv", index=False)
+    error, eta = slopes(table, "energy_error"), slopes(table, "eta")
+    merged = error.merge(eta, on=["scene", "method", "order", "strategy", "levels", "dofs"],
+                         suffixes=("_error", "_eta"))
+    text = ["# Quadrilaterals: the seed's own discretisation", "",
+            f"`{command}`" if command else "", "",
+            "Slopes of the energy error and of eta against the DOFs N (np.polyfit over all "
+            "levels and over the last four); N^(-1/4) is the seed's \"nearly O(h^1/2)\", "
+            "N^(-1/2) is O(h).", "",
+            merged.to_markdown(index=False, floatfmt=".3f"), "",
+            "## Every level", "",
+            table.to_markdown(index=False, floatfmt=".4g"), ""]
+    (folder / "quads.md").write_text("\n".join(text))
+    return str(folder / "quads.md")
