@@ -19,6 +19,7 @@ from estimators.base import Estimate
 from formulations.contact import gauss_legendre
 from formulations.elasticity import stress_tensor_from_gradient
 from formulations.quad_evaluation import QuadGradient
+from scenes.quad_hierarchy import edge_keys
 
 EDGE_POINTS = 4  # Gauss points per edge: exact for the jumps of Q1 and Q2 stresses
 CONTACT_POINTS = 10  # w has kinks where u_hn crosses g (as estimators.contact_terms)
@@ -79,12 +80,11 @@ def edge_pairs(solution) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray
     used, _ = hierarchy.leaf_vertices()
     node, ends_a, ends_b = (np.searchsorted(used, v) for v in hierarchy.hanging())
     if node.size:
-        keys = mesh.facets[0] * mesh.p.shape[1] + mesh.facets[1]
+        keys = edge_keys(mesh.facets[0], mesh.facets[1])  # int64: no overflow past 46 341
         order = np.argsort(keys)
 
         def owner(u, v):  # the (only) cell of the leaf facet (u, v)
-            key = np.minimum(u, v) * mesh.p.shape[1] + np.maximum(u, v)
-            return mesh.f2t[0, order[np.searchsorted(keys[order], key)]]
+            return mesh.f2t[0, order[np.searchsorted(keys[order], edge_keys(u, v))]]
 
         coarse = owner(ends_a, ends_b)
         a = np.concatenate([a, ends_a, node])

@@ -51,3 +51,15 @@ def test_effectivity_on_free_boundary_is_bounded(order, strategy):
     assert np.all((effectivity > 0.5) & (effectivity < 8.0))
     if strategy == "adaptive":
         assert max(r.hanging_nodes for r in rows) > 10
+
+
+def test_edge_pieces_are_found_on_meshes_past_the_int32_key_range():
+    """Edge keys of vertex pairs overflow int32 beyond 46 341 vertices: 66 049 here."""
+    from types import SimpleNamespace
+
+    hierarchy = QuadHierarchy.from_tensor(np.linspace(0, 1, 257), np.linspace(0, 1, 257))
+    hierarchy = hierarchy.refined([40_000])
+    solution = SimpleNamespace(elasticity=SimpleNamespace(
+        basis=SimpleNamespace(mesh=hierarchy.mesh()), hierarchy=hierarchy))
+    a, b, first, second = edge_pairs(solution)
+    assert a.shape[1] - np.count_nonzero(solution.elasticity.basis.mesh.f2t[1] >= 0) == 8
