@@ -82,7 +82,8 @@ def quad_study_command(args) -> int:
         table = run_quad_study(study, show)
     except ValueError as error:
         raise InputError(str(error)) from None
-    report = write_quad_report(table, args.report, " ".join(["python -m bench", *args.argv]))
+    report = write_quad_report(table, args.report, " ".join(["python -m bench", *args.argv]),
+                               min(study.adaptive_max_dofs, 20000))
     print(f"{len(table)} levels; wrote {report}")
     return 0
 

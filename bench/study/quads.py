@@ -188,7 +188,8 @@ def run_quad_study(study: QuadStudy, on_sequence=None) -> pd.DataFrame:
     return as_frame(rows)
 
 
-def write_quad_report(table: pd.DataFrame, folder, command: str = "") -> str:
+def write_quad_report(table: pd.DataFrame, folder, command: str = "",
+                      fig1_dofs: int = 20000) -> str:
     """REPORT/quads.md (the slopes of error and eta, and every level) and quads.csv."""
     from pathlib import Path
 
@@ -206,5 +207,25 @@ def write_quad_report(table: pd.DataFrame, folder, command: str = "") -> str:
             merged.to_markdown(index=False, floatfmt=".3f"), "",
             "## Every level", "",
             table.to_markdown(index=False, floatfmt=".4g"), ""]
+    text[6:6] = write_quad_figures(table, folder, fig1_dofs)
     (folder / "quads.md").write_text("\n".join(text))
     return str(folder / "quads.md")
+
+
+def write_quad_figures(table: pd.DataFrame, folder, fig1_dofs: int = 20000) -> list[str]:
+    """The seed's Fig. 1 (on its first scene) and Fig. 2 (per scene) as PNGs in
+    FOLDER/figures; the Markdown lines that show them."""
+    from bench.study.quad_figures import estimated_error, mesh_and_stress
+
+    figures = folder / "figures"
+    figures.mkdir(exist_ok=True)
+    lines = []
+    scenes = list(dict.fromkeys(table["scene"]))
+    if scenes:
+        mesh_and_stress(scenes[0], fig1_dofs).savefig(figures / "quad-fig1.png", dpi=110)
+        lines += [f"![Fig. 1 on Q1: {scenes[0]}](figures/quad-fig1.png)", ""]
+    for scene in scenes:
+        name = f"quad-fig2-{scene}.png"
+        estimated_error(table, scene).savefig(figures / name, dpi=110)
+        lines += [f"![Fig. 2 on Q1: {scene}](figures/{name})", ""]
+    return lines

@@ -36,7 +36,9 @@ def test_study_cell_quad_writes_its_report(tmp_path, capsys):
     assert set(table["method"]) == {"vi", "mixed", "mixed-H4"}
     assert set(table["strategy"]) == {"uniform", "adaptive"}
     assert table["ndofs"].max() <= 9000 and (table["status"] == "ok").all()
-    assert "slope_last_error" in (report / "quads.md").read_text()
+    text = (report / "quads.md").read_text()
+    assert "slope_last_error" in text and "figures/quad-fig1.png" in text
+    assert (report / "figures" / "quad-fig2-free-boundary.png").stat().st_size > 10_000
 
 
 def test_quadrilaterals_refuse_order_three(tmp_path, capsys):
