@@ -76,3 +76,25 @@ def test_the_multiplier_mesh_is_a_coarser_level_of_the_hierarchy():
         group = coarse_edges(hierarchy, mesh.f2t[0, bottom], normal, up)[order]
         assert np.array_equal(group, np.repeat(group[::size], size))
         assert np.unique(group).size == 8 // size
+
+
+def test_the_inf_sup_constant_levels_off_for_h_over_H_at_most_one_half():
+    """beta_h of the mixed method on uniform Q1 hierarchies of paper: with lambda_H on the
+    leaves' own edges (h/H = 1) it halves with h (measured 0.46 .. 0.027); one or two levels
+    coarser (h/H = 1/2, 1/4) it levels off (measured 0.60 and 0.70 at 4096 cells)."""
+    from formulations.diagnostics import inf_sup_constant
+    from formulations.quad_mixed import mixed_problem
+
+    scene = get_scene("paper")
+    hierarchy = QuadHierarchy.from_tensor(np.linspace(-1, 1, 5), np.linspace(-1, 1, 5))
+    beta = {up: [] for up in (0, 1, 2)}
+    for _ in range(5):
+        for up in beta:
+            beta[up].append(inf_sup_constant(mixed_problem(scene, hierarchy, 1, up)))
+        hierarchy = hierarchy.refined()
+    same = np.array(beta[0])
+    assert np.allclose(same[2:] / same[1:-1], 0.5, atol=0.03)  # beta_h ~ h
+    for up in (1, 2):
+        levels = np.array(beta[up])
+        assert levels[-1] > 0.5  # bounded below ...
+        assert abs(levels[-1] / levels[-2] - 1) < 0.03  # ... and levelled off (within 1 %)
