@@ -7,11 +7,19 @@ import dataclasses
 from bench.cli import option_types as options
 from bench.cli.guards import InputError
 from bench.study import QUICK, StudyConfig, run_study
-from bench.study.quads import QuadStudy, run_quad_study, write_quad_report
+from bench.study.quads import (
+    QuadStudy,
+    as_frame,
+    hex_sequence,
+    run_quad_study,
+    write_hex_report,
+    write_quad_report,
+)
 from bench.study.run import report_study
 from scenes import scene_names
 
 DEFAULTS = StudyConfig()
+HEX_SCENE = "free-boundary-3d"  # the 3D scene with an exact solution
 
 
 def add_study_parser(sub) -> None:
@@ -23,8 +31,9 @@ def add_study_parser(sub) -> None:
         "singular exponents and the effectivity on every level. A rerun reuses every finished "
         "sequence.")
     study.add_argument("--scene", type=options.name_list("scene", scene_names()),
-                       default=list(DEFAULTS.scenes),
-                       help=f"scene(s) (default: {','.join(DEFAULTS.scenes)})")
+                       default=None,
+                       help=f"scene(s) (default: {','.join(DEFAULTS.scenes)}; with --cell hex: "
+                            f"{HEX_SCENE})")
     study.add_argument("--order", type=options.order_list, default=list(DEFAULTS.orders),
                        help="polynomial order(s) (default: 1)")
     study.add_argument("--uniform-max-dofs", type=options.positive_int("uniform_max_dofs"),
@@ -43,12 +52,13 @@ def add_study_parser(sub) -> None:
                        help=f"adaptive sequences run in parallel on a local Dask cluster of "
                             f"this many processes; uniform ones one at a time "
                             f"(default: {DEFAULTS.workers})")
-    study.add_argument("--cell", choices=("tri", "quad"), default="tri",
+    study.add_argument("--cell", choices=("tri", "quad", "hex"), default="tri",
                        help="tri (default): the matrix's formulations on triangles; quad: the "
                             "seed's own discretisation, Q1 (Q2 with --order 2) on hierarchical "
                             "quadrilateral meshes with hanging nodes, vi and the mixed method "
                             "with lambda_H one and two levels coarser, the seed's residual "
-                            "estimator (REPORT/quads.md)")
+                            "estimator (REPORT/quads.md); hex: Q1 on the 3D scenes' cubes, "
+                            "vi, uniform (REPORT/hexes.md)")
     study.add_argument("--quick", action="store_true",
                        help="the reduced study of the default tests: paper, uniform to 9000 "
                             "and adaptive to 5000 DOFs, in this process")
@@ -67,7 +77,7 @@ def quad_study_command(args) -> int:
     if len(orders) < len(args.order):
         raise InputError(f"--order={','.join(map(str, args.order))}: quadrilaterals run "
                          "orders 1 and 2")
-    study = QuadStudy(scenes=tuple(args.scene), orders=orders,
+    study = QuadStudy(scenes=tuple(args.scene or DEFAULTS.scenes), orders=orders,
                       uniform_max_dofs=9000 if args.quick else args.uniform_max_dofs,
                       adaptive_max_dofs=5000 if args.quick else args.adaptive_max_dofs,
                       reference_dofs=args.reference_dofs)
@@ -88,11 +98,31 @@ def quad_study_command(args) -> int:
     return 0
 
 
+def hex_study_command(args) -> int:
+    """``study --cell hex``: uniform Q1 on hexahedra of the 3D scenes given (default:
+    free-boundary-3d) and its report."""
+    scenes = args.scene or [HEX_SCENE]
+    budget = 30000 if args.quick else args.uniform_max_dofs
+    rows = []
+    try:
+        for scene in scenes:
+            rows += hex_sequence(scene, budget)
+            print(f"{scene}/vi/hex-Q1/uniform: {len(rows)} levels", flush=True)
+    except ValueError as error:
+        raise InputError(str(error)) from None
+    report = write_hex_report(as_frame(rows), args.report,
+                              " ".join(["python -m bench", *args.argv]))
+    print(f"{len(rows)} levels; wrote {report}")
+    return 0
+
+
 def study_command(args) -> int:
     if args.cell == "quad":
         return quad_study_command(args)
+    if args.cell == "hex":
+        return hex_study_command(args)
     base = QUICK if args.quick else StudyConfig(
-        scenes=tuple(args.scene), orders=tuple(args.order),
+        scenes=tuple(args.scene or DEFAULTS.scenes), orders=tuple(args.order),
         uniform_max_dofs=args.uniform_max_dofs, adaptive_max_dofs=args.adaptive_max_dofs,
         reference_dofs=args.reference_dofs, workers=args.workers)
     config = dataclasses.replace(base, out=args.out, report=args.report,
