@@ -3,6 +3,9 @@
 from __future__ import annotations
 
 import dataclasses
+from pathlib import Path
+
+import pandas as pd
 
 from bench.cli import option_types as options
 from bench.cli.guards import InputError
@@ -82,6 +85,15 @@ def quad_study_command(args) -> int:
                       adaptive_max_dofs=5000 if args.quick else args.adaptive_max_dofs,
                       reference_dofs=args.reference_dofs)
 
+    if args.report_only:  # the report again from the levels of the last run
+        csv = Path(args.report) / "quads.csv"
+        if not csv.is_file():
+            raise InputError(f"--report={args.report!r} holds no quads.csv; run "
+                             "study --cell quad first")
+        table = pd.read_csv(csv)
+        print(f"wrote {write_quad_report(table, args.report, read_command(args.report), 20000)}")
+        return 0
+
     def show(rows):
         last = rows[-1]
         print(f"{last.scene}/{last.method}/Q{last.order}/{last.strategy}: {len(rows)} "
@@ -114,6 +126,13 @@ def hex_study_command(args) -> int:
                               " ".join(["python -m bench", *args.argv]))
     print(f"{len(rows)} levels; wrote {report}")
     return 0
+
+
+def read_command(folder) -> str:
+    """The command line recorded in an earlier FOLDER/quads.md ('' if none)."""
+    path = Path(folder) / "quads.md"
+    lines = path.read_text().splitlines() if path.is_file() else []
+    return next((line.strip("`") for line in lines if line.startswith("`python -m bench")), "")
 
 
 def study_command(args) -> int:
