@@ -255,11 +255,11 @@ def write_quad_figures(table: pd.DataFrame, folder, fig1_dofs: int = 20000) -> l
     scenes = list(dict.fromkeys(table["scene"]))
     if scenes:
         mesh_and_stress(scenes[0], fig1_dofs).savefig(figures / "quad-fig1.png", dpi=110)
-        lines += [f"![Fig. 1 on Q1: {scenes[0]}](figures/quad-fig1.png)", ""]
+        lines += [f"![Fig. 1, Q1: {scenes[0]}](figures/quad-fig1.png)", ""]
     for scene in scenes:
         name = f"quad-fig2-{scene}.png"
         estimated_error(table, scene).savefig(figures / name, dpi=110)
-        lines += [f"![Fig. 2 on Q1: {scene}](figures/{name})", ""]
+        lines += [f"![Fig. 2: {scene}](figures/{name})", ""]
     return lines
 
 
