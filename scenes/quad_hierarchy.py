@@ -13,6 +13,7 @@ cell are stored consecutively, in the order of its vertices: child k holds verte
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -75,12 +76,21 @@ class QuadHierarchy:
 
     def mesh(self) -> MeshQuad:
         """The leaves as a scikit-fem mesh on the vertices they use (hanging nodes included;
-        ``vertex_numbers`` maps its vertices back to the hierarchy's)."""
+        ``leaf_vertices`` maps its vertices back to the hierarchy's). Built once: the mesh
+        caches its facets, which every assembly on this hierarchy then shares."""
+        return self._leaf_mesh
+
+    @functools.cached_property
+    def _leaf_mesh(self) -> MeshQuad:
         used, local = self.leaf_vertices()
         return MeshQuad(np.ascontiguousarray(self.p[:, used]), np.ascontiguousarray(local))
 
     def leaf_vertices(self) -> tuple[np.ndarray, np.ndarray]:
         """The hierarchy's vertices the leaves use, and the leaves renumbered on them."""
+        return self._leaf_vertices
+
+    @functools.cached_property
+    def _leaf_vertices(self) -> tuple[np.ndarray, np.ndarray]:
         leaves = self.cells[:, self.leaves]
         used, local = np.unique(leaves, return_inverse=True)
         return used, local.reshape(leaves.shape)
