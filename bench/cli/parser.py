@@ -4,6 +4,8 @@ Every list of names comes from a registry."""
 from __future__ import annotations
 
 import argparse
+import sys
+from pathlib import Path
 
 from bench.cli.option_types import (
     gib,
@@ -267,9 +269,16 @@ def _hard_parser(sub) -> None:
     hard.add_argument("--out", default="results-hard",
                       help="folder for hard.csv and hard.md (default: results-hard)")
 
+def program_name() -> str:
+    """How the user started the command line: the console script names itself, anything
+    else (``python -m bench``, a test) is ``python -m bench``."""
+    script = Path(sys.argv[0]).name if sys.argv and sys.argv[0] else ""
+    return "signorini-bench" if script == "signorini-bench" else "python -m bench"
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
-        prog="python -m bench",
+        prog=program_name(),
         description="signorini-bench: compare formulations and a posteriori error estimators "
                     "for Signorini's contact problem.")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")

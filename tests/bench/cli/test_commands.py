@@ -79,3 +79,12 @@ def test_hard_refuses_an_unknown_case(capsys):
     assert exit_.value.code == 2
     assert (f"unknown hard case 'wobbly'; valid hard cases: {', '.join(hard_case_names())}"
             in capsys.readouterr().err)
+
+
+def test_the_usage_line_names_the_command_the_user_typed(monkeypatch):
+    from bench.cli.parser import build_parser
+
+    monkeypatch.setattr(sys, "argv", ["/usr/local/bin/signorini-bench", "--help"])
+    assert build_parser().format_usage().startswith("usage: signorini-bench ")
+    monkeypatch.setattr(sys, "argv", ["/repo/bench/__main__.py", "--help"])
+    assert build_parser().format_usage().startswith("usage: python -m bench ")
