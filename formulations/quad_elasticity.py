@@ -46,10 +46,9 @@ class QuadElasticity:
     def ndofs(self) -> int:
         return int(self.free.size)
 
-    def expand(self, u_free: np.ndarray, u_fixed: np.ndarray | None = None) -> np.ndarray:
-        """The cell-DOF vector P u of free values (the clamped ones 0, or ``u_fixed``, a
-        conforming vector whose free entries are ignored)."""
-        u = np.zeros(self.P.shape[1]) if u_fixed is None else np.array(u_fixed, dtype=float)
+    def expand(self, u_free: np.ndarray) -> np.ndarray:
+        """The cell-DOF vector P u of the free values (the clamped ones 0)."""
+        u = np.zeros(self.P.shape[1])
         u[self.free] = u_free
         return self.P @ u
 

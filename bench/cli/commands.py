@@ -14,23 +14,22 @@ import pandas as pd
 from bench.cli.compare_block import check_readme, write_compare_block
 from bench.cli.diff import diff_command
 from bench.cli.guards import InputError, check_compare_out, check_output_folders
+from bench.cli.listing import list_command
 from bench.cli.parser import build_parser
 from bench.cli.progress import Progress
 from bench.cli.study import study_command
 from bench.export import export_results
 from bench.hard import (
     check_expected,
-    hard_case_descriptions,
     hard_markdown,
     hard_scene_names,
     run_hard,
     write_hard,
 )
-from bench.hard.registry import HARD_CASES
 from bench.matrix import RunConfig, run
-from bench.matrix.plugins import FAILURES, load_plugins
+from bench.matrix.plugins import load_plugins
 from bench.matrix.run import RunRefused, compare_reference_dofs
-from bench.matrix.scene_files import FILE_FAILURES, load_scene_files, scene_files_in
+from bench.matrix.scene_files import load_scene_files, scene_files_in
 from bench.matrix.store import ResultsError, read_results
 from bench.perf.scaling import SIZES, run_scaling, write_scaling
 from bench.perf.scaling_3d import SIZES_3D, run_scaling_3d, write_scaling_3d
@@ -39,16 +38,12 @@ from bench.report import write_report
 from bench.sequence.loop import LevelResult
 from bench.sequence.rows import KEYS, level_time
 from bench.verify import load_expected, verdict_table, verify
-from estimators import estimator_descriptions, estimator_names
-from estimators.base import ESTIMATORS
-from formulations import formulation_descriptions, formulation_names, solver_descriptions
-from formulations.elasticity import order_descriptions
-from formulations.registry import FORMULATIONS
+from estimators import estimator_names
+from formulations import formulation_names
 from formulations.solvers.backends import check_backend
-from formulations.solvers.backends.base import REGISTRY as BACKENDS
-from formulations.solvers.registry import FAST_SOLVER, SOLVERS, SYSTEM_SOLVERS
-from scenes import get_scene, scene_descriptions, scene_names
-from scenes.registry import BUILT_IN, SCENES, broken_units, scene_dim
+from formulations.solvers.registry import FAST_SOLVER
+from scenes import get_scene, scene_names
+from scenes.registry import SCENES, scene_dim
 
 SUMMARY_COLUMNS = ["level", "ndofs", "energy", "contact_force", "active_constraints", "eta",
                    "eta_0", "eta_geometric", "eta_complementarity", "energy_error",
@@ -69,24 +64,6 @@ def summary(table: pd.DataFrame) -> str:
         parts.append("== " + " / ".join(str(k) for k in key if str(k)))
         parts.append(group[SUMMARY_COLUMNS].to_string(index=False, float_format="{:.6g}".format))
     return "\n".join(parts)
-
-
-def list_command(args) -> int:
-    """Every registered unit with its origin (built-in, a scene file, a plugin), then any
-    plugin that failed to load."""
-    for title, items, origin in LISTINGS:
-        print(f"{title}:")
-        for name, text in items().items():
-            print(f"  {name:16s} [{origin(name)}] {text}")
-    for failure in FAILURES:
-        print(f"plugin {failure.distribution!r} skipped (entry point {failure.name!r} in "
-              f"{failure.group}): {failure.reason}")
-    for broken in FILE_FAILURES.values():
-        print(f"scene file {broken.name!r} broken, left out: {broken.reason}")
-    for kind, broken in broken_units():
-        if broken.origin not in {f"file {f.name}" for f in FILE_FAILURES.values()}:
-            print(f"{kind} {broken.name!r} broken, left out ({broken.origin}): {broken.reason}")
-    return 0
 
 
 def configured(**fields) -> RunConfig | None:
@@ -277,22 +254,6 @@ def sequence_command(args) -> int:
     print(f"wrote {write_sequences(frame, args.out, args.readme)}")
     return 0
 
-
-def _solver_origin(name: str) -> str:
-    return (SOLVERS if name in SOLVERS.names() else SYSTEM_SOLVERS).origin(name)
-
-
-def _hard_origin(name: str) -> str:
-    return (HARD_CASES if name in HARD_CASES.names() else SCENES).origin(name)
-
-
-LISTINGS = (("scenes", scene_descriptions, SCENES.origin),
-            ("formulations", formulation_descriptions, FORMULATIONS.origin),
-            ("solvers", solver_descriptions, _solver_origin),
-            ("sparse back-ends (--backend)", BACKENDS.descriptions, BACKENDS.origin),
-            ("estimators", estimator_descriptions, ESTIMATORS.origin),
-            ("orders (--order)", order_descriptions, lambda name: BUILT_IN),
-            ("hard cases", hard_case_descriptions, _hard_origin))
 
 COMMANDS = {"run": run_command, "compare": compare_command, "report": report_command,
             "export": export_command,

@@ -5,6 +5,7 @@ report's appendix)."""
 from __future__ import annotations
 
 import functools
+import json
 import os
 import platform
 import subprocess
@@ -56,3 +57,18 @@ def provenance() -> dict[str, str]:
         "machine": f"{platform.machine()} {platform.system()} {cores} cores "
                    f"{platform.processor() or ''}".strip(),
     }
+
+
+def write_run_record(out: Path, config, run_id: str, reused) -> None:
+    """run.json: this run's command, configuration and numerics, and under ``earlier`` those
+    of every earlier run into the same folder (so a folder of several runs says so)."""
+    path = Path(out) / "run.json"
+    earlier = []
+    try:
+        previous = json.loads(path.read_text())
+        earlier = previous.pop("earlier", []) + [previous]
+    except (OSError, ValueError, AttributeError):
+        pass  # none, or damaged: this run's record replaces it
+    record = {"command": config.command, "configuration": config.record(), "run_id": run_id,
+              "reused": list(reused), "numerics": numerics(), "earlier": earlier}
+    path.write_text(json.dumps(record, indent=1, default=str))

@@ -8,36 +8,35 @@ recomputed, unless ``overwrite``."""
 
 from __future__ import annotations
 
-import json
 import os
 import sys
 from collections.abc import Callable
 from dataclasses import dataclass, fields
-from pathlib import Path
 
 import pandas as pd
 
 from bench.matrix.distributed import SchedulerError, check_scheduler, scheduler_endpoint
 from bench.matrix.local import new_run_identity, run_specs, truth_name, write_truth_summary
 from bench.matrix.plugins import load_plugins
-from bench.matrix.provenance import numerics
+from bench.matrix.provenance import write_run_record
 from bench.matrix.rates import write_rates
 from bench.matrix.scene_files import load_scene_files, source_digest
 from bench.matrix.spec import (
     SequenceSpec,
     build_scene,
     check_formulation_options,
+    check_level_zero,
     cross_product,
     parse_item,
 )
 from bench.matrix.store import ResultStore
-from bench.sequence.loop import STRATEGIES, LevelResult, LoopConfig, memory_refusal
+from bench.sequence.loop import STRATEGIES, LevelResult, LoopConfig
 from bench.sequence.rows import COLUMNS, ResultRow
 from bench.truth import truth_for
 from bench.truth.cache import check_cache_folder
 from estimators import estimator_names, guaranteed_estimators
 from formulations import STATUS_FAILED, formulation_names, solver_names
-from formulations.elasticity import ORDERS, check_order, count_free_dofs, why_no_element
+from formulations.elasticity import ORDERS, check_order
 from formulations.solvers.backends import check_backend
 from formulations.solvers.registry import REFERENCE_SOLVER
 from scenes import scene_names
@@ -182,25 +181,6 @@ def prepare_truths(specs: list[SequenceSpec], crosscheck: bool = False,
         raise RunRefused(str(error)) from None
 
 
-def check_level_zero(spec: SequenceSpec, scene, max_memory_gib: float | None) -> None:
-    """Refuse (ValueError) a sequence whose starting mesh is already over its DOF budget or
-    would not fit in memory: the budgets count from level 0."""
-    if why_no_element(spec.order, scene.dim) is not None:
-        return  # a skipped row, nothing is built
-    ndofs = count_free_dofs(scene, scene.mesh, spec.order)
-    where = f"scene {spec.scene!r}" + (f" ({spec.labels['scene_parameters']})"
-                                       if spec.scene_parameters else "")
-    if ndofs > spec.max_dofs:
-        raise ValueError(f"{where} starts with {ndofs:,} DOFs at P{spec.order}, over "
-                         f"max_dofs={spec.max_dofs:,}; give a coarser starting mesh or "
-                         f"max_dofs >= {ndofs:,}")
-    refusal = memory_refusal(0, ndofs, spec.solver, spec.loop_config(max_memory_gib),
-                             scene.dim)
-    if refusal is not None:
-        raise ValueError(f"{where}: {refusal}; give a coarser starting mesh or a larger "
-                         "max_memory_gib")
-
-
 def _truths(specs: list[SequenceSpec], crosscheck: bool, max_memory_gib) -> dict:
     judged = {}  # per truth: the largest budget and order it judges, and a spec to build it
     scenes, checked = {}, set()
@@ -292,18 +272,3 @@ def _run_into(store: ResultStore, config: RunConfig, specs, truths, on_level, on
         rows = run_specs(todo, store, identity, on_level, truths, config.max_memory_gib,
                          sequence_done)
     return rows, reused
-
-
-def write_run_record(out: Path, config: RunConfig, run_id: str, reused) -> None:
-    """run.json: this run's command, configuration and numerics, and under ``earlier`` those
-    of every earlier run into the same folder (so a folder of several runs says so)."""
-    path = Path(out) / "run.json"
-    earlier = []
-    try:
-        previous = json.loads(path.read_text())
-        earlier = previous.pop("earlier", []) + [previous]
-    except (OSError, ValueError, AttributeError):
-        pass  # none, or damaged: this run's record replaces it
-    record = {"command": config.command, "configuration": config.record(), "run_id": run_id,
-              "reused": list(reused), "numerics": numerics(), "earlier": earlier}
-    path.write_text(json.dumps(record, indent=1, default=str))

@@ -11,9 +11,9 @@ import itertools
 import json
 from dataclasses import dataclass, replace
 
-from bench.sequence.loop import LoopConfig
+from bench.sequence.loop import LoopConfig, memory_refusal
 from formulations import get_formulation
-from formulations.elasticity import why_no_element
+from formulations.elasticity import count_free_dofs, why_no_element
 from formulations.registry import FORMULATIONS
 from scenes import SceneError, get_scene
 from scenes.budget import dof_budget
@@ -155,3 +155,22 @@ def check_formulation_options(spec: SequenceSpec, scene=None) -> None:
             discretise(scene, scene.mesh, order=spec.order, **dict(spec.formulation_options))
         except (ValueError, TypeError) as error:
             raise ValueError(f"formulation {spec.formulation!r}: {error}") from None
+
+
+def check_level_zero(spec: SequenceSpec, scene, max_memory_gib: float | None) -> None:
+    """Refuse (ValueError) a sequence whose starting mesh is already over its DOF budget or
+    would not fit in memory: the budgets count from level 0."""
+    if why_no_element(spec.order, scene.dim) is not None:
+        return  # a skipped row, nothing is built
+    ndofs = count_free_dofs(scene, scene.mesh, spec.order)
+    where = f"scene {spec.scene!r}" + (f" ({spec.labels['scene_parameters']})"
+                                       if spec.scene_parameters else "")
+    if ndofs > spec.max_dofs:
+        raise ValueError(f"{where} starts with {ndofs:,} DOFs at P{spec.order}, over "
+                         f"max_dofs={spec.max_dofs:,}; give a coarser starting mesh or "
+                         f"max_dofs >= {ndofs:,}")
+    refusal = memory_refusal(0, ndofs, spec.solver, spec.loop_config(max_memory_gib),
+                             scene.dim)
+    if refusal is not None:
+        raise ValueError(f"{where}: {refusal}; give a coarser starting mesh or a larger "
+                         "max_memory_gib")
