@@ -127,9 +127,9 @@ def compared_scenes(dim: int) -> list[str]:
     """The scenes of ``compare``: every scene not tagged hard of dimension ``dim``. A scene
     whose registration does not declare its dimension is built to learn it; one that fails
     to build is named once on stderr and left out."""
-    names = []
+    names, hard = [], set(hard_scene_names())
     for name in scene_names():
-        if name in hard_scene_names():
+        if name in hard:
             continue
         known = scene_dim(name)
         if known is None:
