@@ -5,7 +5,13 @@ new module with a ``@register_estimator`` ``estimate(scene, solution)`` function
 line here.
 """
 
-from estimators import averaging, equilibrated, nitsche_residual, residual  # noqa: F401  (register themselves)
+from estimators import (  # noqa: F401  (register themselves)
+    averaging,
+    equilibrated,
+    nitsche_residual,
+    quad_residual,
+    residual,
+)
 from estimators.base import (
     Estimate,
     estimator_descriptions,

@@ -54,13 +54,44 @@ ESTIMATORS = Registry("estimator")
 _GUARANTEED: set[str] = set()
 
 
-def register_estimator(name: str, description: str, applies=None, guaranteed: bool = False):
+SIMPLICES = ("tri", "tet")  # the cell families (formulations.cells) most estimators are built on
+_FAMILIES: dict[str, tuple[str, ...]] = {}  # estimator -> families its own function runs on
+_VARIANTS: dict[tuple[str, str], object] = {}  # (estimator, family) -> estimate function
+
+
+def register_estimator(name: str, description: str, applies=None, guaranteed: bool = False,
+                       families: tuple[str, ...] = SIMPLICES):
     """Register ``estimate(scene, solution) -> Estimate`` under ``name``; ``guaranteed``: its
     eta is an upper bound of the energy error with every constant computed (what
-    ``--target-error`` needs)."""
+    ``--target-error`` needs); ``families``: the cell families it runs on (others can add
+    their own ``register_cell_variant``)."""
     if guaranteed:
         _GUARANTEED.add(name)
+    _FAMILIES[name] = tuple(families)
     return ESTIMATORS.register(name, description, applies)
+
+
+def register_cell_variant(name: str, family: str):
+    """Register ``estimate(scene, solution)`` as estimator ``name`` on the cells of
+    ``family`` (a family name of ``formulations.cells``): one module, one registration."""
+    def decorate(function):
+        _VARIANTS[(name, family)] = function
+        return function
+
+    return decorate
+
+
+def estimator_on(name: str, family: str):
+    """The estimate function of ``name`` on ``family``'s cells."""
+    return _VARIANTS.get((name, family)) or ESTIMATORS.get(name)
+
+
+def why_not_on(name: str, family) -> str | None:
+    """Why estimator ``name`` does not run on ``family``'s cells (a ``CellFamily``), or
+    None."""
+    if family.name in _FAMILIES.get(name, SIMPLICES) or (name, family.name) in _VARIANTS:
+        return None
+    return f"{name} is not built on {family.shape}"
 
 
 def guaranteed_estimators() -> list[str]:

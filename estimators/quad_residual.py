@@ -15,10 +15,12 @@ from __future__ import annotations
 import numpy as np
 from skfem import Basis, ElementQuad0
 
-from estimators.base import Estimate
+from estimators.base import Estimate, register_cell_variant
+from formulations.base import DiscreteSolution
 from formulations.contact import gauss_legendre
 from formulations.elasticity import stress_tensor_from_gradient
 from formulations.quad_evaluation import QuadGradient
+from formulations.quad_vi import ContactEdges
 from scenes.quad_hierarchy import edge_keys
 
 EDGE_POINTS = 4  # Gauss points per edge: exact for the jumps of Q1 and Q2 stresses
@@ -55,6 +57,16 @@ class QuadStress:
                          for i in range(2)])
 
 
+def contact_edges_of(solution) -> ContactEdges:
+    """The contact edges of a solution: a ``DiscreteSolution``'s trace, or the edges of a
+    solution of ``formulations.quad_vi`` and ``formulations.quad_mixed``."""
+    if not isinstance(solution, DiscreteSolution):
+        return solution.edges
+    trace, mesh = solution.trace, solution.elasticity.mesh
+    return ContactEdges(trace.facets, mesh.p[:, trace.vertices[0]], mesh.p[:, trace.vertices[1]],
+                        trace.normal, trace.length, trace.element)
+
+
 def element_residuals(scene, solution, stress: QuadStress) -> np.ndarray:
     """(h_T/p)^2 ||f + div sigma(u_h)||_T^2 per cell."""
     mesh, order = solution.elasticity.basis.mesh, solution.elasticity.order
@@ -73,7 +85,7 @@ def edge_pairs(solution) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray
     conforming interior edges, and both halves of every edge with a hanging node (its fine
     cell, the coarse cell across)."""
     mesh = solution.elasticity.basis.mesh
-    hierarchy = solution.elasticity.hierarchy
+    hierarchy = mesh.hierarchy
     interior = np.flatnonzero(mesh.f2t[1] >= 0)
     a, b = mesh.facets[:, interior]
     first, second = mesh.f2t[:, interior]
@@ -117,9 +129,8 @@ def boundary_residuals(scene, solution, stress: QuadStress) -> np.ndarray:
     mesh, order, n_cells = elasticity.basis.mesh, elasticity.order, elasticity.basis.mesh.t.shape[1]
     out = np.zeros(n_cells)
     t, w = gauss_legendre(EDGE_POINTS)
-    edges = solution.edges
-    taken = np.union1d(edges.facets, elasticity.clamped)
-    neumann = np.setdiff1d(elasticity.boundary, taken)
+    edges = contact_edges_of(solution)
+    neumann = scene.neumann_facets(mesh)
     if neumann.size:
         cells = mesh.f2t[0, neumann]
         a, b = mesh.p[:, mesh.facets[0, neumann]], mesh.p[:, mesh.facets[1, neumann]]
@@ -148,7 +159,7 @@ def boundary_residuals(scene, solution, stress: QuadStress) -> np.ndarray:
 
 def contact_terms(scene, solution, stress: QuadStress) -> tuple[float, float, np.ndarray]:
     """E ||w||_0 ||w||_1, |(lambda_h, w)| and their shares per cell, w = (g - u_hn)_-."""
-    edges, basis = solution.edges, solution.elasticity.basis
+    edges, basis = contact_edges_of(solution), solution.elasticity.basis
     n_cells = basis.mesh.t.shape[1]
     if edges.facets.size == 0:
         return 0.0, 0.0, np.zeros(n_cells)
@@ -180,6 +191,7 @@ def contact_terms(scene, solution, stress: QuadStress) -> tuple[float, float, np
     return geometric, float(complementarity.sum()), shares
 
 
+@register_cell_variant("residual", "quad")
 def quad_residual_estimate(scene, solution) -> Estimate:
     """eta of the paper's (8) for a quadrilateral contact solution, per-cell indicators."""
     stress = QuadStress(solution)

@@ -18,21 +18,18 @@ import numpy as np
 from skfem import CellBasis, MeshTri
 from skfem.element import Element
 
-CENTROID_RULE = (np.full((2, 1), 1.0 / 3.0), np.array([0.5]))  # reference triangle, weight = area
-# the reference tetrahedron's centroid, weight its volume
-TET_CENTROID_RULE = (np.full((3, 1), 1.0 / 4.0), np.array([1.0 / 6.0]))
-
 
 class DofBasis(CellBasis):
-    """A ``CellBasis`` on ``CENTROID_RULE`` whose ``basis`` (the basis functions' values and
-    gradients there) is computed when first asked for; otherwise scikit-fem's own."""
+    """A ``CellBasis`` on the centroid rule of its cells (points (d, 1), weight) whose
+    ``basis`` (the basis functions' values and gradients there) is computed when first asked
+    for; otherwise scikit-fem's own."""
 
-    def __init__(self, mesh: MeshTri, elem: Element):
+    def __init__(self, mesh: MeshTri, elem: Element, centroid_rule: tuple):
         d = mesh.dim()
         # numbering and maps, no values
         super().__init__(mesh, elem, quadrature=(np.zeros((d, 0)), np.zeros(0)))
         self.__dict__.pop("basis", None)  # scikit-fem's empty list: the property below answers
-        self.X, self.W = CENTROID_RULE if d == 2 else TET_CENTROID_RULE
+        self.X, self.W = centroid_rule
         self.dx = np.abs(self.mapping.detDF(self.X)) * np.broadcast_to(self.W, (self.nelems, 1))
 
     @functools.cached_property

@@ -1,8 +1,11 @@
-"""Lagrange P_p (p = 1, 2, 3 on triangles; p = 1, 2 on tetrahedra) linear elasticity on
-scikit-fem: stiffness, loads, stresses (docs/theory.md, sections 1, 9 and 14).
+"""Linear elasticity on scikit-fem for every cell family (``formulations.cells``): Lagrange
+P_p on simplices, Q_p on quadrilaterals and hexahedra; stiffness, loads, stresses
+(docs/theory.md, sections 1, 9, 14 and 15).
 
 Plane stress uses lambda* = E nu / (1 - nu^2), plane strain lambda = E nu / ((1+nu)(1-2nu)).
-Everything is vectorised over elements by scikit-fem's assembly.
+Everything is vectorised over elements by scikit-fem's assembly. On a mesh with hanging nodes
+the family's constraint P joins the cells: the unknowns are the conforming DOFs, the systems
+P' K P and P' F (docs/theory.md, section 15.2).
 """
 
 from __future__ import annotations
@@ -12,39 +15,22 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy import sparse
-from skfem import (
-    Basis,
-    ElementTetP1,
-    ElementTetP2,
-    ElementTriP1,
-    ElementTriP2,
-    ElementTriP3,
-    ElementVector,
-    FacetBasis,
-    LinearForm,
-    MeshTri,
-    asm,
-)
-from skfem.helpers import dot
-from skfem.models.elasticity import linear_elasticity
+from skfem import Basis, ElementVector, MeshTri
 
+from formulations.cells import DEFAULT_CELL, family_for, family_of
+from formulations.cells.triangle import TRIANGLES, predict_uniform_free_dofs  # noqa: F401
 from formulations.dof_basis import DofBasis
-from formulations.load import body_load
-from formulations.p1_stiffness import p1_stiffness
-from formulations.p2_stiffness import p2_stiffness
-from formulations.tet_stiffness import tet_stiffness
 from scenes import Scene
 from scenes.base import is_integer
-from scenes.topology import RefinementPlan, ensure_topology
+from scenes.topology import ensure_topology
 
-ELEMENTS = {1: ElementTriP1, 2: ElementTriP2, 3: ElementTriP3}
+ELEMENTS = TRIANGLES.elements
 ORDERS = tuple(ELEMENTS)
-TET_ELEMENTS = {1: ElementTetP1, 2: ElementTetP2}  # scikit-fem has no P3 tetrahedron
 
 
-def scalar_elements(dim: int) -> dict:
-    """The scalar Lagrange elements by order on a mesh of dimension ``dim``."""
-    return ELEMENTS if dim == 2 else TET_ELEMENTS
+def scalar_elements(dim: int, cell: str = DEFAULT_CELL) -> dict:
+    """The scalar Lagrange elements by order of the family of ``cell`` in ``dim`` dimensions."""
+    return family_for(cell, dim).elements
 
 
 def order_descriptions() -> dict[str, str]:
@@ -60,32 +46,30 @@ def check_order(order) -> int:
     return int(order)
 
 
-def check_order_in(order, dim: int) -> int:
-    """``check_order``, and refused in 3D above the orders tetrahedra have here."""
+def check_order_in(order, dim: int, cell: str = DEFAULT_CELL) -> int:
+    """``check_order``, and refused above the orders the family has here."""
     order = check_order(order)
-    if order not in scalar_elements(dim):
-        raise ValueError(f"order={order!r} is not one of "
-                         f"{', '.join(map(str, scalar_elements(dim)))} in {dim}D")
+    why = family_for(cell, dim).why_no_element(order)
+    if why is not None:
+        raise ValueError(f"order={order!r}: {why}")
     return order
 
 
-def why_no_element(order: int, dim: int) -> str | None:
-    """Why there is no P_order element in ``dim`` dimensions here, or None."""
-    if order in scalar_elements(dim):
-        return None
-    return (f"order {order} on {'triangles' if dim == 2 else 'tetrahedra'} is not available "
-            f"(orders {', '.join(map(str, scalar_elements(dim)))})")
+def why_no_element(order: int, dim: int, cell: str = DEFAULT_CELL) -> str | None:
+    """Why there is no element of ``order`` on the cells of ``cell`` in ``dim`` dimensions."""
+    return family_for(cell, dim).why_no_element(order)
 
 
-def vector_element(order: int = 1, dim: int = 2) -> ElementVector:
-    """The displacement element: vector Lagrange P_order on triangles (tetrahedra in 3D)."""
-    return ElementVector(scalar_elements(dim)[check_order_in(order, dim)]())
+def vector_element(order: int = 1, dim: int = 2, cell: str = DEFAULT_CELL) -> ElementVector:
+    """The displacement element: vector Lagrange of ``order`` on the family's cells."""
+    return ElementVector(scalar_elements(dim, cell)[check_order_in(order, dim, cell)]())
 
 
 @dataclass(frozen=True, eq=False)
 class Elasticity:
-    """Assembled elasticity operator on one mesh; K and F are over ALL DOFs, ``free`` excludes
-    the clamped DOFs on Gamma_D (u = 0 there)."""
+    """Assembled elasticity operator on one mesh. K and F are over the basis's DOFs (every
+    cell DOF); ``constraint`` (None on conforming meshes) is P from the conforming DOFs to
+    them, and ``free`` the conforming DOFs off Gamma_D (u = 0 there): the unknowns."""
 
     mesh: MeshTri
     basis: Basis
@@ -94,6 +78,7 @@ class Elasticity:
     F: np.ndarray
     free: np.ndarray
     order: int = 1
+    constraint: sparse.csr_matrix | None = None
 
     @property
     def ndofs(self) -> int:
@@ -101,12 +86,35 @@ class Elasticity:
         return int(self.free.size)
 
     @functools.cached_property
+    def _free_columns(self) -> sparse.csr_matrix | None:
+        """P restricted to the free DOFs (None on conforming meshes)."""
+        return None if self.constraint is None else self.constraint[:, self.free].tocsr()
+
+    @functools.cached_property
     def K_free(self) -> sparse.csr_matrix:
-        """K on the free DOFs (built once)."""
-        return self.K[self.free][:, self.free].tocsr()
+        """K on the unknowns (built once): P_f' K P_f with hanging nodes."""
+        if self.constraint is None:
+            return self.K[self.free][:, self.free].tocsr()
+        P = self._free_columns
+        return (P.T @ self.K @ P).tocsr()
+
+    @property
+    def F_free(self) -> np.ndarray:
+        """F on the unknowns: P_f' F with hanging nodes."""
+        return self.F[self.free] if self.constraint is None else self._free_columns.T @ self.F
+
+    def restrict(self, B: sparse.spmatrix) -> sparse.csr_matrix:
+        """Rows over the basis's DOFs (contact constraints, traces) as rows over the
+        unknowns: B P_f."""
+        if self.constraint is None:
+            return B.tocsr()[:, self.free].tocsr()
+        return (B @ self._free_columns).tocsr()
 
     def expand(self, u_free: np.ndarray) -> np.ndarray:
-        """Full DOF vector from the free DOFs (zero on Gamma_D)."""
+        """Every DOF of the basis from the unknowns (zero on Gamma_D; P u with hanging
+        nodes)."""
+        if self.constraint is not None:
+            return self._free_columns @ u_free
         u = np.zeros(self.basis.N)
         u[self.free] = u_free
         return u
@@ -134,16 +142,16 @@ class Elasticity:
 
 def dof_basis(mesh: MeshTri, order: int = 1) -> Basis:
     """The displacement basis an ``Elasticity`` carries: its DOF numbering, element maps and
-    element, on the one-point centroid rule (nothing integrates with it: each integral builds
-    the basis of its own rule, and the quadrature data of a default basis cost more than K)."""
-    return DofBasis(mesh, vector_element(order, mesh.dim()))
+    element, on the one-point centroid rule of its cells (nothing integrates with it: each
+    integral builds the basis of its own rule, and the quadrature data of a default basis
+    cost more than K)."""
+    family = family_of(mesh)
+    return DofBasis(mesh, ElementVector(family.elements[order]()), family.centroid_rule)
 
 
 def element_diameters(mesh: MeshTri) -> np.ndarray:
-    """Longest edge of every triangle or tetrahedron (h_T)."""
-    p, k = mesh.p[:, mesh.t], mesh.t.shape[0]
-    return np.max([np.linalg.norm(p[:, i] - p[:, j], axis=0)
-                   for i in range(k) for j in range(i + 1, k)], axis=0)
+    """h_T of every cell: its longest distance between two vertices."""
+    return family_of(mesh).diameters(mesh)
 
 
 def stress_tensor_from_gradient(grad: np.ndarray, lam: float, mu: float) -> np.ndarray:
@@ -175,90 +183,45 @@ def von_mises(stress: np.ndarray) -> np.ndarray:
 
 
 def assemble_elasticity(scene: Scene, mesh: MeshTri, order: int = 1) -> Elasticity:
-    """Stiffness K, load F = (f, v) + (q, v)_{Gamma_N}, and the free DOFs for ``mesh`` with
-    P_order displacements."""
-    order = check_order_in(order, mesh.dim())
+    """Stiffness K, load F = (f, v) + (q, v)_{Gamma_N}, the free DOFs and (with hanging
+    nodes) the constraint for ``mesh`` with the family's elements of ``order``."""
+    family = family_of(mesh)
+    order = check_order_in(order, mesh.dim(), family.cell)
     ensure_topology(mesh)
     basis = dof_basis(mesh, order)
     lam, mu = scene.material.lame
-    if mesh.dim() == 3:  # local matrices on affine tetrahedra (formulations.tet_stiffness)
-        K = tet_stiffness(basis, lam, mu)
-    elif order == 1:  # constant strains: the closed-form local matrices (formulations.p1_stiffness)
-        K = p1_stiffness(mesh, lam, mu)
-    elif order == 2:  # the same straight into CSR (formulations.p2_stiffness)
-        K = p2_stiffness(mesh, lam, mu)
-    else:  # strain products have degree 2(p - 1): a rule of that order is exact
-        stiffness_basis = Basis(mesh, basis.elem, intorder=2 * (order - 1))
-        K = asm(linear_elasticity(lam, mu), stiffness_basis).tocsr()
+    K = family.stiffness(basis, lam, mu, order)
     F = np.zeros(basis.N)
-    if scene.body_force is not None:  # scikit-fem's default rule, of order 2p
-        F += body_load(scene.body_force, Basis(mesh, basis.elem))
+    if scene.body_force is not None:
+        F += family.body_load(scene.body_force, basis, order)
     neumann = scene.neumann_facets(mesh)
     if scene.traction is not None and neumann.size:
-        @LinearForm
-        def surface(v, w):
-            return dot(scene.traction(w.x), v)
-
-        F += asm(surface, FacetBasis(mesh, basis.elem, facets=neumann,
-                                     intorder=max(4, 2 * order)))
-    free = free_dofs(basis, scene.dirichlet_facets(mesh))
-    return Elasticity(mesh=mesh, basis=basis, lame=(lam, mu), K=K, F=F, free=free, order=order)
+        F += family.traction_load(scene.traction, basis, neumann, order)
+    constraint = family.constraint(basis)
+    free = free_dofs(basis, scene.dirichlet_facets(mesh), constraint)
+    return Elasticity(mesh=mesh, basis=basis, lame=(lam, mu), K=K, F=F, free=free, order=order,
+                      constraint=constraint)
 
 
-def free_dofs(basis: Basis, dirichlet: np.ndarray) -> np.ndarray:
-    """The DOFs not on a clamped facet, sorted."""
-    is_free = np.ones(basis.N, dtype=bool)  # a mask, not a sorted set difference: O(N)
-    is_free[basis.get_dofs(dirichlet).all()] = False
-    return np.flatnonzero(is_free)
-
-
-def lagrange_dofs(vertices: int, edges: int, triangles: int, order: int) -> int:
-    """Scalar P_order DOFs of a mesh: one per vertex, p - 1 per edge, (p-1)(p-2)/2 inside."""
-    return vertices + (order - 1) * edges + (order - 1) * (order - 2) // 2 * triangles
+def free_dofs(basis: Basis, dirichlet: np.ndarray,
+              constraint: sparse.csr_matrix | None = None) -> np.ndarray:
+    """The DOFs (conforming ones, with a constraint) not on a clamped facet, sorted."""
+    if constraint is None:
+        is_free = np.ones(basis.N, dtype=bool)  # a mask, not a sorted set difference: O(N)
+        is_free[basis.get_dofs(dirichlet).all()] = False
+        return np.flatnonzero(is_free)
+    fixed = np.zeros(basis.N)
+    fixed[basis.get_dofs(dirichlet).all()] = 1.0
+    return np.flatnonzero(np.asarray(constraint.T @ fixed).ravel() == 0)
 
 
 def count_free_dofs(scene: Scene, mesh: MeshTri, order: int = 1) -> int:
     """The number of unknowns ``assemble_elasticity`` would give on ``mesh``, without
-    assembling: two per Lagrange node, none on a node of a clamped facet."""
-    dirichlet = scene.dirichlet_facets(mesh)
-    if mesh.dim() == 3:  # P1, P2: one node per vertex, p - 1 per edge
-        clamped = (np.unique(mesh.facets[:, dirichlet]).size
-                   + (order - 1) * np.unique(mesh.f2e[:, dirichlet]).size)
-        return int(3 * (mesh.p.shape[1] + (order - 1) * mesh.edges.shape[1] - clamped))
-    clamped = np.unique(mesh.facets[:, dirichlet]).size + (order - 1) * dirichlet.size
-    nodes = lagrange_dofs(mesh.p.shape[1], mesh.facets.shape[1], mesh.t.shape[1], order)
-    return int(2 * (nodes - clamped))
+    assembling (the family counts them)."""
+    return family_of(mesh).count_free_dofs(scene, mesh, order)
 
 
-def predict_refined_free_dofs(scene: Scene, plan: RefinementPlan, order: int = 1) -> int:
-    """``count_free_dofs`` of ``plan.refined`` without splitting a triangle: a red-green-blue
-    split adds one vertex per split facet, which becomes two facets (two clamped ones on
-    Gamma_D), and k triangles and k interior edges to a triangle with k split edges. A plan
-    that scikit-fem carries out itself is counted after refining (uniform ones by
-    ``predict_uniform_free_dofs``)."""
-    mesh = plan.mesh
-    if mesh.dim() == 3:
-        return count_free_dofs(scene, plan.refined, order)
-    if plan.split is None:
-        return (predict_uniform_free_dofs(scene, mesh, order) if plan.marked is None
-                else count_free_dofs(scene, plan.refined, order))
-    dirichlet = scene.dirichlet_facets(mesh)
-    new_vertices, more = plan.new_vertices(), int(plan.new_elements_per_element().sum())
-    split_clamped = int(np.count_nonzero(plan.split[dirichlet]))
-    clamped = (np.unique(mesh.facets[:, dirichlet]).size + split_clamped
-               + (order - 1) * (dirichlet.size + split_clamped))
-    nodes = lagrange_dofs(mesh.p.shape[1] + new_vertices,
-                          mesh.facets.shape[1] + new_vertices + more, mesh.t.shape[1] + more,
-                          order)
-    return int(2 * (nodes - clamped))
-
-
-def predict_uniform_free_dofs(scene: Scene, mesh: MeshTri, order: int = 1) -> int:
-    """``count_free_dofs`` of ``mesh.refined()``, without refining: uniform refinement adds one
-    vertex per edge, splits every edge in two and adds three inside every triangle (which
-    becomes four); each clamped facet adds one clamped vertex and becomes two facets."""
-    dirichlet = scene.dirichlet_facets(mesh)
-    nv, ne, nt = mesh.p.shape[1], mesh.facets.shape[1], mesh.t.shape[1]
-    clamped = (np.unique(mesh.facets[:, dirichlet]).size + dirichlet.size
-               + (order - 1) * 2 * dirichlet.size)
-    return int(2 * (lagrange_dofs(nv + ne, 2 * ne + 3 * nt, 4 * nt, order) - clamped))
+def predict_refined_free_dofs(scene: Scene, plan, order: int = 1) -> int:
+    """``count_free_dofs`` of a refinement plan's mesh (``formulations.cells.base.Plan``),
+    predicted without making it where the family can."""
+    return plan.free_dofs(scene, order)

@@ -160,8 +160,8 @@ def discretise(scene: Scene, mesh: MeshTri, h_over_H: float = 0.5, order: int = 
     t, w = gauss_legendre(GAP_QUADRATURE_POINTS)
     G = segment_weights(trace, segment, breaks, degree, t, w) @ np.ravel(
         scene.gap(trace.points(t)))
-    qp = ContactQP(K=elasticity.K_free, F=elasticity.F[elasticity.free],
-                   B=B[:, elasticity.free].tocsr(), G=G, row_scale=np.repeat(H, degree + 1),
+    qp = ContactQP(K=elasticity.K_free, F=elasticity.F_free,
+                   B=elasticity.restrict(B), G=G, row_scale=np.repeat(H, degree + 1),
                    objective_scale=float(scene.material.young_modulus))
     # each coefficient sits at its Greville point k / q of the segment (the middle for q = 0)
     greville = np.array([0.5]) if degree == 0 else np.linspace(0.0, 1.0, degree + 1)
@@ -208,8 +208,8 @@ def discretise_surface(scene: Scene, mesh, h_over_H: float, order: int,
     t, w = surface.rule(GAP_RULE_DEGREE)
     G = patch_sum(patch, t.shape[1]) @ (np.asarray(scene.gap(surface.points(t)))
                                         * np.outer(surface.measure, w)).ravel()
-    qp = ContactQP(K=elasticity.K_free, F=elasticity.F[elasticity.free],
-                   B=drop_roundoff(B[:, elasticity.free].tocsr()), G=G, row_scale=area,
+    qp = ContactQP(K=elasticity.K_free, F=elasticity.F_free,
+                   B=drop_roundoff(elasticity.restrict(B)), G=G, row_scale=area,
                    objective_scale=float(scene.material.young_modulus))
     centroid = np.array([np.bincount(patch, weights=c * surface.measure) / area
                          for c in surface.coordinate.mean(axis=1)])

@@ -100,13 +100,13 @@ def pressure_function(gap_h, elasticity, trace, gamma_facet: np.ndarray, u_free:
 def nitsche_system(scene: Scene, elasticity, trace, gap_h, t: np.ndarray, w: np.ndarray,
                    gamma_facet: np.ndarray, theta: float) -> SemismoothSystem:
     """The discrete equation of the module docstring as a ``SemismoothSystem``."""
-    free, nq = elasticity.free, t.shape[-1]
+    nq = t.shape[-1]
     at = evaluate_on_trace(elasticity.basis, trace, t)
     normal = np.repeat(trace.normal, nq, axis=1)
     return SemismoothSystem(
-        K=elasticity.K_free, F=elasticity.F[free],
-        S=at.normal_stress_matrix(normal, elasticity.lame)[:, free].tocsr(),
-        N=at.matrix(normal)[:, free].tocsr(),
+        K=elasticity.K_free, F=elasticity.F_free,
+        S=elasticity.restrict(at.normal_stress_matrix(normal, elasticity.lame)),
+        N=elasticity.restrict(at.matrix(normal)),
         gap=gap_h(t).ravel(),
         weight=np.tile(w, trace.size) * np.repeat(trace.measure, nq),
         gamma=np.repeat(gamma_facet, nq), theta=float(theta),

@@ -137,19 +137,19 @@ def discretise(scene: Scene, mesh: MeshTri, epsilon_0: float = DEFAULT_EPSILON_0
     ns = nf * nq
     gap_h = gap_interpolant(scene, trace, order)
     gap = gap_h(t)
-    P = normal_trace_matrix(elasticity.basis, trace, t)[:, elasticity.free].tocsr()
+    P = elasticity.restrict(normal_trace_matrix(elasticity.basis, trace, t))
     if trace.dim == 3:  # round-off of the functions that vanish on the facet, and normal
         P = drop_roundoff(P)  # components it lacks: not columns of the Schur set
     epsilon = epsilon_0 * trace.diameter / (order**2 * young)
     # per Gauss point: eps, and Gauss weight x facet measure (its share of Gamma_C)
     row_epsilon, row_length = np.repeat(epsilon, nq), np.tile(w, nf) * np.repeat(trace.measure,
                                                                                  nq)
-    system = SemismoothSystem(K=elasticity.K_free, F=elasticity.F[elasticity.free],
+    system = SemismoothSystem(K=elasticity.K_free, F=elasticity.F_free,
                               S=sparse.csr_matrix((0, n)), N=P, gap=gap.ravel(),
                               weight=row_length, gamma=1.0 / row_epsilon, theta=0.0,
                               objective_scale=young)
     # D_q = w_q |e| / eps_e = p^2 E w_q / eps_0 (|e| / h_e: 1 in 2D, exactly)
-    qp = slack_qp(elasticity.K_free, elasticity.F[elasticity.free], P, gap.ravel(),
+    qp = slack_qp(elasticity.K_free, elasticity.F_free, P, gap.ravel(),
                   order**2 * young / epsilon_0 * np.tile(w, nf)
                   * np.repeat(trace.measure / trace.diameter, nq), young)
     pressure_floor = young * np.abs(gap).max(initial=0.0) / trace.measure.sum()

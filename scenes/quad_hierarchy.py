@@ -18,6 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from skfem import MeshQuad
+from skfem.mesh import MeshQuad1
 
 from scenes.budget import check_vertex_count
 
@@ -81,9 +82,10 @@ class QuadHierarchy:
         return self._leaf_mesh
 
     @functools.cached_property
-    def _leaf_mesh(self) -> MeshQuad:
+    def _leaf_mesh(self) -> QuadLeafMesh:
         used, local = self.leaf_vertices()
-        return MeshQuad(np.ascontiguousarray(self.p[:, used]), np.ascontiguousarray(local))
+        return QuadLeafMesh(np.ascontiguousarray(self.p[:, used]), np.ascontiguousarray(local),
+                            hierarchy=self)
 
     def leaf_vertices(self) -> tuple[np.ndarray, np.ndarray]:
         """The hierarchy's vertices the leaves use, and the leaves renumbered on them."""
@@ -169,3 +171,27 @@ class QuadHierarchy:
         middle = self.midpoints(edge_keys(a, b))
         split = middle >= 0
         return middle[split], a[split], b[split]
+
+
+@dataclass(repr=False)
+class QuadLeafMesh(MeshQuad1):
+    """The leaves of a ``QuadHierarchy`` as a scikit-fem mesh that knows its hierarchy. Its
+    boundary facets are the body's: scikit-fem sees each side of an edge with a hanging node
+    as a boundary facet (the leaves do not share it), and those are left out, so that a
+    scene's boundary predicates and loads never meet them."""
+
+    hierarchy: QuadHierarchy | None = None
+
+    def boundary_facets(self) -> np.ndarray:
+        return self._body_boundary
+
+    @functools.cached_property
+    def _body_boundary(self) -> np.ndarray:
+        facets = np.flatnonzero(self.f2t[1] == -1)
+        if self.hierarchy is None:
+            return facets
+        used, _ = self.hierarchy.leaf_vertices()
+        node, a, b = self.hierarchy.hanging()
+        inner = np.concatenate([edge_keys(a, b), edge_keys(a, node), edge_keys(node, b)])
+        keys = edge_keys(used[self.facets[0, facets]], used[self.facets[1, facets]])
+        return facets[~np.isin(keys, inner)]

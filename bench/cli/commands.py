@@ -94,7 +94,7 @@ def run_command(args) -> int:
     config = configured(
         scenes=args.scene, formulations=args.formulation, solvers=args.solver,
         estimators=args.estimator, strategies=args.strategy, orders=args.order,
-        max_dofs=args.max_dofs,
+        cells=args.cell, max_dofs=args.max_dofs,
         max_levels=args.max_levels, marking=args.marking, theta=args.theta,
         backend=args.backend, nested=not args.cold_start, reference_dofs=args.reference_dofs,
         reference_crosscheck=args.reference_crosscheck, crosscheck_dofs=args.crosscheck_dofs,
@@ -153,7 +153,7 @@ def compare_command(args) -> int:
     config = configured(
         scenes=compared_scenes(args.dim),
         formulations=formulation_names(), solvers=(FAST_SOLVER,),
-        estimators=estimator_names(), strategies=("uniform", "adaptive"),
+        estimators=estimator_names(), strategies=("uniform", "adaptive"), cells=args.cell,
         max_dofs=args.max_dofs,
         reference_dofs=compare_reference_dofs(args.reference_dofs, args.dim),
         crosscheck_dofs=args.crosscheck_dofs, max_memory_gib=args.max_memory, out=args.out,

@@ -10,6 +10,7 @@ import sys
 from bench.matrix.distributed import SchedulerError, scheduler_endpoint
 from bench.matrix.spec import parse_item
 from bench.perf.sequence import SEQUENCES
+from formulations.cells import cell_names
 from formulations.elasticity import ORDERS
 
 
@@ -42,6 +43,11 @@ def name_list(kind: str, valid: list[str], plural: str | None = None, sweep: boo
                   file=sys.stderr)
         return once
     return parse
+
+
+def cell_list(text: str) -> list[str]:
+    """A comma-separated list of cell shapes (``formulations.cells``)."""
+    return name_list("cell", cell_names())(text)
 
 
 def order_list(text: str) -> list[int]:

@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 
 from bench.cli.option_types import (
+    cell_list,
     gib,
     name_list,
     non_negative_int,
@@ -25,6 +26,7 @@ from bench.sequence.loop import STRATEGIES
 from bench.sequence.marking import MARKINGS
 from estimators import estimator_names
 from formulations import formulation_names, solver_names
+from formulations.cells import DEFAULT_CELL, cell_names
 from formulations.elasticity import ORDERS
 from formulations.solvers.backends import backend_names
 from formulations.solvers.registry import REFERENCE_SOLVER
@@ -98,6 +100,7 @@ def _run_parser(sub) -> None:
                      help="polynomial order(s) p of the displacements, comma-separated, from "
                           f"{', '.join(map(str, ORDERS))}; every formulation and estimator "
                           "runs at each (default: 1)")
+    _cell_option(run, "every formulation and estimator runs on each")
     run.add_argument("--max-dofs", type=positive_int("max_dofs"), default=20000,
                      help="DOF budget: stop before a level with more unknowns (default: 20000)")
     run.add_argument("--max-levels", type=positive_int("max_levels"), default=40,
@@ -136,6 +139,13 @@ def _run_parser(sub) -> None:
     run.add_argument("--overwrite", action="store_true",
                      help="delete earlier results in OUT first (default: keep them, and reuse "
                           "every sequence an earlier run finished with the same settings)")
+
+
+def _cell_option(parser, each: str) -> None:
+    parser.add_argument("--cell", type=cell_list, default=[DEFAULT_CELL],
+                        help=f"cell shape(s), comma-separated: {', '.join(cell_names())} (tri: "
+                             "triangles, tetrahedra in 3D; quad: quadrilaterals with hanging "
+                             f"nodes, hexahedra in 3D); {each} (default: {DEFAULT_CELL})")
 
 
 def _report_parser(sub) -> None:
@@ -177,6 +187,7 @@ def _compare_parser(sub) -> None:
         "hard case into the same folder, then render the report.")
     compare.add_argument("--max-dofs", type=positive_int("max_dofs"), default=20000,
                          help="DOF budget per sequence (default: 20000)")
+    _cell_option(compare, "the whole comparison runs on each")
     compare.add_argument("--reference-dofs", type=positive_int("reference_dofs"),
                          default=None,
                          help="DOF budget of the overkill references (default: "

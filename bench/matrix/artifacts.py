@@ -15,7 +15,7 @@ import numpy as np
 
 from bench.measure.contact import contact_zone
 from bench.measure.discretisation_error import element_energy_errors
-from bench.sequence.rows import KEYS
+from bench.sequence.rows import name_parts
 from formulations.contact_surface import TRIANGLE_VERTICES
 from formulations.elasticity import von_mises
 
@@ -31,11 +31,11 @@ def file_stem(*parts) -> str:
 
 
 def artifact_path(out: str | Path, row) -> Path:
-    return Path(out) / "artifacts" / f"{file_stem(*(getattr(row, k) for k in KEYS))}.npz"
+    return Path(out) / "artifacts" / f"{file_stem(*name_parts(row))}.npz"
 
 
 def level_artifact_path(out: str | Path, row) -> Path:
-    return (Path(out) / "artifacts" / "levels" / file_stem(*(getattr(row, k) for k in KEYS))
+    return (Path(out) / "artifacts" / "levels" / file_stem(*name_parts(row))
             / f"level-{row.level:03d}.npz")
 
 

@@ -36,6 +36,7 @@ from bench.truth import truth_for
 from bench.truth.cache import check_cache_folder
 from estimators import estimator_names, guaranteed_estimators
 from formulations import STATUS_FAILED, formulation_names, solver_names
+from formulations.cells import DEFAULT_CELL, cell_names, check_cell
 from formulations.elasticity import ORDERS, check_order
 from formulations.solvers.backends import check_backend
 from formulations.solvers.registry import REFERENCE_SOLVER
@@ -73,6 +74,7 @@ class RunConfig:
     estimators: tuple[str, ...] = ("residual",)
     strategies: tuple[str, ...] = ("adaptive",)
     orders: tuple[int, ...] = (1,)  # polynomial orders of the displacements, a matrix dimension
+    cells: tuple[str, ...] = (DEFAULT_CELL,)  # cell shapes (formulations.cells), a dimension
     max_dofs: int = 20000
     max_levels: int = 40
     marking: str = "doerfler"
@@ -115,6 +117,12 @@ class RunConfig:
                              f"{', '.join(map(str, ORDERS))}")
         for order in self.orders:
             check_order(order)
+        object.__setattr__(self, "cells", tuple(self.cells))
+        if not self.cells or len(set(self.cells)) < len(self.cells):
+            raise ValueError(f"cells={list(self.cells)!r}: give each cell once, from "
+                             f"{', '.join(cell_names())}")
+        for cell in self.cells:
+            check_cell(cell)
         for name in ("reference_dofs", "crosscheck_dofs", "workers"):
             value = getattr(self, name)
             if value is not None and not (is_integer(value) and value >= 0):
@@ -137,6 +145,7 @@ class RunConfig:
             [s for item in self.scenes for s in parse_item(item, "scenes")],
             [f for item in self.formulations for f in parse_item(item, "formulations")],
             self.solvers, self.estimators, self.strategies, self.orders, self.loop(),
+            cells=self.cells,
             reference_dofs=self.reference_dofs, crosscheck_dofs=self.crosscheck_dofs,
             scene_source=source_digest(self.scene_files))
 

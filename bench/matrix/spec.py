@@ -13,7 +13,8 @@ from dataclasses import dataclass, replace
 
 from bench.sequence.loop import LoopConfig, memory_refusal
 from formulations import get_formulation
-from formulations.elasticity import count_free_dofs, why_no_element
+from formulations.cells import DEFAULT_CELL, family_for
+from formulations.elasticity import why_no_element
 from formulations.registry import FORMULATIONS
 from scenes import SceneError, get_scene
 from scenes.budget import dof_budget
@@ -41,6 +42,7 @@ class SequenceSpec:
 
     strategy = property(lambda self: self.loop.strategy)
     order = property(lambda self: self.loop.order)
+    cell = property(lambda self: self.loop.cell)
     max_dofs = property(lambda self: self.loop.max_dofs)
     backend = property(lambda self: self.loop.solver_options.get("backend"))
 
@@ -60,6 +62,8 @@ class SequenceSpec:
             fields["scene_source"] = self.scene_source
         if loop.target_error:
             fields["target_error"] = loop.target_error
+        if loop.cell != DEFAULT_CELL:
+            fields["cell"] = loop.cell
         text = json.dumps({**fields, "version": SPEC_VERSION}, sort_keys=True, default=str)
         return hashlib.sha256(text.encode()).hexdigest()[:20]
 
@@ -74,17 +78,29 @@ class SequenceSpec:
 
 
 def cross_product(scenes, formulations, solvers, estimators, strategies, orders, loop: LoopConfig,
-                  **settings) -> list[SequenceSpec]:
+                  cells=(DEFAULT_CELL,), **settings) -> list[SequenceSpec]:
     """Every combination as a spec; ``scenes`` and ``formulations`` are (name, parameter
     pairs) as ``parse_item`` gives them, ``loop`` the loop settings every spec shares (its
-    strategy and order replaced per spec), ``settings`` the remaining fields."""
+    strategy, order and cell replaced per spec), ``settings`` the remaining fields."""
     return [SequenceSpec(scene=scene, formulation=formulation, solver=solver,
-                         estimator=estimator, loop=replace(loop, strategy=strategy, order=order),
+                         estimator=estimator,
+                         loop=replace(loop, strategy=strategy, order=order, cell=cell),
                          scene_parameters=tuple(sorted(parameters)),
                          formulation_options=tuple(sorted(options)), **settings)
-            for (scene, parameters), (formulation, options), solver, estimator, strategy, order
-            in itertools.product(scenes, formulations, solvers, estimators, strategies,
-                                 orders)]
+            for (scene, parameters), (formulation, options), solver, estimator, strategy, order,
+            cell in itertools.product(scenes, formulations, solvers, estimators, strategies,
+                                      orders, cells)]
+
+
+def why_no_cells(spec: SequenceSpec, scene) -> str | None:
+    """Why the spec's cells cannot carry ``scene`` (no family of that shape in its dimension,
+    the family's own refusal, or no element of the order), or None."""
+    try:
+        family = family_for(spec.cell, scene.dim)
+    except ValueError as error:
+        return str(error)
+    return (family.why_not(scene, spec.strategy)
+            or why_no_element(spec.order, scene.dim, spec.cell))
 
 
 def label(pairs) -> str:
@@ -149,10 +165,11 @@ def check_formulation_options(spec: SequenceSpec, scene=None) -> None:
                          "--order (RunConfig.orders), not as a formulation option")
     discretise = get_formulation(spec.formulation)
     check_parameters("formulation", spec.formulation, spec.formulation_options, discretise)
-    if scene is not None and why_no_element(spec.order, scene.dim) is None and \
+    if scene is not None and why_no_cells(spec, scene) is None and \
             FORMULATIONS.why_not(spec.formulation, scene=scene) is None:  # else a skipped row
+        mesh = family_for(spec.cell, scene.dim).starting_mesh(scene)
         try:
-            discretise(scene, scene.mesh, order=spec.order, **dict(spec.formulation_options))
+            discretise(scene, mesh, order=spec.order, **dict(spec.formulation_options))
         except (ValueError, TypeError) as error:
             raise ValueError(f"formulation {spec.formulation!r}: {error}") from None
 
@@ -160,9 +177,10 @@ def check_formulation_options(spec: SequenceSpec, scene=None) -> None:
 def check_level_zero(spec: SequenceSpec, scene, max_memory_gib: float | None) -> None:
     """Refuse (ValueError) a sequence whose starting mesh is already over its DOF budget or
     would not fit in memory: the budgets count from level 0."""
-    if why_no_element(spec.order, scene.dim) is not None:
+    if why_no_cells(spec, scene) is not None:
         return  # a skipped row, nothing is built
-    ndofs = count_free_dofs(scene, scene.mesh, spec.order)
+    family = family_for(spec.cell, scene.dim)
+    ndofs = family.count_free_dofs(scene, family.starting_mesh(scene), spec.order)
     where = f"scene {spec.scene!r}" + (f" ({spec.labels['scene_parameters']})"
                                        if spec.scene_parameters else "")
     if ndofs > spec.max_dofs:

@@ -12,8 +12,9 @@ from bench.matrix.artifacts import level_artifact_path, publish_last_level, save
 from bench.matrix.spec import SequenceSpec, build_scene, check_formulation_options
 from bench.sequence.loop import LevelResult, run_sequence
 from bench.sequence.rows import ResultRow, identity_columns
-from estimators.base import ESTIMATORS
+from estimators.base import ESTIMATORS, why_not_on
 from formulations import STATUS_FAILED, STATUS_SKIPPED
+from formulations.cells import DEFAULT_CELL, family_for
 from formulations.discretisation import why_unsolvable
 from formulations.elasticity import why_no_element
 from formulations.registry import FORMULATIONS, get_formulation
@@ -29,17 +30,25 @@ class Outcome:
 
 
 def why_skipped(scene: Scene, formulation: str, solver: str, estimator: str,
-                options: dict | None = None, order: int = 1) -> str | None:
-    """The reason a combination is impossible (declared by the registrations, or no method of
-    the solver for the problem the formulation offers with these options), or None."""
-    reason = (why_no_element(order, scene.dim)
+                options: dict | None = None, order: int = 1, cell: str = DEFAULT_CELL,
+                strategy: str = "uniform") -> str | None:
+    """The reason a combination is impossible (declared by the registrations and the cell
+    family, or no method of the solver for the problem the formulation offers with these
+    options), or None."""
+    try:
+        family = family_for(cell, scene.dim)
+    except ValueError as error:
+        return str(error)
+    reason = (family.why_not(scene, strategy) or why_no_element(order, scene.dim, cell)
               or FORMULATIONS.why_not(formulation, scene=scene)
               or (SOLVERS.why_not(solver, scene=scene, formulation=formulation)
                   if solver in SOLVERS.names() else None)
-              or ESTIMATORS.why_not(estimator, scene=scene, formulation=formulation))
+              or ESTIMATORS.why_not(estimator, scene=scene, formulation=formulation)
+              or why_not_on(estimator, family))
     if reason is not None:
         return reason
-    coarse = get_formulation(formulation)(scene, scene.mesh, order=order, **(options or {}))
+    coarse = get_formulation(formulation)(scene, family.starting_mesh(scene), order=order,
+                                          **(options or {}))
     return why_unsolvable(coarse, solver)
 
 
@@ -78,8 +87,10 @@ def run_spec(spec: SequenceSpec, run: dict, out, truth_of: Callable[[Scene], obj
         scene = build_scene(spec)
         check_formulation_options(spec)
         names["dim"] = scene.dim
+        names["cell"] = spec.cell
         reason = why_skipped(scene, spec.formulation, spec.solver, spec.estimator,
-                             dict(spec.formulation_options), spec.order)
+                             dict(spec.formulation_options), spec.order, spec.cell,
+                             spec.strategy)
         if reason is not None:
             record(whole_sequence_row(names, STATUS_SKIPPED, reason))
             return STATUS_SKIPPED  # also its end reason

@@ -19,19 +19,15 @@ from bench.sequence.columns import (
 from bench.sequence.marking import check_marking, grade_contact_trace, mark
 from bench.sequence.memory import available_gib, predict_peak_gib, route
 from bench.sequence.rows import ResultRow, identity_columns
-from estimators import get_estimator
+from estimators.base import estimator_on
 from formulations import STATUS_FAILED, get_formulation, solve
-from formulations.elasticity import (
-    check_order,
-    count_free_dofs,
-    element_diameters,
-    predict_refined_free_dofs,
-)
+from formulations.cells import DEFAULT_CELL, check_cell, family_for
+from formulations.cells.base import Plan
+from formulations.elasticity import check_order, element_diameters
 from formulations.solvers.backends import check_backend
 from formulations.solvers.registry import REFERENCE_SOLVER
 from scenes import Scene
 from scenes.base import is_integer, is_number
-from scenes.topology import RefinementPlan, refinement_plan
 
 STRATEGIES = ("uniform", "adaptive")
 
@@ -42,6 +38,7 @@ class LoopConfig:
 
     strategy: str = "adaptive"
     order: int = 1  # polynomial order p of the displacements (formulations.elasticity.ORDERS)
+    cell: str = DEFAULT_CELL  # the cell family's shape (formulations.cells): tri or quad
     max_dofs: int = 20000
     max_levels: int = 40
     marking: str = "doerfler"
@@ -63,6 +60,7 @@ class LoopConfig:
         if self.strategy not in STRATEGIES:
             raise ValueError(f"strategy={self.strategy!r} is not one of {', '.join(STRATEGIES)}")
         check_order(self.order)
+        check_cell(self.cell)
         for name in ("max_dofs", "max_levels"):
             value = getattr(self, name)
             if not (is_integer(value) and value > 0):
@@ -97,17 +95,18 @@ def level_columns(disc, sol, mesh, options: dict) -> dict:
         reason=sol.reason, **vars(sol.residuals))
 
 
-def refinement(mesh: MeshTri, sol, est, config: LoopConfig) -> RefinementPlan:
+def refinement(mesh: MeshTri, sol, est, config: LoopConfig) -> Plan:
     """The plan of the next mesh: uniform refinement, or marking (plus the contact grading
     closure)."""
+    family = family_for(config.cell, mesh.dim())
     if config.strategy == "uniform":
-        return refinement_plan(mesh)
+        return family.refinement(mesh)
     marked = mark(est.indicators, config.marking, config.theta)
     if config.grade_contact and sol.trace.dim == 2:  # a 2:1 grading along a 1D Gamma_C
         trace = sol.trace
         marked = grade_contact_trace(marked, trace.length, trace.element, trace.coordinate,
                                      mesh.t.shape[1])
-    return refinement_plan(mesh, marked)
+    return family.refinement(mesh, marked)
 
 
 def refine(mesh: MeshTri, sol, est, config: LoopConfig) -> MeshTri:
@@ -149,13 +148,14 @@ def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
     configuration's ``order``."""
     discretise = functools.partial(get_formulation(formulation), order=config.order,
                                    **(formulation_options or {}))
-    estimate = get_estimator(estimator)
+    family = family_for(config.cell, scene.dim)
+    estimate = estimator_on(estimator, family.name)
     ident = identity_columns(scene.name, formulation, solver, estimator, config, identity,
                              scene.dim)
-    mesh = scene.mesh if mesh is None else mesh
+    mesh = family.starting_mesh(scene) if mesh is None else mesh
     t_refine, previous = 0.0, None
     for level in range(config.max_levels):
-        ndofs = count_free_dofs(scene, mesh, config.order)  # budgets: before any assembly
+        ndofs = family.count_free_dofs(scene, mesh, config.order)  # before any assembly
         if ndofs > config.max_dofs:  # the starting mesh counts too: a failed row says so
             if level == 0:
                 yield LevelResult(ResultRow(
@@ -204,7 +204,7 @@ def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
         start = time.perf_counter()
         plan = refinement(mesh, sol, est, config)
         # the next level's size before its triangles are made: no refinement is wasted
-        if predict_refined_free_dofs(scene, plan, config.order) > config.max_dofs:
+        if plan.free_dofs(scene, config.order) > config.max_dofs:
             return "budget"
         mesh = plan.refined
         t_refine = time.perf_counter() - start

@@ -20,6 +20,7 @@ class ResultRow:
     level: int
     order: int = 1  # polynomial order p of the displacements
     dim: int = 2  # of the body: 2 (triangles) or 3 (tetrahedra)
+    cell: str = "tri"  # the cells' shape: tri (simplices) or quad (quadrilaterals, hexahedra)
     ndofs: int = 0
     n_elements: int = 0
     h_max: float = math.nan
@@ -87,8 +88,8 @@ class ResultRow:
 
 COLUMNS = [f.name for f in fields(ResultRow)]
 # identity of a combination (the sweep labels are empty outside sweeps)
-KEYS = ["scene", "formulation", "solver", "estimator", "strategy", "order", "scene_parameters",
-        "formulation_options"]
+KEYS = ["scene", "formulation", "solver", "estimator", "strategy", "order", "cell",
+        "scene_parameters", "formulation_options"]
 LABELS = ["scene_parameters", "formulation_options"]
 # sequence_end of a complete sequence; INTERRUPTED (or no end at all) marks one cut short
 FINISHED = ("budget", "max_levels", "memory", "failed", "skipped", "target")
@@ -103,18 +104,27 @@ def identity_columns(scene: str, formulation: str, solver: str, estimator: str, 
     ``bench.sequence.loop.LoopConfig``) and the run's identity, sweep labels and provenance
     (``run``) and the body's dimension."""
     return dict(scene=scene, formulation=formulation, solver=solver, estimator=estimator,
-                strategy=config.strategy, order=config.order, dim=dim, marking=config.marking,
+                strategy=config.strategy, order=config.order, dim=dim, cell=config.cell,
+                marking=config.marking,
                 theta=config.theta,
                 **(run or {}))
 
 
+def name_parts(row) -> list:
+    """The values of KEYS of a row, the default cell left out: what names its files (so that
+    a triangle sequence keeps the names it had before cells were an axis)."""
+    return [getattr(row, k) for k in KEYS if not (k == "cell" and getattr(row, k) == "tri")]
+
+
 def with_labels(frame):
     """A result table with the sweep label columns present and empty strings for missing
-    labels (rows of older tables; their order is 1), so that grouping by KEYS keeps every
-    row."""
+    labels (rows of older tables; their order is 1, their cells triangles), so that grouping
+    by KEYS keeps every row."""
     frame = frame.copy()
     frame["order"] = (frame["order"].fillna(1).astype(int) if "order" in frame else 1)
     frame["dim"] = (frame["dim"].fillna(2).astype(int) if "dim" in frame else 2)
+    frame["cell"] = (frame["cell"].astype(object).fillna("tri").astype(str) if "cell" in frame
+                     else "tri")
     for column in LABELS + ["sequence_key", "sequence_end"]:
         frame[column] = (frame[column].astype(object).fillna("").astype(str) if column in frame
                          else "")

@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 
+from formulations.cells import family_of
 from formulations.elasticity import (
     assemble_elasticity,
     count_free_dofs,
@@ -11,7 +12,6 @@ from formulations.elasticity import (
     von_mises,
 )
 from scenes import get_scene
-from scenes.topology import refinement_plan
 
 
 @pytest.fixture(scope="module")
@@ -86,7 +86,7 @@ def test_the_next_levels_size_is_known_before_refining(name, order):
     for fraction in (0.05, 0.3, 1.0, None):
         marked = (None if fraction is None else
                   np.flatnonzero(rng.random(mesh.t.shape[1]) < fraction))
-        plan = refinement_plan(mesh, marked)
+        plan = family_of(mesh).refinement(mesh, marked)
         assert predict_refined_free_dofs(scene, plan, order) == count_free_dofs(
             scene, plan.refined, order)
         mesh = plan.refined

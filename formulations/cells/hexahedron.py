@@ -1,0 +1,45 @@
+"""Hexahedra: Q1 on tensor grids, refined uniformly (docs/theory.md, section 15.5). Adaptive
+refinement would need hanging nodes on faces and edges, and the formulations a contact surface
+of quadrilateral faces: neither is built, so a run on hexahedra is a skipped row that says
+so, and ``python -m bench study --cell hex`` runs the VI on them."""
+
+from __future__ import annotations
+
+import numpy as np
+from skfem import ElementHex1, MeshHex
+from skfem.mesh import MeshHex1
+
+from formulations.cells.base import CellFamily, register_family
+from formulations.cells.quadrilateral import not_a_grid, tensor_axes
+
+
+class Hexahedra(CellFamily):
+    name, cell, dim, shape = "hex", "quad", 3, "hexahedra"
+    mesh_type = MeshHex1
+    elements = {1: ElementHex1}
+    centroid_rule = (np.full((3, 1), 0.5), np.array([1.0]))  # the unit cube
+    adaptive = False
+
+    def why_no_mesh(self, scene) -> str | None:
+        return not_a_grid(scene, self.shape)
+
+    def why_no_contact(self) -> str | None:
+        return ("the contact surface of hexahedra (quadrilateral faces) is not built; "
+                "`python -m bench study --cell hex` runs the VI on them")
+
+    def starting_mesh(self, scene) -> MeshHex:
+        why = self.why_no_mesh(scene)
+        if why is not None:
+            raise ValueError(why)
+        return MeshHex.init_tensor(*tensor_axes(scene))
+
+    def count_free_dofs(self, scene, mesh, order: int) -> int:
+        """Three per vertex off the clamped faces."""
+        clamped = np.unique(mesh.facets[:, scene.dirichlet_facets(mesh)]).size
+        return int(3 * (mesh.p.shape[1] - clamped))
+
+    def stiffness_intorder(self, order: int) -> int:
+        return 2  # 2 x 2 x 2 Gauss points: exact on parallelepipeds
+
+
+HEXAHEDRA = register_family(Hexahedra(), "hexahedra: Q1 on tensor grids, uniform refinement")
