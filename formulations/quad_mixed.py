@@ -18,7 +18,7 @@ from scipy import sparse
 
 from formulations.base import ContactQP
 from formulations.contact import gauss_legendre
-from formulations.quad_elasticity import assemble_quad_elasticity
+from formulations.elasticity import assemble_elasticity
 from formulations.quad_vi import SIMPSON, QuadContactSolution, contact_edges, failed
 from formulations.solvers.registry import FAST_SOLVER, SOLVERS
 from scenes import Scene
@@ -59,7 +59,7 @@ def mixed_problem(scene: Scene, hierarchy: QuadHierarchy, order: int = 1,
                   levels_up: int = 1) -> QuadMixedProblem:
     """Assemble the mixed method with lambda_H on the coarse edges ``levels_up`` levels above
     the leaves (module docstring)."""
-    elasticity = assemble_quad_elasticity(scene, hierarchy, order)
+    elasticity = assemble_elasticity(scene, hierarchy.mesh(), order)
     basis, mesh = elasticity.basis, elasticity.basis.mesh
     edges = contact_edges(scene, elasticity)
     facets, a, b, length = edges.facets, edges.a, edges.b, edges.length
@@ -84,9 +84,8 @@ def mixed_problem(scene: Scene, hierarchy: QuadHierarchy, order: int = 1,
     points = a[:, :, None] + (b - a)[:, :, None] * t
     G = np.bincount(group, (np.asarray(scene.gap(points)) * w).sum(axis=1) * length, m)
     H = np.bincount(group, length, m)
-    free = elasticity.free
-    qp = ContactQP(K=elasticity.K[free][:, free].tocsr(), F=elasticity.F[free],
-                   B=(B @ elasticity.P)[:, free].tocsr(), G=G, row_scale=H,
+    qp = ContactQP(K=elasticity.K_free, F=elasticity.F_free, B=elasticity.restrict(B), G=G,
+                   row_scale=H,
                    objective_scale=float(scene.material.young_modulus))
     return QuadMixedProblem(elasticity, edges, group, H, qp)
 

@@ -1,7 +1,7 @@
 """The primal variational inequality ``vi`` on a quadrilateral hierarchy (Q1, Q2): nodal
 constraints u_h(x_i) . n_i <= g(x_i) at every Lagrange node of Gamma_C (its vertices, and for
-Q2 its edge midpoints), posed on the conforming space of ``formulations.quad_elasticity``
-(docs/theory.md, sections 3 and 15).
+Q2 its edge midpoints), posed on the conforming space of the quadrilateral family's
+``formulations.elasticity.Elasticity`` (docs/theory.md, sections 3 and 15).
 
 Nodes on Gamma_C are never hanging (an edge on the boundary has one cell), so each row is
 n_i' at the node's two cell DOFs, taken to the conforming space by P. The multiplier of row i
@@ -16,11 +16,7 @@ import numpy as np
 from scipy import sparse
 
 from formulations.base import ContactQP
-from formulations.quad_elasticity import (
-    QuadElasticity,
-    assemble_quad_elasticity,
-    boundary_facets_of,
-)
+from formulations.elasticity import Elasticity, assemble_elasticity
 from formulations.solvers.registry import FAST_SOLVER, SOLVERS
 from scenes import Scene
 from scenes.quad_hierarchy import QuadHierarchy
@@ -54,7 +50,7 @@ class QuadContactSolution:
     ``edge_pressure`` (n_edges, k + 1) at k + 1 equispaced points of each edge, linear between
     them."""
 
-    elasticity: QuadElasticity
+    elasticity: Elasticity
     u: np.ndarray
     reactions: np.ndarray
     energy: float
@@ -78,10 +74,10 @@ class QuadContactSolution:
         return values[:, k] + (values[:, k + 1] - values[:, k]) * (x - k)[None, :]
 
 
-def contact_edges(scene: Scene, elasticity: QuadElasticity) -> ContactEdges:
+def contact_edges(scene: Scene, elasticity: Elasticity) -> ContactEdges:
     """The leaf edges on Gamma_C with their outer normals (from each edge's cell)."""
     mesh = elasticity.basis.mesh
-    facets = boundary_facets_of(scene.is_contact, mesh, elasticity.boundary)
+    facets = scene.contact_facets(mesh)
     a, b = mesh.p[:, mesh.facets[0, facets]], mesh.p[:, mesh.facets[1, facets]]
     cells = mesh.f2t[0, facets]
     normal = np.array([(b - a)[1], -(b - a)[0]])
@@ -91,7 +87,7 @@ def contact_edges(scene: Scene, elasticity: QuadElasticity) -> ContactEdges:
     return ContactEdges(facets, a, b, normal / np.maximum(length, 1e-300), length, cells)
 
 
-def failed(elasticity: QuadElasticity, edges: ContactEdges, rows: int, answer,
+def failed(elasticity: Elasticity, edges: ContactEdges, rows: int, answer,
            nodes: int) -> QuadContactSolution:
     """A solution that failed: NaN arrays, the solver's status and reason."""
     return QuadContactSolution(elasticity, np.full(elasticity.basis.N, np.nan),
@@ -100,7 +96,7 @@ def failed(elasticity: QuadElasticity, edges: ContactEdges, rows: int, answer,
                                np.full((edges.facets.size, nodes), np.nan))
 
 
-def contact_rows(scene: Scene, elasticity: QuadElasticity, edges: ContactEdges):
+def contact_rows(scene: Scene, elasticity: Elasticity, edges: ContactEdges):
     """B (one row per contact node, over the cell DOFs), the gap at the nodes, the lumped
     boundary mass of each node and the node of each edge's k + 1 points (n_edges, k + 1).
     A vertex's normal is the length-weighted mean of its edges' outer normals."""
@@ -134,12 +130,11 @@ def solve_quad_vi(scene: Scene, hierarchy: QuadHierarchy, order: int = 1,
                   solver: str = FAST_SOLVER, **options) -> QuadContactSolution:
     """The Q_order VI on the leaves of ``hierarchy`` with a registered QP solver (the fast
     active-set one by default; ``reference`` is Clarabel)."""
-    elasticity = assemble_quad_elasticity(scene, hierarchy, order)
+    elasticity = assemble_elasticity(scene, hierarchy.mesh(), order)
     edges = contact_edges(scene, elasticity)
     B, gap, weight, edge_nodes = contact_rows(scene, elasticity, edges)
-    free = elasticity.free
-    qp = ContactQP(K=elasticity.K[free][:, free].tocsr(), F=elasticity.F[free],
-                   B=(B @ elasticity.P)[:, free].tocsr(), G=gap, row_scale=np.ones(gap.size),
+    qp = ContactQP(K=elasticity.K_free, F=elasticity.F_free, B=elasticity.restrict(B), G=gap,
+                   row_scale=np.ones(gap.size),
                    objective_scale=float(scene.material.young_modulus))
     answer = SOLVERS.get(solver)(qp, **options)
     if answer.u is None or answer.multipliers is None or not np.all(np.isfinite(answer.u)):

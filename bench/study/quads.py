@@ -22,8 +22,8 @@ from bench.measure.nonnested import energy_difference
 from bench.measure.quad_fields import quad_gradient_field
 from bench.sequence.marking import mark
 from estimators.quad_residual import quad_residual_estimate
+from formulations.elasticity import count_free_dofs
 from formulations.hex_vi import hex_mesh, solve_hex_vi
-from formulations.quad_elasticity import count_quad_dofs
 from formulations.quad_mixed import solve_quad_mixed
 from formulations.quad_vi import solve_quad_vi
 from scenes import get_scene
@@ -99,7 +99,7 @@ def quad_sequence(scene_name: str, method: str, order: int, strategy: str, max_d
     solve, options = METHODS[method]
     error_of, rows = judge(scene, reference), []
     for level in range(60):
-        if count_quad_dofs(scene, hierarchy, order) > max_dofs:  # before anything is built
+        if count_free_dofs(scene, hierarchy.mesh(), order) > max_dofs:  # before anything is built
             break
         start = time.perf_counter()
         solution = solve(scene, hierarchy, order, **options)

@@ -33,7 +33,7 @@ def test_every_edge_with_a_hanging_node_is_measured_on_both_halves(compression_s
     a, b, first, second = edge_pairs(solution)
     mesh = solution.elasticity.basis.mesh
     conforming = np.count_nonzero(mesh.f2t[1] >= 0)
-    hanging = solution.elasticity.hierarchy.hanging()[0].size
+    hanging = solution.elasticity.mesh.hierarchy.hanging()[0].size
     assert a.shape[1] == conforming + 2 * hanging and hanging > 0
     # the pieces of the hanging edges have half the length of the coarse cell's edge
     pieces = np.linalg.norm(b - a, axis=0)[conforming:]
