@@ -15,6 +15,7 @@ import numpy as np
 from skfem import Basis, MeshTri
 
 from bench.measure.fields import GradientField, Locator, _lattice, _powers, monomials
+from formulations.cells import family_of
 
 # the halves of the reference square [0, 1]^2: corners (v0, v1, v2) and (v0, v2, v3)
 HALVES = (np.array([[0.0, 1.0, 1.0], [0.0, 0.0, 1.0]]),
@@ -41,6 +42,14 @@ def quad_gradient_field(basis: Basis, u: np.ndarray) -> GradientField:
     # unsorted: the coefficients are in the reference coordinates of this vertex order
     halves = MeshTri(np.ascontiguousarray(mesh.p), triangles, sort_t=False)
     return GradientField(Locator.from_mesh(halves), degree, coefficients)
+
+
+def gradient_field_of(basis: Basis, u: np.ndarray) -> GradientField:
+    """The ``GradientField`` of a solution on any mesh: split into triangles on tensor-product
+    cells (``quad_gradient_field``), the element's own polynomials on simplices."""
+    if family_of(basis.mesh).tensor_product:
+        return quad_gradient_field(basis, u)
+    return GradientField.from_solution(basis, u)
 
 
 def _order(basis: Basis) -> int:

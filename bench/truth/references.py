@@ -36,6 +36,7 @@ from bench.measure.contact import contact_zone
 from bench.measure.discretisation_error import Errors, errors_from
 from bench.measure.fields import GradientField
 from bench.measure.nonnested import energy_difference
+from bench.measure.quad_fields import gradient_field_of
 from bench.sequence.loop import LoopConfig, run_sequence
 from bench.truth.error_bar import error_bar
 from formulations import STATUS_OK, DiscreteSolution
@@ -114,7 +115,7 @@ class Reference:
         return GradientField.from_dofs(self.mesh, self.order, self.u)
 
     def errors(self, solution: DiscreteSolution) -> Errors:
-        judged = GradientField.from_solution(solution.elasticity.basis, solution.u)
+        judged = gradient_field_of(solution.elasticity.basis, solution.u)
         return errors_from(energy_difference(judged, self.field, self.lame), solution,
                            self.pressure, self.zone)
 

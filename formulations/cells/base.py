@@ -61,6 +61,7 @@ class CellFamily:
     elements: dict = {}  # scalar Lagrange element class per order
     centroid_rule: tuple[np.ndarray, np.ndarray] = (np.zeros((2, 1)), np.ones(1))
     adaptive: bool = True  # meshes refine where marked (else uniform only)
+    tensor_product: bool = False  # Q_p on mapped squares or cubes (else P_p on simplices)
 
     # --- elements ---------------------------------------------------------------------------
     def why_no_element(self, order: int) -> str | None:

@@ -15,6 +15,7 @@ from formulations.cells.quadrilateral import not_a_grid, tensor_axes
 
 class Hexahedra(CellFamily):
     name, cell, dim, shape = "hex", "quad", 3, "hexahedra"
+    tensor_product = True
     mesh_type = MeshHex1
     elements = {1: ElementHex1}
     centroid_rule = (np.full((3, 1), 0.5), np.array([1.0]))  # the unit cube

@@ -34,6 +34,7 @@ def not_a_grid(scene, shape: str) -> str | None:
 
 class Quadrilaterals(CellFamily):
     name, cell, dim, shape = "quad", "quad", 2, "quadrilaterals"
+    tensor_product = True
     mesh_type = QuadLeafMesh
     elements = {1: ElementQuad1, 2: ElementQuad2}
     centroid_rule = (np.full((2, 1), 0.5), np.array([1.0]))  # the unit square
