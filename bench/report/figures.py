@@ -9,7 +9,7 @@ import textwrap
 
 import numpy as np
 import pandas as pd
-from matplotlib.collections import LineCollection
+from matplotlib.collections import LineCollection, PolyCollection
 from matplotlib.figure import Figure
 from matplotlib.tri import Triangulation
 
@@ -62,19 +62,22 @@ def _slope_triangle(ax, x0: float, y0: float, slope: float, text: str):
 
 
 def _keys(table):
-    """Groups of one sequence's levels: formulation, estimator, strategy (and the order where
-    the table has several)."""
+    """Groups of one sequence's levels: formulation, estimator, strategy (and the order and
+    the cells where the table has several)."""
     return table.groupby(["formulation", "estimator", "strategy", *_order_key(table)],
                          sort=True)
 
 
 def _order_key(table) -> list[str]:
-    return ["order"] if "order" in table and table["order"].nunique() > 1 else []
+    """The sequence columns beyond the combination that vary in ``table``: order, cell."""
+    return [c for c in ("order", "cell") if c in table and table[c].nunique() > 1]
 
 
 def _name(key: tuple) -> str:
-    """'formulation/estimator/strategy', with '/P<order>' when the key carries one."""
-    return "/".join(str(k) for k in key[:3]) + (f"/P{key[3]}" if len(key) > 3 else "")
+    """'formulation/estimator/strategy', with '/P<order>' and '/<cell>' when the key carries
+    them."""
+    return "/".join(str(k) for k in key[:3]) + "".join(
+        f"/P{k}" if isinstance(k, (int, np.integer)) else f"/{k}" for k in key[3:])
 
 
 def convergence(table: pd.DataFrame):
@@ -150,6 +153,12 @@ def work_precision(table: pd.DataFrame):
     return fig
 
 
+def cell_polygons(p: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """The cells as polygons (n_cells, corners, 2), triangles and quadrilaterals alike (a
+    hanging node is a vertex of its fine cells and lies on the coarse cell's edge)."""
+    return np.transpose(p[:2, t], (2, 1, 0))
+
+
 def meshes(artifacts: dict):
     """Final adaptive mesh per formulation/estimator (the paper's Figure 1b)."""
     items = sorted((k, v) for k, v in artifacts.items() if k[2] == "adaptive")
@@ -162,10 +171,12 @@ def meshes(artifacts: dict):
     for ax in axes.ravel():
         ax.set_axis_off()
     for ax, (key, data) in zip(axes.ravel(), items, strict=False):
-        ax.triplot(Triangulation(data["p"][0], data["p"][1], data["t"].T), linewidth=0.15,
-                   color=colour(key[0]))
+        ax.add_collection(PolyCollection(cell_polygons(data["p"], data["t"]), facecolors="none",
+                                         edgecolors=colour(key[0]), linewidths=0.15))
+        ax.autoscale_view()
         order = f"/P{key[3]}" if len(key) > 3 and key[3] != 1 else ""
-        ax.set_title(f"{key[0]}/{key[1]}{order}: {int(data['ndofs'])} DOFs", fontsize=9)
+        cell = f"/{key[4]}" if len(key) > 4 and key[4] != "tri" else ""
+        ax.set_title(f"{key[0]}/{key[1]}{order}{cell}: {int(data['ndofs'])} DOFs", fontsize=9)
         ax.set_aspect("equal")
     fig.tight_layout()
     return fig
@@ -184,8 +195,11 @@ def deformed(data: dict, title: str):
     top = np.percentile(vm, VON_MISES_PERCENTILE)
     fig = Figure(figsize=(6, 5))
     ax = fig.subplots()
-    shown = Triangulation(p[0] + scale * u[0], p[1] + scale * u[1], data["t"].T)
-    art = ax.tripcolor(shown, facecolors=np.minimum(vm, top), cmap="viridis", vmin=0, vmax=top)
+    art = PolyCollection(cell_polygons(p + scale * u, data["t"]), array=np.minimum(vm, top),
+                         cmap="viridis", edgecolors="face", linewidths=0.1)
+    art.set_clim(0, top)
+    ax.add_collection(art)
+    ax.autoscale_view()
     fig.colorbar(art, ax=ax, label=f"von Mises stress (clipped at its "
                                    f"{VON_MISES_PERCENTILE:g}th percentile = {top:.4g})")
     ax.set_title(f"{title}, displacement x {scale:g}", fontsize=9)

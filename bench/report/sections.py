@@ -46,7 +46,7 @@ def _artifacts(results: Path | None, group: pd.DataFrame) -> dict:
         data = load_artifact(artifact_path(results, row))
         if data is not None:
             out[(row["formulation"], row["estimator"], row["strategy"],
-                 int(row.get("order", 1)))] = data
+                 int(row.get("order", 1)), str(row.get("cell", "tri")))] = data
     return out
 
 
