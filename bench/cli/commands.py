@@ -60,7 +60,7 @@ def progress(result: LevelResult) -> None:
 
 def summary(table: pd.DataFrame) -> str:
     parts = []
-    for key, group in table.groupby(KEYS, sort=False):
+    for key, group in table.groupby(KEYS, sort=False, dropna=False):
         parts.append("== " + " / ".join(str(k) for k in key if str(k)))
         parts.append(group[SUMMARY_COLUMNS].to_string(index=False, float_format="{:.6g}".format))
     return "\n".join(parts)

@@ -28,8 +28,12 @@ def stress_tensor(stress: np.ndarray) -> np.ndarray:
     return out.reshape(-1, 9)
 
 
+# meshio's cell type by (dimension, corners of a cell)
+MESHIO_CELLS = {(2, 3): "triangle", (2, 4): "quad", (3, 4): "tetra", (3, 8): "hexahedron"}
+
+
 def body_mesh(data: dict):
-    """The triangles (3D points, z = 0) or tetrahedra with their point and cell fields."""
+    """The cells (in 2D with 3D points, z = 0) with their point and cell fields."""
     import meshio
 
     planar = data["p"].shape[0] == 2
@@ -37,7 +41,8 @@ def body_mesh(data: dict):
     u = (np.vstack([data["u"], np.zeros(data["u"].shape[1])]) if planar else data["u"]).T
     cells = {"stress": stress_tensor(data["stress"]), "von_mises": data["von_mises"],
              "indicator": data["indicators"], "error_density": data["error_density"]}
-    return meshio.Mesh(points, [("triangle" if planar else "tetra", data["t"].T)],
+    kind = MESHIO_CELLS[(data["p"].shape[0], data["t"].shape[0])]
+    return meshio.Mesh(points, [(kind, data["t"].T)],
                        point_data={"displacement": u},
                        cell_data={k: [np.asarray(v, dtype=float)] for k, v in cells.items()})
 

@@ -39,7 +39,7 @@ def judged_levels(rows: pd.DataFrame) -> pd.DataFrame:
 def rates_table(table: pd.DataFrame, levels: int = RATE_LEVELS) -> pd.DataFrame:
     rows = []
     table = with_labels(table[table["level"] >= 0])
-    for key, group in table.groupby(KEYS, sort=True):
+    for key, group in table.groupby(KEYS, sort=True, dropna=False):
         group = group.sort_values("level")
         ok = group[group["status"] == STATUS_OK]
         tail = ok.tail(levels)

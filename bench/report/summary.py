@@ -34,7 +34,7 @@ def fastest(group: pd.DataFrame) -> dict:
     if ok.empty:
         return {"column": column, "target": float("nan"), "ranking": [], "compared": 0}
     sequences = [seq.assign(cumulative=phase_time(seq).cumsum())
-                 for _, seq in ok.groupby(KEYS, sort=True)]
+                 for _, seq in ok.groupby(KEYS, sort=True, dropna=False)]
     target = _target(pd.Series([seq[column].iloc[-1] for seq in sequences]))
     ranking = []
     for seq in sequences:

@@ -92,7 +92,7 @@ def without_empty_labels(table: pd.DataFrame) -> pd.DataFrame:
 
 def accuracy_table(rows: pd.DataFrame) -> pd.DataFrame:
     out = []
-    for key, group in rows.groupby(KEYS, sort=True):
+    for key, group in rows.groupby(KEYS, sort=True, dropna=False):
         last = group.sort_values("level").iloc[-1]
         out.append({**dict(zip(KEYS, key, strict=True)), "ndofs": int(last["ndofs"]),
                     "energy": _fmt(last["energy"], ".6g"),

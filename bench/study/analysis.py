@@ -29,7 +29,7 @@ def _ok(table: pd.DataFrame) -> pd.DataFrame:
 def local_slopes(table: pd.DataFrame) -> pd.DataFrame:
     """One row per pair of consecutive levels of every sequence: the slopes between them."""
     rows = []
-    for key, group in _ok(table).groupby(KEYS, sort=True):
+    for key, group in _ok(table).groupby(KEYS, sort=True, dropna=False):
         group = group.sort_values("ndofs")
         for (_, a), (_, b) in zip(group.iloc[:-1].iterrows(), group.iloc[1:].iterrows(),
                                   strict=True):
@@ -80,7 +80,7 @@ def asymptotic_table(table: pd.DataFrame, levels: int = FIT_LEVELS) -> pd.DataFr
     scenes, orders = sorted(ok["scene"].unique()), sorted(ok["order"].unique())
     predicted = predictions(scenes, orders).set_index(["scene", "order"])
     rows = []
-    for key, group in ok.groupby(KEYS, sort=True):
+    for key, group in ok.groupby(KEYS, sort=True, dropna=False):
         group = group.sort_values("ndofs")
         row = {**dict(zip(KEYS, key, strict=True)), "levels": len(group),
                "ndofs_first": int(group["ndofs"].iloc[0]),

@@ -164,7 +164,7 @@ def _report_text(table, asymptotic, predicted, nearly, figures, wall_seconds, pl
                       "singular_share", "crossover_ndofs", "effectivity_min", "effectivity_max",
                       "too_coarse_rows"]
     lines = ["# Rate study", "",
-             f"{len(table)} levels of {table.groupby(KEYS).ngroups} sequences"
+             f"{len(table)} levels of {table.groupby(KEYS, dropna=False).ngroups} sequences"
              + (f" (of {planned} planned)" if planned else "") + "; "
              f"{int(table['reference_too_coarse'].astype(bool).sum())} rows flagged "
              "`reference_too_coarse`. The levels' own phase times add up to "
