@@ -1,5 +1,5 @@
 """Cell families: what a kind of cell brings to every formulation, estimator and measurement
-(docs/theory.md, section 15.6).
+(docs/theory.md, section 15.4).
 
 A family (triangles, tetrahedra, quadrilaterals, hexahedra) is one module that registers one
 ``CellFamily``: its Lagrange elements per order, the centroid rule of its reference cell, how

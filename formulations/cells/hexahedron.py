@@ -1,4 +1,4 @@
-"""Hexahedra: Q1 on tensor grids, refined uniformly (docs/theory.md, section 15.5). Adaptive
+"""Hexahedra: Q1 on tensor grids, refined uniformly (docs/theory.md, sections 15.3-15.4). Adaptive
 refinement would need hanging nodes on faces and edges, and the formulations a contact surface
 of quadrilateral faces: neither is built, so a run on hexahedra is a skipped row that says
 so, and ``python -m bench study --cell hex`` runs the VI on them."""
