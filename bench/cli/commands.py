@@ -111,7 +111,7 @@ def hard_command(args) -> int:
               + ", ".join(f"{v} {n}" for v, n in frame["verdict"].value_counts().items()),
               flush=True)
 
-    table = run_hard(args.case, on_case=show)
+    table = run_hard(args.case, on_case=show, cells=args.cell)
     print(f"wrote {write_hard(table, args.out)}\n")
     print(hard_markdown(table))
     checks = check_expected(table, load_expected().get("hard", []))

@@ -241,6 +241,7 @@ def _hard_parser(sub) -> None:
                            "(default: all)")
     hard.add_argument("--out", default="results-hard",
                       help="folder for hard.csv and hard.md (default: results-hard)")
+    _cell_option(hard, "the hard scenes run on each (the other cases on triangles)")
 
 def program_name() -> str:
     """How the user started the command line: the console script names itself, anything

@@ -1,14 +1,16 @@
 """Every scene tagged ``hard`` as a hard case: every formulation that applies to it, every
-solver, at HARD_SCENE_LEVEL uniform refinements, with a finding stated in the scene's own
-numbers and whether the discretisation has settled."""
+solver, at HARD_SCENE_LEVEL uniform refinements, on each cell shape asked for (the variant
+names a cell other than triangles), with a finding stated in the scene's own numbers and
+whether the discretisation has settled."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from bench.hard.verdicts import solve_both
+from bench.hard.verdicts import REFUSED, solve_both
 from bench.measure.contact import contact_zone
 from formulations import STATUS_FAILED, get_formulation, solve
+from formulations.cells import DEFAULT_CELL, family_for
 from formulations.registry import FORMULATIONS
 from formulations.solvers.registry import FAST_SOLVER
 from scenes import get_scene
@@ -45,22 +47,36 @@ def scene_finding(row: dict, solution) -> str:
     return text
 
 
-def force_change(scene, formulation: str, fine: float) -> float:
+def uniform_meshes(scene, cell: str, levels: int) -> list:
+    """The starting mesh of ``cell``'s family and its ``levels`` uniform refinements."""
+    family = family_for(cell, scene.dim)
+    meshes = [family.starting_mesh(scene)]
+    for _ in range(levels):
+        meshes.append(family.refinement(meshes[-1]).refined)
+    return meshes
+
+
+def force_change(scene, formulation: str, coarse_mesh, fine: float) -> float:
     """Relative change of the contact force from one uniform level coarser."""
-    coarse = solve(get_formulation(formulation)(scene, scene.mesh.refined(
-        hard_level(scene) - 1)), FAST_SOLVER).contact_force()
+    coarse = solve(get_formulation(formulation)(scene, coarse_mesh), FAST_SOLVER).contact_force()
     return abs(fine - coarse) / max(abs(fine), abs(coarse)) if fine or coarse else 0.0
 
 
-def scene_case(name: str) -> list[dict]:
+def scene_case(name: str, cell: str = DEFAULT_CELL) -> list[dict]:
     scene = get_scene(name)
-    mesh = scene.mesh.refined(hard_level(scene))
+    why = family_for(cell, scene.dim).why_not(scene)
+    if why is not None:
+        return [dict(case=name, scene=name, formulation="", solver="", variant=cell, level=0,
+                     status="skipped", reason=why, verdict=REFUSED, finding=why)]
+    *_, coarse, mesh = uniform_meshes(scene, cell, hard_level(scene))
+    variant = "" if cell == DEFAULT_CELL else cell
     records = []
     for formulation in FORMULATIONS.names():
         if FORMULATIONS.why_not(formulation, scene=scene) is not None:
             continue
-        rows, sols = solve_both(name, scene, formulation, mesh, level=hard_level(scene))
-        change = force_change(scene, formulation, rows[0]["contact_force"])
+        rows, sols = solve_both(name, scene, formulation, mesh, variant=variant,
+                                level=hard_level(scene))
+        change = force_change(scene, formulation, coarse, rows[0]["contact_force"])
         for row, sol in zip(rows, sols, strict=True):
             row["finding"] = (scene_finding(row, sol)
                               + f"; force changed by {change:.1%} from the level before")
