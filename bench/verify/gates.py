@@ -20,6 +20,7 @@ from bench.sequence.rows import KEYS
 from bench.verify.closed_form import closed_form_table
 from bench.verify.expected import EXPECTED, load_expected
 from bench.verify.truth_checks import error_bar_table, truth_table
+from formulations.cells import DEFAULT_CELL
 
 
 @dataclass(frozen=True)
@@ -43,6 +44,7 @@ def run_gate_matrices(expected: dict, out: str | Path, on_level=None,
         config = RunConfig(scenes=(entry["scene"],), formulations=entry["formulations"],
                            solvers=(entry["solver"],), estimators=entry["estimators"],
                            strategies=entry["strategies"], orders=entry.get("orders", (1,)),
+                           cells=entry.get("cells", (DEFAULT_CELL,)),
                            max_dofs=entry["max_dofs"],
                            reference_dofs=entry.get("reference_dofs"), out=str(out),
                            overwrite=k == 0, workers=workers,
