@@ -16,6 +16,7 @@ import numpy as np
 from skfem import Basis, ElementQuad0
 
 from estimators.base import Estimate, register_cell_variant
+from estimators.contact_terms import contact_terms as shared_contact_terms
 from formulations.base import DiscreteSolution
 from formulations.contact import gauss_legendre
 from formulations.elasticity import stress_tensor_from_gradient
@@ -197,7 +198,12 @@ def quad_residual_estimate(scene, solution) -> Estimate:
     stress = QuadStress(solution)
     volume = (element_residuals(scene, solution, stress) + jump_residuals(solution, stress)
               + boundary_residuals(scene, solution, stress)) / float(scene.material.young_modulus)
-    geometric, complementarity, shares = contact_terms(scene, solution, stress)
+    if isinstance(solution, DiscreteSolution):  # the contact terms every estimator shares
+        shared = shared_contact_terms(scene, solution)
+        geometric, complementarity = shared.geometric, shared.complementarity
+        shares = shared.per_element
+    else:
+        geometric, complementarity, shares = contact_terms(scene, solution, stress)
     eta_0 = float(np.sqrt(volume.sum()))
     return Estimate(estimator="residual", eta=float(np.sqrt(eta_0**2 + geometric
                                                             + complementarity)),

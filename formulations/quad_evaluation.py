@@ -34,10 +34,17 @@ def monomial_values(xi: np.ndarray, exponents: np.ndarray, derivative: int | Non
     return factor[:, None] * monomial_values(xi, power)
 
 
+def combine(coefficients: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """sum_m coefficients[n, m, :] values[m, n] as the gradient (2, 2, n)."""
+    return np.einsum("nmc,mn->cn", coefficients, values).reshape(2, 2, -1)
+
+
 @dataclass(frozen=True, eq=False)
 class QuadGradient:
-    """grad u_h per cell: ``coefficients`` (2, 2, M, nE) of the monomials ``exponents`` in the
-    reference coordinates of each cell (origin v0, ``inverse`` of A)."""
+    """grad u_h per cell: ``coefficients`` (nE, M, 4) of the monomials ``exponents`` in the
+    reference coordinates of each cell (origin v0, ``inverse`` of A), the last axis the
+    components (du_1/dx_1, du_1/dx_2, du_2/dx_1, du_2/dx_2): cell-major, so that gathering the
+    cells of many points reads contiguous rows."""
 
     origin: np.ndarray
     inverse: np.ndarray
@@ -59,7 +66,8 @@ class QuadGradient:
         sampled = Basis(basis.mesh, basis.elem, quadrature=(lattice, np.ones(lattice.shape[1])))
         values = sampled.interpolate(u).grad  # (2, 2, nE, M)
         solve = np.linalg.inv(monomial_values(lattice, exponents).T)
-        coefficients = np.einsum("mk,ijek->ijme", solve, values)
+        coefficients = (values @ solve.T).reshape(4, -1, solve.shape[0])  # (4, nE, M)
+        coefficients = np.ascontiguousarray(coefficients.transpose(1, 2, 0))  # (nE, M, 4)
         inverse = np.linalg.inv(A.transpose(2, 0, 1)).transpose(1, 2, 0)  # rows: d xi_r / dx
         return cls(p[:, 0], inverse, exponents, coefficients)
 
@@ -69,13 +77,12 @@ class QuadGradient:
     def at(self, x: np.ndarray, cells: np.ndarray) -> np.ndarray:
         """grad u_h (2, 2, n) at points x (2, n) of ``cells``."""
         values = monomial_values(self.reference(x, cells), self.exponents)
-        return np.einsum("ijmn,mn->ijn", self.coefficients[:, :, :, cells], values)
+        return combine(self.coefficients[cells], values)
 
     def derivatives_at(self, x: np.ndarray, cells: np.ndarray) -> np.ndarray:
         """d/dx_k (grad u_h)_ij (2, 2, 2, n) at points x of ``cells``."""
         xi = self.reference(x, cells)
-        coefficients = self.coefficients[:, :, :, cells]
-        by_reference = np.array([np.einsum("ijmn,mn->ijn", coefficients,
-                                           monomial_values(xi, self.exponents, r))
+        coefficients = self.coefficients[cells]
+        by_reference = np.array([combine(coefficients, monomial_values(xi, self.exponents, r))
                                  for r in range(2)])  # (r, 2, 2, n)
         return np.einsum("rijn,rkn->ijkn", by_reference, self.inverse[:, :, cells])

@@ -21,6 +21,7 @@ from skfem import MeshQuad
 from skfem.mesh import MeshQuad1
 
 from scenes.budget import check_vertex_count
+from scenes.topology import QUAD_EDGES, build_f2t, build_facets
 
 KEY_BASE = np.int64(1) << 31  # edge key = low * KEY_BASE + high (vertex numbers below 2^31)
 
@@ -84,8 +85,12 @@ class QuadHierarchy:
     @functools.cached_property
     def _leaf_mesh(self) -> QuadLeafMesh:
         used, local = self.leaf_vertices()
-        return QuadLeafMesh(np.ascontiguousarray(self.p[:, used]), np.ascontiguousarray(local),
+        mesh = QuadLeafMesh(np.ascontiguousarray(self.p[:, used]), np.ascontiguousarray(local),
                             hierarchy=self)
+        # scikit-fem's facets, t2f and f2t, bit for bit, without its row-wise np.unique
+        mesh._facets, mesh._t2f = build_facets(mesh.t, mesh.p.shape[1], QUAD_EDGES)
+        mesh._f2t = build_f2t(mesh._t2f, mesh._facets.shape[1])
+        return mesh
 
     def leaf_vertices(self) -> tuple[np.ndarray, np.ndarray]:
         """The hierarchy's vertices the leaves use, and the leaves renumbered on them."""

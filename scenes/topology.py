@@ -36,13 +36,16 @@ def quiet_skfem():
 
 # a triangle's facets as pairs of its local vertices: scikit-fem's RefTri.facets
 TRIANGLE_EDGES = ((0, 1), (1, 2), (0, 2))
+QUAD_EDGES = ((0, 1), (1, 2), (2, 3), (0, 3))  # scikit-fem's RefQuad.facets
 
 
-def build_facets(t: np.ndarray, n_vertices: int) -> tuple[np.ndarray, np.ndarray]:
+def build_facets(t: np.ndarray, n_vertices: int,
+                 edges: tuple = TRIANGLE_EDGES) -> tuple[np.ndarray, np.ndarray]:
     """(facets, t2f): the unique edges (2, n_facets), each sorted and in lexicographic order,
-    and each triangle's three edges (3, n_elements), in the order ``TRIANGLE_EDGES``."""
-    a = np.concatenate([t[i] for i, _ in TRIANGLE_EDGES]).astype(np.int64)
-    b = np.concatenate([t[j] for _, j in TRIANGLE_EDGES]).astype(np.int64)
+    and each cell's edges (len(edges), n_elements), in the order ``edges`` (the reference
+    cell's facets: ``TRIANGLE_EDGES``, ``QUAD_EDGES``)."""
+    a = np.concatenate([t[i] for i, _ in edges]).astype(np.int64)
+    b = np.concatenate([t[j] for _, j in edges]).astype(np.int64)
     key = np.minimum(a, b) * n_vertices + np.maximum(a, b)
     order = np.argsort(key, kind="stable")
     ordered = key[order]
@@ -53,7 +56,7 @@ def build_facets(t: np.ndarray, n_vertices: int) -> tuple[np.ndarray, np.ndarray
     inverse[order] = np.cumsum(is_new) - 1
     unique = ordered[is_new]
     facets = np.vstack((unique // n_vertices, unique % n_vertices)).astype(t.dtype)
-    return np.ascontiguousarray(facets), inverse.reshape(len(TRIANGLE_EDGES), -1)
+    return np.ascontiguousarray(facets), inverse.reshape(len(edges), -1)
 
 
 def build_f2t(t2f: np.ndarray, n_facets: int) -> np.ndarray:

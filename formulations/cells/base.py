@@ -16,6 +16,7 @@ hexahedra).
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 from typing import Any
 
@@ -41,7 +42,7 @@ class Plan:
     marked: np.ndarray | None
     detail: Any = None  # the family's own plan (scenes.topology.RefinementPlan for simplices)
 
-    @property
+    @functools.cached_property
     def refined(self):
         return self.family.refined(self)
 

@@ -14,6 +14,7 @@ from skfem import Basis, ElementQuad1, ElementQuad2
 from formulations.cells.base import CellFamily, Plan, register_family
 from formulations.hanging_nodes import prolongation
 from formulations.quad_load import quad_body_load
+from formulations.tensor_stiffness import tensor_stiffness
 from scenes.quad_hierarchy import QuadHierarchy, QuadLeafMesh
 
 
@@ -52,20 +53,26 @@ class Quadrilaterals(CellFamily):
         return plan.mesh.hierarchy.refined(plan.marked).mesh()
 
     def count_free_dofs(self, scene, mesh, order: int) -> int:
-        """Two per conforming Lagrange node off Gamma_D (a hanging node and the DOFs inside
-        the halves of its edge are not unknowns)."""
-        basis = Basis(mesh, self.vector_element(order), intorder=1)
-        P = self.constraint(basis)
-        fixed = np.zeros(basis.N)
-        fixed[basis.get_dofs(scene.dirichlet_facets(mesh)).all()] = 1.0
-        return int(np.count_nonzero(np.asarray(P.T @ fixed).ravel() == 0))
+        """Two per conforming Lagrange node off Gamma_D, counted from the leaf mesh: every
+        vertex, and for Q2 every edge and cell, less the nodes a hanging node constrains (its
+        vertex; for Q2 also the midpoints of its edge's halves). Gamma_D holds no hanging
+        node (a boundary edge has one cell)."""
+        hanging = mesh.hierarchy.hanging()[0].size
+        dirichlet = scene.dirichlet_facets(mesh)
+        clamped = np.unique(mesh.facets[:, dirichlet]).size
+        nodes = mesh.p.shape[1] - hanging
+        if order == 2:
+            nodes += mesh.facets.shape[1] + mesh.t.shape[1] - 2 * hanging
+            clamped += dirichlet.size
+        return int(2 * (nodes - clamped))
 
-    def vector_element(self, order: int):
-        from skfem import ElementVector
-        return ElementVector(self.elements[order]())
+    def stiffness(self, basis, lam: float, mu: float, order: int):
+        """Vectorised over cells on the (p + 1)^2 Gauss points (formulations.tensor_stiffness):
+        exact on parallelograms."""
+        return tensor_stiffness(basis, lam, mu, order)
 
     def stiffness_intorder(self, order: int) -> int:
-        return 2 * order + 1  # exact on parallelograms, with one degree to spare
+        return 2 * order + 1  # the loads' rule: exact on parallelograms, one degree to spare
 
     def traction_intorder(self, order: int) -> int:
         return 2 * order + 2
