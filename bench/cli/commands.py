@@ -246,11 +246,12 @@ def show_3d(row) -> None:
 
 def sequence_command(args) -> int:
     def show(row):
-        print(f"{row['strategy']} to {row['max_dofs']}: {row['levels']} levels, finest "
+        print(f"{row['strategy']} to {row['max_dofs']} ({row['cell']}): {row['levels']} levels, "
+              f"finest "
               f"{row['final_ndofs']} DOFs, {row['t_sequence']:.1f} s = "
               f"{row['sequence_over_linear']:.1f} linear solves at the finest level", flush=True)
     budgets = zip([s for s, _ in SEQUENCES], args.sequence_max_dofs, strict=True)
-    frame = run_sequences(list(budgets), args.backend, on_row=show)
+    frame = run_sequences(list(budgets), args.backend, on_row=show, cells=args.cell)
     print(f"wrote {write_sequences(frame, args.out, args.readme)}")
     return 0
 

@@ -2,10 +2,17 @@
 
 from __future__ import annotations
 
-from bench.cli.option_types import name_list, order_list, positive_int, sequence_budgets
+from bench.cli.option_types import (
+    cell_list,
+    name_list,
+    order_list,
+    positive_int,
+    sequence_budgets,
+)
 from bench.perf.scaling import SIZES
 from bench.perf.scaling_3d import SIZES_3D
 from bench.perf.sequence import SEQUENCES
+from formulations.cells import DEFAULT_CELL, cell_names
 from formulations.solvers.backends import backend_names
 
 
@@ -37,6 +44,10 @@ def add_scaling_parser(sub) -> None:
                          help="time whole sequences instead (an adaptive one and a uniform one, "
                               "every level and phase) against one linear solve at the finest "
                               "level; writes OUT/scaling-sequence.{md,csv}")
+    scaling.add_argument("--cell", type=cell_list, default=[DEFAULT_CELL],
+                         help="with --sequence: the cell shape(s) of the sequences, "
+                              f"comma-separated, from {', '.join(cell_names())} (default: "
+                              f"{DEFAULT_CELL})")
     scaling.add_argument("--sequence-max-dofs", type=sequence_budgets,
                          default=[b for _, b in SEQUENCES],
                          help="the DOF budgets of the adaptive and the uniform sequence, "

@@ -11,6 +11,7 @@ row; ``t_sequence`` is the wall time of the whole sequence, everything included.
 
 from __future__ import annotations
 
+import itertools
 import tempfile
 import time
 from pathlib import Path
@@ -18,6 +19,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from formulations.cells import DEFAULT_CELL
 from formulations.solvers.registry import FAST_SOLVER
 
 # (strategy, DOF budget): the sequences the benchmark runs by default
@@ -28,7 +30,7 @@ README_START, README_END = "<!-- sequence:start -->", "<!-- sequence:end -->"
 
 
 def measure_sequence(strategy: str, max_dofs: int, backend: str | None = None,
-                     reference_dofs: int = REFERENCE_DOFS) -> dict:
+                     reference_dofs: int = REFERENCE_DOFS, cell: str = DEFAULT_CELL) -> dict:
     """Run one sequence and time it; run in a fresh process for a meaningful peak."""
     from bench.matrix.store import ResultStore
     from bench.perf.scaling import peak_gib
@@ -40,7 +42,7 @@ def measure_sequence(strategy: str, max_dofs: int, backend: str | None = None,
     backend = check_backend(backend)
     scene = get_scene("paper")
     truth = truth_for(scene, reference_dofs, max_dofs)
-    config = LoopConfig(strategy=strategy, max_dofs=max_dofs, max_levels=60,
+    config = LoopConfig(strategy=strategy, max_dofs=max_dofs, max_levels=60, cell=cell,
                         solver_options={"backend": backend})
     rows, t_store, last = [], 0.0, None
     with tempfile.TemporaryDirectory() as folder:
@@ -59,7 +61,7 @@ def measure_sequence(strategy: str, max_dofs: int, backend: str | None = None,
     clock = time.perf_counter()
     factorise(K, backend)(np.ones(K.shape[0]))
     t_linear = time.perf_counter() - clock
-    out = {"strategy": strategy, "max_dofs": max_dofs, "backend": backend,
+    out = {"strategy": strategy, "cell": cell, "max_dofs": max_dofs, "backend": backend,
            "levels": len(rows), "final_ndofs": int(frame["ndofs"].iloc[-1]),
            "status": ",".join(sorted(set(frame["status"]))), "t_sequence": t_sequence,
            "t_linear_finest": t_linear}
@@ -71,13 +73,16 @@ def measure_sequence(strategy: str, max_dofs: int, backend: str | None = None,
     return out
 
 
-def run_sequences(sequences=SEQUENCES, backend=None, on_row=None) -> pd.DataFrame:
-    """``measure_sequence`` for every (strategy, budget), each in its own spawned process."""
+def run_sequences(sequences=SEQUENCES, backend=None, on_row=None,
+                  cells=(DEFAULT_CELL,)) -> pd.DataFrame:
+    """``measure_sequence`` for every (strategy, budget) and cell shape, each in its own
+    spawned process."""
     from bench.perf.scaling import in_fresh_process
 
     rows = []
-    for strategy, max_dofs in sequences:
-        row = in_fresh_process(measure_sequence, strategy, max_dofs, backend)
+    for (strategy, max_dofs), cell in itertools.product(sequences, cells):
+        row = in_fresh_process(measure_sequence, strategy, max_dofs, backend, REFERENCE_DOFS,
+                               cell)
         rows.append(row)
         if on_row is not None:
             on_row(row)
@@ -89,7 +94,9 @@ def sequence_table(frame: pd.DataFrame) -> str:
     solve."""
     table = pd.DataFrame({
         "sequence": frame["strategy"] + " to " + frame["max_dofs"].map(
-            lambda n: f"{n:.2g}".replace("e+0", "e").replace("e+", "e")),
+            lambda n: f"{n:.2g}".replace("e+0", "e").replace("e+", "e"))
+        + frame.get("cell", pd.Series("tri", index=frame.index)).map(
+            lambda c: "" if c == DEFAULT_CELL else f", {c}"),
         "levels": frame["levels"], "finest N": frame["final_ndofs"],
         "whole sequence [s]": frame["t_sequence"].map("{:.1f}".format),
         "linear solve at finest [s]": frame["t_linear_finest"].map("{:.2f}".format),

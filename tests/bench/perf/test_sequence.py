@@ -40,3 +40,9 @@ def test_bad_budgets_are_refused_in_one_line(budgets, capsys):
     with pytest.raises(SystemExit):
         main(["scaling", "--sequence", "--sequence-max-dofs", budgets])
     assert "sequence_max_dofs=" in capsys.readouterr().err
+
+
+def test_a_quadrilateral_sequence_is_timed_and_named_by_its_cells():
+    quad = measure_sequence("adaptive", 3000, reference_dofs=20000, cell="quad")
+    assert quad["status"] == "ok" and quad["cell"] == "quad" and quad["levels"] >= 3
+    assert "adaptive to 3e3, quad" in sequence_table(pd.DataFrame([quad]))
