@@ -26,11 +26,8 @@ from skfem import Basis
 from estimators.base import Estimate, combine, register_estimator
 from estimators.contact_terms import contact_terms
 from formulations import DiscreteSolution
-from formulations.elasticity import (
-    scalar_elements,
-    stress_from_gradient,
-    stress_tensor_from_gradient,
-)
+from formulations.cells import family_of
+from formulations.elasticity import stress_from_gradient, stress_tensor_from_gradient
 from formulations.evaluation import gradients_at_reference
 from formulations.p1_stiffness import barycentric_gradients
 
@@ -49,10 +46,12 @@ def averaged_stress(solution: DiscreteSolution, scalar: Basis) -> np.ndarray:
     n_local = grad.shape[-1]
     stress = stresses(grad, elasticity.lame).reshape(-1, grad.shape[2] * n_local)
     dofs = scalar.element_dofs.T.ravel()  # element-major, as ``stress``
-    sizes = element_areas(mesh) if mesh.dim() == 2 else scalar.dx.sum(axis=1)  # volumes
-    weight = np.repeat(sizes, n_local)
+    weight = np.repeat(scalar.dx.sum(axis=1), n_local)  # the cells' areas (volumes)
     total = np.bincount(dofs, weight, scalar.N)
-    return np.array([np.bincount(dofs, weight * s, scalar.N) for s in stress]) / total
+    mean = np.array([np.bincount(dofs, weight * s, scalar.N) for s in stress]) / total
+    # with hanging nodes: the means at the conforming nodes, interpolated at the others
+    return family_of(mesh).conforming(mean, scalar)
+
 
 
 def stresses(grad: np.ndarray, lame: tuple[float, float]) -> np.ndarray:
@@ -80,7 +79,7 @@ def averaging_indicators(solution: DiscreteSolution) -> np.ndarray:
     lam, mu = elasticity.lame
     order = elasticity.order
     mesh = elasticity.mesh
-    scalar = Basis(mesh, scalar_elements(mesh.dim())[order](), intorder=2 * order)
+    scalar = Basis(mesh, family_of(mesh).elements[order](), intorder=2 * order)
     recovered = averaged_stress(solution, scalar)
     at_points = np.array([np.asarray(scalar.interpolate(r)) for r in recovered])
     grad = Basis(mesh, elasticity.basis.elem, quadrature=scalar.quadrature)
@@ -89,6 +88,7 @@ def averaging_indicators(solution: DiscreteSolution) -> np.ndarray:
 
 
 @register_estimator("averaging", "Zienkiewicz-Zhu nodal stress averaging in the energy norm "
-                                 "plus the geometric and complementarity contact terms of (8)")
+                                 "plus the geometric and complementarity contact terms of (8)",
+                    families=("tri", "tet", "quad"))
 def estimate(scene, solution: DiscreteSolution) -> Estimate:
     return combine("averaging", averaging_indicators(solution), contact_terms(scene, solution))

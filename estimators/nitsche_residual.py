@@ -33,7 +33,12 @@ def nitsche_only(scene=None, formulation: str = "", **_) -> str | None:
                                         "for nitsche: eta_0 with the Nitsche contact residual, "
                                         "no eq. (8) terms", applies=nitsche_only)
 def estimate(scene, solution: DiscreteSolution) -> Estimate:
-    local = volume_terms(scene, solution)
+    return nitsche_estimate(volume_terms(scene, solution))
+
+
+def nitsche_estimate(local: np.ndarray) -> Estimate:
+    """The estimate from the residual estimator's squared volume indicators (module
+    docstring): no eq. (8) contact terms."""
     eta = float(np.sqrt(local.sum()))
     return Estimate(estimator="nitsche-residual", eta=eta, eta_0=eta, eta_geometric=0.0,
                     eta_complementarity=0.0, indicators=local)

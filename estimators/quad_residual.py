@@ -17,6 +17,7 @@ from skfem import Basis, ElementQuad0
 
 from estimators.base import Estimate, register_cell_variant
 from estimators.contact_terms import contact_terms as shared_contact_terms
+from estimators.nitsche_residual import nitsche_estimate
 from formulations.base import DiscreteSolution
 from formulations.contact import gauss_legendre
 from formulations.elasticity import stress_tensor_from_gradient
@@ -192,12 +193,24 @@ def contact_terms(scene, solution, stress: QuadStress) -> tuple[float, float, np
     return geometric, float(complementarity.sum()), shares
 
 
+def quad_volume_terms(scene, solution, stress: QuadStress | None = None) -> np.ndarray:
+    """eta_0^2 per cell (the module docstring's terms, over E)."""
+    stress = QuadStress(solution) if stress is None else stress
+    return (element_residuals(scene, solution, stress) + jump_residuals(solution, stress)
+            + boundary_residuals(scene, solution, stress)) / float(scene.material.young_modulus)
+
+
+@register_cell_variant("nitsche-residual", "quad")
+def nitsche_residual_estimate(scene, solution) -> Estimate:
+    """``nitsche-residual`` on quadrilaterals: the same volume terms, no eq. (8) terms."""
+    return nitsche_estimate(quad_volume_terms(scene, solution))
+
+
 @register_cell_variant("residual", "quad")
 def quad_residual_estimate(scene, solution) -> Estimate:
     """eta of the paper's (8) for a quadrilateral contact solution, per-cell indicators."""
     stress = QuadStress(solution)
-    volume = (element_residuals(scene, solution, stress) + jump_residuals(solution, stress)
-              + boundary_residuals(scene, solution, stress)) / float(scene.material.young_modulus)
+    volume = quad_volume_terms(scene, solution, stress)
     if isinstance(solution, DiscreteSolution):  # the contact terms every estimator shares
         shared = shared_contact_terms(scene, solution)
         geometric, complementarity = shared.geometric, shared.complementarity

@@ -138,6 +138,12 @@ class CellFamily:
         """P from the conforming DOFs to the basis's DOFs, or None (conforming meshes)."""
         return None
 
+    def conforming(self, values: np.ndarray, basis) -> np.ndarray:
+        """``values`` (..., basis.N) of a field given at every DOF, made conforming: kept at
+        the conforming DOFs and interpolated by P at the others (unchanged on conforming
+        meshes)."""
+        return values
+
 
 def register_family(family: CellFamily, description: str) -> CellFamily:
     """Register ``family`` under its name (one line per family module)."""

@@ -85,6 +85,10 @@ class Quadrilaterals(CellFamily):
     def constraint(self, basis):
         return prolongation(basis.mesh.hierarchy, basis)[0]
 
+    def conforming(self, values: np.ndarray, basis) -> np.ndarray:
+        P, kept = prolongation(basis.mesh.hierarchy, basis)
+        return (P @ np.atleast_2d(values)[:, kept].T).T.reshape(np.shape(values))
+
 
 QUADRILATERALS = register_family(Quadrilaterals(), "quadrilaterals: Q1-Q2 on hierarchical "
                                                    "meshes with hanging nodes")
