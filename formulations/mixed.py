@@ -15,6 +15,10 @@ facets would not: on graded traces they stay as coarse as the coarsest facet aro
 Hertz scene, whose contact zone is smaller than one initial facet, such a multiplier mesh lags
 the refinement by a dozen levels.)
 
+On a quadrilateral hierarchy the segments are the seed's T_CH instead: the Gamma_C edges of the
+contact cells' ancestors log2(H/h) levels up (one for h/H = 1/2), from the cell family
+(``formulations.cells``; docs/theory.md, section 15.3).
+
 On tetrahedra (``discretise_surface``, docs/theory.md, section 14.7) lambda_H is piecewise
 constant on patches of contact triangles, each holding the whole star of a vertex
 (``formulations.contact_patches``), for P1 and P2 alike.
@@ -30,6 +34,7 @@ from scipy import sparse
 from skfem import MeshTri
 
 from formulations.base import ContactQP, DiscreteSolution, QPSolution, Residuals
+from formulations.cells import family_of
 from formulations.contact import contact_trace, gauss_legendre
 from formulations.contact_patches import (
     free_normal_vertices,
@@ -134,7 +139,8 @@ def discretise(scene: Scene, mesh: MeshTri, h_over_H: float = 0.5, order: int = 
     paper's 1/2 (default) keeps the pair uniformly inf-sup stable; 1 (multiplier mesh = trace
     mesh) is not guaranteed to be (a hard case, see ``formulations.diagnostics``).
     ``multiplier_degree``: the polynomial degree q of lambda_H on each segment (default
-    p - 1, docs/theory.md, section 9). On tetrahedra (``discretise_surface``) h_over_H = 1/2
+    p - 1, docs/theory.md, section 9). On a quadrilateral hierarchy h_over_H = 2^-k takes the
+    edges k levels up (module docstring). On tetrahedra (``discretise_surface``) h_over_H = 1/2
     means star patches, 1 the contact triangles, and q is 0."""
     if scene.dim == 3:
         return discretise_surface(scene, mesh, h_over_H, order, multiplier_degree)
@@ -147,7 +153,9 @@ def discretise(scene: Scene, mesh: MeshTri, h_over_H: float = 0.5, order: int = 
                          f"[0, order={order}]")
     elasticity = assemble_elasticity(scene, mesh, order)
     trace = contact_trace(scene, mesh)
-    segment = multiplier_segments(trace.length, h_over_H)
+    segment = family_of(mesh).multiplier_groups(mesh, trace, h_over_H)
+    if segment is None:  # no hierarchy: runs of facets (module docstring)
+        segment = multiplier_segments(trace.length, h_over_H)
     H = np.bincount(segment, weights=trace.length)
     h_over_H = float((trace.length / H[segment]).max())
 

@@ -178,6 +178,18 @@ class QuadHierarchy:
         return middle[split], a[split], b[split]
 
 
+def coarse_edges(hierarchy: QuadHierarchy, cells: np.ndarray, normal: np.ndarray,
+                 levels_up: int) -> np.ndarray:
+    """The coarse edge (a group number) of each leaf edge: its cell's ancestor ``levels_up``
+    levels above (a root has none above), and the side the edge faces."""
+    ancestor = hierarchy.leaves[cells]
+    for _ in range(levels_up):
+        ancestor = np.where(hierarchy.parent[ancestor] >= 0, hierarchy.parent[ancestor],
+                            ancestor)
+    side = np.argmax(np.abs(normal), axis=0) * 2 + (normal.max(axis=0) > -normal.min(axis=0))
+    return np.unique(ancestor * 4 + side, return_inverse=True)[1]
+
+
 @dataclass(repr=False)
 class QuadLeafMesh(MeshQuad1):
     """The leaves of a ``QuadHierarchy`` as a scikit-fem mesh that knows its hierarchy. Its

@@ -138,6 +138,12 @@ class CellFamily:
         """P from the conforming DOFs to the basis's DOFs, or None (conforming meshes)."""
         return None
 
+    def multiplier_groups(self, mesh, trace, h_over_H: float) -> np.ndarray | None:
+        """The multiplier segment of each contact facet of ``trace`` from the mesh's own
+        hierarchy (numbered along Gamma_C), or None where the meshes have none (the mixed
+        method then groups the facets itself)."""
+        return None
+
     def conforming(self, values: np.ndarray, basis) -> np.ndarray:
         """``values`` (..., basis.N) of a field given at every DOF, made conforming: kept at
         the conforming DOFs and interpolated by P at the others (unchanged on conforming

@@ -15,7 +15,7 @@ from formulations.cells.base import CellFamily, Plan, register_family
 from formulations.hanging_nodes import prolongation
 from formulations.quad_load import quad_body_load
 from formulations.tensor_stiffness import tensor_stiffness
-from scenes.quad_hierarchy import QuadHierarchy, QuadLeafMesh
+from scenes.quad_hierarchy import QuadHierarchy, QuadLeafMesh, coarse_edges
 
 
 def tensor_axes(scene) -> list[np.ndarray] | None:
@@ -84,6 +84,16 @@ class Quadrilaterals(CellFamily):
 
     def constraint(self, basis):
         return prolongation(basis.mesh.hierarchy, basis)[0]
+
+    def multiplier_groups(self, mesh, trace, h_over_H: float) -> np.ndarray:
+        """The seed's T_CH: each contact edge's ancestor log2(H/h) levels up in the hierarchy
+        (one level for h/H = 1/2), numbered along Gamma_C (docs/theory.md, section 15.3)."""
+        levels_up = max(0, int(round(-np.log2(h_over_H))))
+        groups = coarse_edges(mesh.hierarchy, trace.element, trace.normal, levels_up)
+        _, first, inverse = np.unique(groups, return_index=True, return_inverse=True)
+        rank = np.empty(first.size, dtype=np.int64)
+        rank[np.argsort(first, kind="stable")] = np.arange(first.size)
+        return rank[inverse]
 
     def conforming(self, values: np.ndarray, basis) -> np.ndarray:
         P, kept = prolongation(basis.mesh.hierarchy, basis)
