@@ -10,6 +10,7 @@ from bench.matrix.scene_files import FILE_FAILURES
 from estimators import estimator_descriptions
 from estimators.base import ESTIMATORS
 from formulations import formulation_descriptions, solver_descriptions
+from formulations.cells import CELL_FAMILIES
 from formulations.elasticity import order_descriptions
 from formulations.registry import FORMULATIONS
 from formulations.solvers.backends.base import REGISTRY as BACKENDS
@@ -50,4 +51,6 @@ LISTINGS = (("scenes", scene_descriptions, SCENES.origin),
             ("sparse back-ends (--backend)", BACKENDS.descriptions, BACKENDS.origin),
             ("estimators", estimator_descriptions, ESTIMATORS.origin),
             ("orders (--order)", order_descriptions, lambda name: BUILT_IN),
+            ("cell families (--cell tri: simplices, quad: tensor-product cells)",
+             CELL_FAMILIES.descriptions, CELL_FAMILIES.origin),
             ("hard cases", hard_case_descriptions, _hard_origin))

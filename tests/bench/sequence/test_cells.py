@@ -68,4 +68,5 @@ def test_the_inf_sup_constant_levels_off_on_quadrilaterals_for_h_over_H_one_half
 
     stable, unstable = constants(0.5), constants(1.0)
     assert min(stable) > 0.5 and max(stable) / min(stable) < 1.1  # levelled off
-    assert all(0.4 < b / a < 0.6 for a, b in zip(unstable, unstable[1:]))  # halves with h
+    assert all(0.4 < b / a < 0.6  # halves with h
+               for a, b in zip(unstable[:-1], unstable[1:], strict=True))
