@@ -34,6 +34,16 @@ def monomial_values(xi: np.ndarray, exponents: np.ndarray, derivative: int | Non
     return factor[:, None] * monomial_values(xi, power)
 
 
+def reference_gradients(scalar, exponents: np.ndarray) -> np.ndarray:
+    """D[j, r, m]: the coefficient of monomial m (``exponents``) in d phi_j / d xi_r of the
+    scalar element's basis functions (exact: sampled at a lattice of the monomials' degree)."""
+    degree = int(exponents.max())
+    lattice = exponents / max(degree, 1)
+    solve = np.linalg.inv(monomial_values(lattice, exponents).T)
+    return np.array([solve @ scalar.lbasis(lattice, j)[1].T
+                     for j in range(scalar.doflocs.shape[0])]).transpose(0, 2, 1)
+
+
 def combine(coefficients: np.ndarray, values: np.ndarray) -> np.ndarray:
     """sum_m coefficients[n, m, :] values[m, n] as the gradient (2, 2, n)."""
     return np.einsum("nmc,mn->cn", coefficients, values).reshape(2, 2, -1)
@@ -53,7 +63,10 @@ class QuadGradient:
 
     @classmethod
     def from_solution(cls, basis: Basis, u: np.ndarray, degree: int) -> QuadGradient:
-        """The gradient of the cell-DOF vector ``u`` of a vector Q_degree ``basis``."""
+        """The gradient of the cell-DOF vector ``u`` of a vector Q_degree ``basis``: on a
+        parallelogram grad u_h = sum_j u_j A^-T grad_xi phi_j, and grad_xi phi_j is one
+        polynomial in xi for every cell (its monomial coefficients found once, on the
+        reference square), so no basis is evaluated cell by cell."""
         p = basis.mesh.p[:, basis.mesh.t]  # (2, 4, nE)
         A = np.array([p[:, 1] - p[:, 0], p[:, 3] - p[:, 0]]).transpose(1, 0, 2)  # (2, 2, nE)
         size = np.linalg.norm(A, axis=(0, 1))
@@ -62,14 +75,13 @@ class QuadGradient:
             raise ValueError("the quadrilaterals are not all parallelograms: their gradients "
                              "are not polynomials in x")
         exponents = tensor_exponents(degree)
-        lattice = exponents / max(degree, 1)  # (2, M) in the reference square
-        sampled = Basis(basis.mesh, basis.elem, quadrature=(lattice, np.ones(lattice.shape[1])))
-        values = sampled.interpolate(u).grad  # (2, 2, nE, M)
-        solve = np.linalg.inv(monomial_values(lattice, exponents).T)
-        coefficients = (values @ solve.T).reshape(4, -1, solve.shape[0])  # (4, nE, M)
-        coefficients = np.ascontiguousarray(coefficients.transpose(1, 2, 0))  # (nE, M, 4)
         inverse = np.linalg.inv(A.transpose(2, 0, 1)).transpose(1, 2, 0)  # rows: d xi_r / dx
-        return cls(p[:, 0], inverse, exponents, coefficients)
+        D = reference_gradients(basis.elem.elem, exponents)  # (nb, 2 r, M)
+        nodal = u[basis.element_dofs].reshape(D.shape[0], 2, -1)  # (nb, component c, nE)
+        by_reference = np.einsum("jcE,jrm->Emcr", nodal, D, optimize=True)  # (nE, M, 2, 2)
+        coefficients = np.einsum("Emcr,rkE->Emck", by_reference, inverse, optimize=True)
+        return cls(p[:, 0], inverse, exponents,
+                   np.ascontiguousarray(coefficients.reshape(-1, exponents.shape[1], 4)))
 
     def reference(self, x: np.ndarray, cells: np.ndarray) -> np.ndarray:
         return np.einsum("rkn,kn->rn", self.inverse[:, :, cells], x - self.origin[:, cells])
@@ -86,3 +98,17 @@ class QuadGradient:
         by_reference = np.array([combine(coefficients, monomial_values(xi, self.exponents, r))
                                  for r in range(2)])  # (r, 2, 2, n)
         return np.einsum("rijn,rkn->ijkn", by_reference, self.inverse[:, :, cells])
+
+    def at_reference(self, X: np.ndarray) -> np.ndarray:
+        """grad u_h (2, 2, nE, nq) at the same reference points X (2, nq) of every cell."""
+        return np.einsum("Emc,mq->cEq", self.coefficients, monomial_values(X, self.exponents),
+                         optimize=True).reshape(2, 2, *self.coefficients.shape[:1], X.shape[1])
+
+    def derivatives_at_reference(self, X: np.ndarray) -> np.ndarray:
+        """d/dx_k (grad u_h)_ij (2, 2, 2, nE, nq) at the same reference points X (2, nq) of
+        every cell (no gathering: each cell's own coefficients)."""
+        by_reference = np.array([
+            np.einsum("Emc,mq->cEq", self.coefficients, monomial_values(X, self.exponents, r),
+                      optimize=True).reshape(2, 2, *self.coefficients.shape[:1], X.shape[1])
+            for r in range(2)])  # (r, 2, 2, nE, nq)
+        return np.einsum("rijEq,rkE->ijkEq", by_reference, self.inverse, optimize=True)

@@ -5,8 +5,9 @@ so that its error against a reference on another mesh is measured by the same
 Each cell is split along its diagonal v0-v2 into two triangles. On a parallelogram the bilinear
 map is affine, so the gradient of a Q_p field is, on each half, a polynomial of degree at most
 2p - 1 in x (Q1: linear; Q2: cubic): it is sampled at the lattice of that degree on the half
-and stored exactly, as ``GradientField.from_solution`` does for P_p. On a cell that is not a
-parallelogram the stored polynomial interpolates the gradient at the lattice points.
+and stored exactly, as ``GradientField.from_solution`` does for P_p (the values from the
+cell's own gradient polynomials, ``formulations.quad_evaluation``; cells that are not
+parallelograms are refused there).
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ from skfem import Basis, MeshTri
 
 from bench.measure.fields import GradientField, Locator, _lattice, _powers, monomials
 from formulations.cells import family_of
+from formulations.quad_evaluation import QuadGradient
 
 # the halves of the reference square [0, 1]^2: corners (v0, v1, v2) and (v0, v2, v3)
 HALVES = (np.array([[0.0, 1.0, 1.0], [0.0, 0.0, 1.0]]),
@@ -28,12 +30,12 @@ def quad_gradient_field(basis: Basis, u: np.ndarray) -> GradientField:
     mesh = basis.mesh
     degree = 2 * _order(basis) - 1
     nodes = _lattice(degree, 2)  # (2, k) in the reference triangle
+    field = QuadGradient.from_solution(basis, u, _order(basis))
     values = []
     for half in HALVES:
         square = half[:, :1] + (half[:, 1:2] - half[:, :1]) * nodes[0] \
             + (half[:, 2:3] - half[:, :1]) * nodes[1]
-        sampled = Basis(mesh, basis.elem, quadrature=(square, np.full(square.shape[1], 1.0)))
-        values.append(sampled.interpolate(u).grad)  # (2, 2, nE, k)
+        values.append(field.at_reference(square))  # (2, 2, nE, k)
     grad = np.stack(values, axis=3).reshape(2, 2, -1, nodes.shape[1])  # cell-major halves
     solve = np.linalg.inv(_powers(nodes, degree).T)
     coefficients = np.einsum("mk,ijek->ijme", solve, grad)
