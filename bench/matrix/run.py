@@ -111,18 +111,8 @@ class RunConfig:
             if name in SWEPT:
                 for item in items:
                     parse_item(item, name)
-        object.__setattr__(self, "orders", tuple(self.orders))
-        if not self.orders or len(set(self.orders)) < len(self.orders):
-            raise ValueError(f"orders={list(self.orders)!r}: give each order once, from "
-                             f"{', '.join(map(str, ORDERS))}")
-        for order in self.orders:
-            check_order(order)
-        object.__setattr__(self, "cells", tuple(self.cells))
-        if not self.cells or len(set(self.cells)) < len(self.cells):
-            raise ValueError(f"cells={list(self.cells)!r}: give each cell once, from "
-                             f"{', '.join(cell_names())}")
-        for cell in self.cells:
-            check_cell(cell)
+        self._check_axis("orders", "order", list(map(str, ORDERS)), check_order)
+        self._check_axis("cells", "cell", cell_names(), check_cell)
         for name in ("reference_dofs", "crosscheck_dofs", "workers"):
             value = getattr(self, name)
             if value is not None and not (is_integer(value) and value >= 0):
@@ -139,6 +129,17 @@ class RunConfig:
                              f"a guaranteed bound ({', '.join(guaranteed_estimators())}); "
                              f"{', '.join(unsafe)} bound the error only up to a constant")
         self.loop()  # validates the loop's options
+
+    def _check_axis(self, name: str, one: str, allowed: list[str], check) -> None:
+        """A matrix axis (orders, cells): a non-empty tuple naming each value once, each one
+        passing ``check``."""
+        values = tuple(getattr(self, name))
+        object.__setattr__(self, name, values)
+        if not values or len(set(values)) < len(values):
+            raise ValueError(f"{name}={list(values)!r}: give each {one} once, from "
+                             f"{', '.join(allowed)}")
+        for value in values:
+            check(value)
 
     def specs(self) -> list[SequenceSpec]:
         return cross_product(
