@@ -135,6 +135,18 @@ def memory_refusal(level: int, ndofs: int, solver: str, config: LoopConfig,
             f"{route(solver, backend)}), {limit:.2f} available")
 
 
+def level_refusal(level: int, ndofs: int, solver: str, config: LoopConfig,
+                  dim: int) -> tuple[str, str] | None:
+    """Why a level of ``ndofs`` unknowns is not built, as (end of the sequence, the failed
+    row's reason, '' for none), or None: over the DOF budget (a failed row only for the
+    starting mesh) or over the memory."""
+    if ndofs > config.max_dofs:
+        return "budget", (f"budget: the starting mesh has {ndofs} DOFs, over max_dofs="
+                          f"{config.max_dofs}" if level == 0 else "")
+    refusal = memory_refusal(level, ndofs, solver, config, dim)
+    return None if refusal is None else ("memory", refusal)
+
+
 def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
                  config: LoopConfig, identity: dict | None = None,
                  mesh: MeshTri | None = None, truth=None, crosscheck_dofs: int = 0,
@@ -156,19 +168,14 @@ def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
     t_refine, previous = 0.0, None
     for level in range(config.max_levels):
         ndofs = family.count_free_dofs(scene, mesh, config.order)  # before any assembly
-        if ndofs > config.max_dofs:  # the starting mesh counts too: a failed row says so
-            if level == 0:
-                yield LevelResult(ResultRow(
-                    **ident, level=0, ndofs=ndofs, n_elements=mesh.t.shape[1],
-                    status=STATUS_FAILED, reason=f"budget: the starting mesh has {ndofs} DOFs, "
-                    f"over max_dofs={config.max_dofs}"), None, None)
-            return "budget"
-        refusal = memory_refusal(level, ndofs, solver, config, scene.dim)
-        if refusal is not None:
-            yield LevelResult(ResultRow(**ident, level=level, ndofs=ndofs,
-                                        n_elements=mesh.t.shape[1], status=STATUS_FAILED,
-                                        reason=refusal), None, None)
-            return "memory"
+        refusal = level_refusal(level, ndofs, solver, config, scene.dim)
+        if refusal is not None:  # over the budget or the memory: a failed row says so
+            end, reason = refusal
+            if reason:  # a later level over the budget is just the end
+                yield LevelResult(ResultRow(**ident, level=level, ndofs=ndofs,
+                                            n_elements=mesh.t.shape[1], status=STATUS_FAILED,
+                                            reason=reason), None, None)
+            return end
         scene.check_mesh(mesh, level)
         start = time.perf_counter()
         disc = discretise(scene, mesh)
