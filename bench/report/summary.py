@@ -69,8 +69,11 @@ def claim_verdicts(rates: pd.DataFrame, scene: str) -> str:
     mine = rates[(rates["scene"] == scene) & (rates["verdict"] != "")]
     if mine.empty:
         return "no claim"
-    agree = int((mine["verdict"] == "agrees").sum())
-    return f"{agree} of {len(mine)} slopes agree"
+    coarse = mine["verdict"].str.startswith("too coarse")
+    judged = mine[~coarse]
+    agree = int((judged["verdict"] == "agrees").sum())
+    text = f"{agree} of {len(judged)} slopes agree"
+    return text + (f" ({int(coarse.sum())} too coarse to judge)" if coarse.any() else "")
 
 
 def flags(everything: pd.DataFrame) -> str:

@@ -12,6 +12,10 @@ from estimators import guaranteed_estimators
 from formulations import STATUS_OK
 
 CLAIM_TOLERANCE = 0.1  # |measured - claimed| slope within which we say "agrees"
+# a slope is a verdict only from this many levels whose last has at least this many DOFs:
+# fewer, coarser levels are pre-asymptotic (a 3-level fit under 600 DOFs says nothing)
+MIN_FIT_LEVELS = 4
+MIN_VERDICT_DOFS = 2000
 TIME_SHIFT = 1.0  # s, shift of the shifted geometric mean of times
 
 
@@ -22,12 +26,23 @@ def _fmt(value, spec=".3g") -> str:
         else str(value)
 
 
-def _verdict(measured: float, claimed: float) -> str:
+def _verdict(measured: float, claimed: float, levels: int = MIN_FIT_LEVELS,
+             ndofs: int = MIN_VERDICT_DOFS, pressure_rate: float = np.nan) -> str:
+    """The measured slope against the claimed one; no verdict from too few or too coarse
+    levels; a growing error never agrees (nor a row whose pressure error grows)."""
     if not np.isfinite(measured):
         return "not measured"
+    if levels < MIN_FIT_LEVELS or ndofs < MIN_VERDICT_DOFS:
+        return f"too coarse to judge ({levels} levels to {ndofs} DOFs)"
+    if measured >= 0:
+        return "error grows"
     if abs(measured - claimed) <= CLAIM_TOLERANCE:
-        return "agrees"
-    return "steeper than claimed" if measured < claimed else "shallower than claimed"
+        verdict = "agrees"
+    else:
+        verdict = "steeper than claimed" if measured < claimed else "shallower than claimed"
+    if np.isfinite(pressure_rate) and pressure_rate > 0:
+        verdict += f", but the pressure error grows (slope {pressure_rate:+.2f})"
+    return verdict
 
 
 def rate_verdicts(rates: pd.DataFrame) -> pd.DataFrame:
@@ -43,7 +58,10 @@ def rate_verdicts(rates: pd.DataFrame) -> pd.DataFrame:
                      "error rate": _fmt(r["error_rate"]), "eta rate": _fmt(r["eta_rate"]),
                      "pressure error rate": _fmt(r["pressure_error_rate"]),
                      "claimed": _fmt(claimed), "source": source,
-                     "verdict": _verdict(measured, claimed) if np.isfinite(claimed) else ""})
+                     "verdict": _verdict(measured, claimed, int(r.get("fit_levels", 0)),
+                                         int(r.get("ndofs_last", 0)),
+                                         r.get("pressure_error_rate", np.nan))
+                     if np.isfinite(claimed) else ""})
     return without_empty_labels(pd.DataFrame(rows))
 
 
