@@ -41,6 +41,8 @@ def body_mesh(data: dict):
     u = (np.vstack([data["u"], np.zeros(data["u"].shape[1])]) if planar else data["u"]).T
     cells = {"stress": stress_tensor(data["stress"]), "von_mises": data["von_mises"],
              "indicator": data["indicators"], "error_density": data["error_density"]}
+    # a field the run did not compute (no truth: no error density) is left out, not NaN
+    cells = {k: v for k, v in cells.items() if np.isfinite(np.asarray(v, dtype=float)).any()}
     kind = MESHIO_CELLS[(data["p"].shape[0], data["t"].shape[0])]
     return meshio.Mesh(points, [(kind, data["t"].T)],
                        point_data={"displacement": u},

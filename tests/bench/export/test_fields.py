@@ -106,3 +106,16 @@ def test_every_level_is_written_and_collected_in_one_series(results, tmp_path, f
         for item in root.iter("DataItem"):  # every heavy-data path resolves from the series
             assert (tmp_path / item.text.strip().split(":")[0]).is_file()
     assert (tmp_path / f"{stem}-contact{series.suffix}").is_file()
+
+
+def test_a_field_the_run_did_not_compute_is_left_out_not_written_as_nan():
+    from bench.export.fields import body_mesh
+
+    mesh = get_scene("paper").mesh
+    n = mesh.t.shape[1]
+    data = {"p": mesh.p, "t": mesh.t, "u": np.zeros_like(mesh.p),
+            "stress": np.ones((3, n)), "von_mises": np.ones(n), "indicators": np.ones(n),
+            "error_density": np.full(n, np.nan)}  # a scene without truth
+    body = body_mesh(data)
+    assert "error_density" not in body.cell_data
+    assert {"stress", "von_mises", "indicator"} <= set(body.cell_data)
