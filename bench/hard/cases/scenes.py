@@ -35,8 +35,10 @@ def applied_load(solution) -> float:
 
 def scene_finding(row: dict, solution) -> str:
     """The contact zone, force and active rows in numbers; the force against the applied load
-    where the body is loaded."""
-    zone = contact_zone(solution) if solution.status != STATUS_FAILED else (np.nan, np.nan)
+    where the body is loaded; a failed solve says that it failed, and why."""
+    if solution.status == STATUS_FAILED:
+        return f"the {row['solver']} solve failed: {row['reason'] or 'no reason given'}"
+    zone = contact_zone(solution)
     force = row["contact_force"]
     text = (f"contact zone [{zone[0]:.3g}, {zone[1]:.3g}], force {force:.4g}" if np.isfinite(
         zone[0]) else f"no contact, force {force:.3g}")
@@ -76,11 +78,14 @@ def scene_case(name: str, cell: str = DEFAULT_CELL) -> list[dict]:
             continue
         rows, sols = solve_both(name, scene, formulation, mesh, variant=variant,
                                 level=hard_level(scene))
-        change = force_change(scene, formulation, coarse, rows[0]["contact_force"])
+        fine = next((r["contact_force"] for r in rows if r["status"] != STATUS_FAILED), np.nan)
+        change = force_change(scene, formulation, coarse, fine)
         for row, sol in zip(rows, sols, strict=True):
-            row["finding"] = (scene_finding(row, sol)
-                              + f"; force changed by {change:.1%} from the level before")
+            row["finding"] = scene_finding(row, sol)
             row["force_change"] = change
-            row["discretisation"] = "settled" if change <= SETTLED else "unsettled"
+            row["discretisation"] = ""  # a failed solve judges no discretisation
+            if sol.status != STATUS_FAILED:
+                row["finding"] += f"; force changed by {change:.1%} from the level before"
+                row["discretisation"] = "settled" if change <= SETTLED else "unsettled"
         records += rows
     return records

@@ -2,6 +2,7 @@
 scene's grid, the variant naming the cells; a shape that cannot carry a scene is one row that
 says why, and no verdict is judged on it."""
 
+import numpy as np
 import pandas as pd
 
 from bench.hard.cases.scenes import scene_case
@@ -23,3 +24,13 @@ def test_hexahedra_are_one_row_that_says_why_and_judge_nothing():
     assert len(records) == 1 and records[0]["status"] == "skipped"
     assert "contact surface of hexahedra" in records[0]["reason"]
     assert check_expected(pd.DataFrame(records), load_expected().get("hard", [])) == []
+
+
+def test_a_failed_solve_is_reported_as_a_failure_with_its_reason():
+    from types import SimpleNamespace
+
+    from bench.hard.cases.scenes import scene_finding
+
+    row = {"solver": "reference", "reason": "Clarabel: max iterations", "contact_force": np.nan}
+    finding = scene_finding(row, SimpleNamespace(status="failed"))
+    assert finding == "the reference solve failed: Clarabel: max iterations"
