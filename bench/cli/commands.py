@@ -17,6 +17,7 @@ from bench.cli.guards import InputError, check_compare_out, check_output_folders
 from bench.cli.listing import list_command
 from bench.cli.parser import build_parser
 from bench.cli.progress import Progress
+from bench.cli.scaling_commands import scaling_command
 from bench.cli.study import study_command
 from bench.export import export_results
 from bench.hard import (
@@ -31,16 +32,13 @@ from bench.matrix.plugins import load_plugins
 from bench.matrix.run import RunRefused, compare_reference_dofs
 from bench.matrix.scene_files import load_scene_files, scene_files_in
 from bench.matrix.store import ResultsError, read_results
-from bench.perf.scaling import SIZES, run_scaling, write_scaling
-from bench.perf.scaling_3d import SIZES_3D, run_scaling_3d, write_scaling_3d
-from bench.perf.sequence import SEQUENCES, run_sequences, write_sequences
 from bench.report import write_report
+from bench.report.console import console_summary
 from bench.sequence.loop import LevelResult
 from bench.sequence.rows import KEYS, level_time
 from bench.verify import load_expected, verdict_table, verify
 from estimators import estimator_names
 from formulations import formulation_names
-from formulations.solvers.backends import check_backend
 from formulations.solvers.registry import FAST_SOLVER
 from scenes import get_scene, scene_names
 from scenes.registry import SCENES, scene_dim
@@ -75,7 +73,9 @@ def configured(**fields) -> RunConfig | None:
         return None
 
 
-def run_config(config: RunConfig | None) -> int:
+def run_config(config: RunConfig | None, quiet: bool = False) -> int:
+    """Run ``config``; ``quiet``: without the per-sequence tables (compare prints its own
+    summary)."""
     if config is None:
         return 2
     live = Progress(len(config.specs()))
@@ -84,9 +84,10 @@ def run_config(config: RunConfig | None) -> int:
     if result.reused:
         print(f"reused {len(result.reused)} sequences finished by an earlier run in "
               f"{result.store.out}")
-    print(f"wrote {result.store.out / 'rates.md'}\n")
-    print(summary(result.table))
-    print(f"\nwrote {len(result.rows)} rows to {result.store.parquet} and {result.store.csv}")
+    print(f"wrote {result.store.out / 'rates.md'}")
+    if not quiet:
+        print("\n" + summary(result.table) + "\n")
+    print(f"wrote {len(result.rows)} rows to {result.store.parquet} and {result.store.csv}")
     return 1 if result.failed else 0
 
 
@@ -105,17 +106,21 @@ def run_command(args) -> int:
     return run_config(config)
 
 
-def hard_command(args) -> int:
+def hard_command(args, quiet: bool = False) -> int:
+    """Run the hard cases; ``quiet``: one line per case and the file written (compare prints
+    the verdict counts and the unexpected rows last)."""
     def show(name, frame):
         print(f"hard case {name}: {len(frame)} rows, verdicts "
               + ", ".join(f"{v} {n}" for v, n in frame["verdict"].value_counts().items()),
               flush=True)
 
     table = run_hard(args.case, on_case=show, cells=args.cell)
-    print(f"wrote {write_hard(table, args.out)}\n")
-    print(hard_markdown(table))
+    print(f"wrote {write_hard(table, args.out)}")
     checks = check_expected(table, load_expected().get("hard", []))
     wrong = [c for c in checks if not c["passed"]]
+    if quiet:
+        return 1 if wrong else 0
+    print("\n" + hard_markdown(table))
     for c in wrong:
         print(f"UNEXPECTED: {c['case']}/{c['formulation']}/{c['solver']}/{c['variant']}: "
               f"{c['verdict']}, expected {c['expected']}")
@@ -165,16 +170,25 @@ def compare_command(args) -> int:
         except ValueError as error:
             raise InputError(str(error)) from None
     start = time.perf_counter()
-    status = run_config(config)
+    status = run_config(config, quiet=True)
     if config is None:
         return status
     args.case = None
-    hard_status = hard_command(args) if args.dim == 2 else 0  # the hard cases are 2D
-    print(f"wrote {write_report(read_results(args.out), args.reports, args.out)}")
+    hard_status = hard_command(args, quiet=True) if args.dim == 2 else 0  # the hard cases: 2D
+    table = read_results(args.out)
+    readme = write_report(table, args.reports, args.out)
     if args.readme is not None:
         write_compare_block(args.readme, args.out, time.perf_counter() - start)
         print(f"wrote the compare figures into {args.readme}")
+    print_summary(readme, table, args.out, time.perf_counter() - start)
     return status or hard_status
+
+
+def print_summary(readme: Path, table: pd.DataFrame, results, seconds: float | None) -> None:
+    """The console's last lines (``bench.report.console``)."""
+    hard_csv = Path(results) / "hard.csv"
+    hard = pd.read_csv(hard_csv) if hard_csv.exists() else None
+    print("\n" + "\n".join(console_summary(readme, table, hard, seconds)))
 
 
 def report_command(args) -> int:
@@ -182,7 +196,9 @@ def report_command(args) -> int:
     if table is None:
         print(f"error: --results={args.results!r} holds no results.parquet", file=sys.stderr)
         return 2
-    print(f"wrote {write_report(table, args.out, args.results)}")
+    start = time.perf_counter()
+    readme = write_report(table, args.out, args.results)
+    print_summary(readme, table, args.results, time.perf_counter() - start)
     return 0
 
 
@@ -208,52 +224,6 @@ def verify_command(args) -> int:
     print(f"\n{len(verdicts) - len(failed)} of {len(verdicts)} gates pass"
           f"{'' if not failed else '; FAILED: ' + ', '.join(sorted({v.gate for v in failed}))}")
     return 1 if failed else 0
-
-
-def scaling_command(args) -> int:
-    def show(row):
-        print(f"{row['size']} P{row['order']}: ndofs {row['ndofs']}  "
-              f"fast {row['t_fast_solve']:.2f} s  "
-              f"linear {row['t_linear_solve']:.2f} s  reference "
-              f"{row['t_reference_solve']:.2f} s  peak {row['peak_gib']:.2f} GiB", flush=True)
-    try:
-        check_backend(args.backend)
-    except ValueError as error:
-        raise InputError(f"--backend: {error}") from None
-    if args.sequence:
-        return sequence_command(args)
-    sizes = args.sizes or list(SIZES_3D if args.dim == 3 else SIZES)
-    allowed = SIZES_3D if args.dim == 3 else SIZES
-    wrong = [size for size in sizes if size not in allowed]
-    if wrong:
-        raise InputError(f"--sizes={','.join(wrong)} is not one of {', '.join(allowed)} "
-                         f"in {args.dim}D")
-    if args.dim == 3:
-        frame = run_scaling_3d(sizes, args.backend, args.order, on_row=show_3d)
-        print(f"wrote {write_scaling_3d(frame, args.out, args.readme)}")
-        return 0
-    frame = run_scaling(sizes, args.backend, args.reference_max_dofs, on_row=show,
-                        orders=args.order)
-    print(f"wrote {write_scaling(frame, args.out, args.readme)}")
-    return 0
-
-
-def show_3d(row) -> None:
-    print(f"{row['size']} P{row['order']} 3D: ndofs {row['ndofs']}  assembly "
-          f"{row['t_assemble']:.2f} s  linear {row['t_linear_solve']:.2f} s  fast "
-          f"{row['t_fast_solve']:.2f} s  peak {row['peak_gib']:.2f} GiB", flush=True)
-
-
-def sequence_command(args) -> int:
-    def show(row):
-        print(f"{row['strategy']} to {row['max_dofs']} ({row['cell']}): {row['levels']} levels, "
-              f"finest "
-              f"{row['final_ndofs']} DOFs, {row['t_sequence']:.1f} s = "
-              f"{row['sequence_over_linear']:.1f} linear solves at the finest level", flush=True)
-    budgets = zip([s for s, _ in SEQUENCES], args.sequence_max_dofs, strict=True)
-    frame = run_sequences(list(budgets), args.backend, on_row=show, cells=args.cell)
-    print(f"wrote {write_sequences(frame, args.out, args.readme)}")
-    return 0
 
 
 COMMANDS = {"run": run_command, "compare": compare_command, "report": report_command,

@@ -41,7 +41,9 @@ def fastest(group: pd.DataFrame) -> dict:
         below = seq[seq[column] <= target]
         if len(below):
             first = below.iloc[0]
-            ranking.append({"combination": "/".join(str(first[k]) for k in COMBINATION[:4]),
+            cell = str(first.get("cell", "tri"))
+            ranking.append({"combination": "/".join(str(first[k]) for k in COMBINATION[:4])
+                            + ("" if cell in ("tri", "nan") else f"/{cell}"),
                             "order": int(first["order"]), "ndofs": int(first["ndofs"]),
                             "seconds": float(first["cumulative"])})
     ranking.sort(key=lambda r: r["seconds"])

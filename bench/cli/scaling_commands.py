@@ -1,0 +1,55 @@
+"""``python -m bench scaling``: the scaling table (2D, 3D) and the sequence benchmark."""
+
+from __future__ import annotations
+
+from bench.cli.guards import InputError
+from bench.perf.scaling import SIZES, run_scaling, write_scaling
+from bench.perf.scaling_3d import SIZES_3D, run_scaling_3d, write_scaling_3d
+from bench.perf.sequence import SEQUENCES, run_sequences, write_sequences
+from formulations.solvers.backends import check_backend
+
+
+def scaling_command(args) -> int:
+    def show(row):
+        print(f"{row['size']} P{row['order']}: ndofs {row['ndofs']}  "
+              f"fast {row['t_fast_solve']:.2f} s  "
+              f"linear {row['t_linear_solve']:.2f} s  reference "
+              f"{row['t_reference_solve']:.2f} s  peak {row['peak_gib']:.2f} GiB", flush=True)
+    try:
+        check_backend(args.backend)
+    except ValueError as error:
+        raise InputError(f"--backend: {error}") from None
+    if args.sequence:
+        return sequence_command(args)
+    sizes = args.sizes or list(SIZES_3D if args.dim == 3 else SIZES)
+    allowed = SIZES_3D if args.dim == 3 else SIZES
+    wrong = [size for size in sizes if size not in allowed]
+    if wrong:
+        raise InputError(f"--sizes={','.join(wrong)} is not one of {', '.join(allowed)} "
+                         f"in {args.dim}D")
+    if args.dim == 3:
+        frame = run_scaling_3d(sizes, args.backend, args.order, on_row=show_3d)
+        print(f"wrote {write_scaling_3d(frame, args.out, args.readme)}")
+        return 0
+    frame = run_scaling(sizes, args.backend, args.reference_max_dofs, on_row=show,
+                        orders=args.order)
+    print(f"wrote {write_scaling(frame, args.out, args.readme)}")
+    return 0
+
+
+def show_3d(row) -> None:
+    print(f"{row['size']} P{row['order']} 3D: ndofs {row['ndofs']}  assembly "
+          f"{row['t_assemble']:.2f} s  linear {row['t_linear_solve']:.2f} s  fast "
+          f"{row['t_fast_solve']:.2f} s  peak {row['peak_gib']:.2f} GiB", flush=True)
+
+
+def sequence_command(args) -> int:
+    def show(row):
+        print(f"{row['strategy']} to {row['max_dofs']} ({row['cell']}): {row['levels']} levels, "
+              f"finest "
+              f"{row['final_ndofs']} DOFs, {row['t_sequence']:.1f} s = "
+              f"{row['sequence_over_linear']:.1f} linear solves at the finest level", flush=True)
+    budgets = zip([s for s, _ in SEQUENCES], args.sequence_max_dofs, strict=True)
+    frame = run_sequences(list(budgets), args.backend, on_row=show, cells=args.cell)
+    print(f"wrote {write_sequences(frame, args.out, args.readme)}")
+    return 0
