@@ -1,6 +1,6 @@
 """The starting mesh's budget: a scene builds its initial mesh through ``tensor_mesh`` (or
 calls ``check_vertex_count`` before building one of its own), which refuses a mesh larger than
-the run allows before a single vertex is allocated (README, "Reliability").
+the run allows before a single vertex is allocated (docs/reliability.md).
 
 The caller of a scene factory sets the budget (``vertex_budget``) from its DOF budget; without
 one, nothing is refused. The exact level-0 DOF count is checked again once the mesh exists

@@ -9,7 +9,7 @@ approach delta, traction-free sides. At the contact force P, with E* = E / (1 - 
     a = (3 P R / (4 E*))^(1/3),   p0 = 3 P / (2 pi a^2),   p(r) = p0 sqrt(1 - r^2 / a^2),
 
 valid while a << D, W. The defaults give a ~ 0.14 (R = 1, delta = 0.02) against D = W = 2; the
-half-space assumption's own cost is measured in the README's 3D section.
+half-space assumption's own cost is measured in docs/three-d.md.
 """
 
 from __future__ import annotations

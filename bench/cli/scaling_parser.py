@@ -21,7 +21,7 @@ def add_scaling_parser(sub) -> None:
         "scaling", help="time assembly, linear solve, fast and reference contact solves and "
         "the estimator against N, with peak memory",
         description="Measure every phase once per size, each size in a fresh process, and "
-        "write OUT/scaling.{md,csv} (and the README's table with --readme).")
+        "write OUT/scaling.{md,csv} (and the table of a Markdown page with --readme).")
     scaling.add_argument("--sizes", type=name_list("size", sorted(set(SIZES) | set(SIZES_3D))),
                          default=None, help=f"sizes, comma-separated: {', '.join(SIZES)}; with "
                          f"--dim 3: {', '.join(SIZES_3D)} (default: all of the dimension's)")
@@ -39,7 +39,7 @@ def add_scaling_parser(sub) -> None:
     scaling.add_argument("--out", default="reports", help="output folder (default: reports)")
     scaling.add_argument("--readme", default=None,
                          help="also replace the table between the scaling markers of this "
-                              "README (e.g. README.md)")
+                              "Markdown file (e.g. docs/solvers.md; docs/three-d.md with --dim 3)")
     scaling.add_argument("--sequence", action="store_true",
                          help="time whole sequences instead (an adaptive one and a uniform one, "
                               "every level and phase) against one linear solve at the finest "

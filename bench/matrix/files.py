@@ -1,6 +1,6 @@
 """Files of a results folder that may be damaged: a parquet read from one open, atomic writes,
 the checksums that say whether the tables are stale, and a damaged partition restored from
-the tables or set aside (README, "Reliability")."""
+the tables or set aside (docs/reliability.md)."""
 
 from __future__ import annotations
 

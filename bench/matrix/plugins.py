@@ -1,5 +1,5 @@
 """Plugins: installed packages that register scenes, formulations, solvers, back-ends,
-estimators or hard cases through entry points (README, "Plugins").
+estimators or hard cases through entry points (docs/own-problem.md, "Plugins").
 
 A package declares, in its ``pyproject.toml``, one entry point per module to import, in the
 group of what it registers::

@@ -66,7 +66,7 @@ def compare_reference_dofs(given: int | None, dim: int) -> int:
 class RunConfig:
     """Everything that determines a run of the matrix (the options of ``python -m bench run``).
     Name lists are checked against the registries on construction; a scene or formulation may
-    carry a sweep, ``paper:poisson_ratio=0.3|0.45`` (see the README)."""
+    carry a sweep, ``paper:poisson_ratio=0.3|0.45`` (docs/command-line.md)."""
 
     scenes: tuple[str, ...] = ("paper",)
     formulations: tuple[str, ...] = ("mixed",)

@@ -151,7 +151,7 @@ def phase_table(frame: pd.DataFrame) -> str:
 def run_scaling(sizes, backend=None, reference_max_dofs=200_000, on_row=None,
                 orders=(1,)) -> pd.DataFrame:
     """``measure`` every size (and order) in its own spawned process; the reference only up to
-    ``reference_max_dofs`` (its time grows fastest; see the README for where it stops)."""
+    ``reference_max_dofs`` (its time grows fastest; docs/solvers.md says where it stops)."""
     from formulations.elasticity import count_free_dofs
 
     rows = []

@@ -1,6 +1,6 @@
 """One result row per (scene, formulation, solver, estimator, strategy, level).
 
-Column names are a public interface (see the README's table of columns and units): add new
+Column names are a public interface (docs/columns.md: the columns and their units): add new
 columns, never rename.
 """
 

@@ -1,5 +1,5 @@
-"""The documented baseline workflow of pytest-benchmark (README, "Benchmarks"): save a baseline
-JSON, then compare a second run against it with a regression threshold."""
+"""The documented baseline workflow of pytest-benchmark (docs/solvers.md, "Benchmarks"): save a
+baseline JSON, then compare a second run against it with a regression threshold."""
 
 import json
 import subprocess
@@ -27,8 +27,8 @@ def test_a_saved_baseline_is_compared_and_gates_regressions(tmp_path):
     [baseline] = (tmp_path / "store").rglob("0001_baseline.json")
     names = {b["name"] for b in json.loads(baseline.read_text())["benchmarks"]}
     assert {"test_linear_solve[1e4]", "test_fast_contact_solve[1e4]"} <= names
-    # the same code again: within the README's threshold (median +100 %: three runs of these
-    # 10^4 workloads spread by 7 to 46 % on the 2-core machine)
+    # the same code again: within the threshold of docs/solvers.md (median +100 %: three runs of
+    # these 10^4 workloads spread by 7 to 46 % on the 2-core machine)
     same = _pytest(tmp_path, "--benchmark-compare=0001", "--benchmark-compare-fail=median:100%")
     assert same.returncode == 0, same.stdout + same.stderr
     assert "0001_baseli" in same.stdout and "(NOW)" in same.stdout  # both rows in the table

@@ -8,7 +8,7 @@ benchmarks cannot rot. To measure (the larger sizes are marked slow)::
         --benchmark-json=benchmarks.json
 
 The reference solver is benchmarked at 10^4 and 10^5 only: at 10^6 DOFs one Clarabel solve
-takes minutes (see the README's scaling table), too long to repeat.
+takes minutes (see the scaling table in docs/solvers.md), too long to repeat.
 """
 
 import numpy as np

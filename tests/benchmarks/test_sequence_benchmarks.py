@@ -1,7 +1,7 @@
 """pytest-benchmark benchmarks of adaptive refinement (marking included) and of whole
 sequences at ~10^4 and 10^5 DOFs (10^6 marked slow): the paper scene, mixed method, active set,
 residual estimator, the workloads of ``python -m bench scaling --sequence`` without the error
-against the reference. Run and compared as the README's "Benchmarks" says."""
+against the reference. Run and compared as docs/solvers.md, "Benchmarks", says."""
 
 import pytest
 

@@ -34,6 +34,7 @@ def test_energy_and_contact_force_spreads_shrink(values):
 
 
 def test_every_formulation_presses_with_a_plausible_force(values):
-    # the adaptive mixed run settles at 5865 (README); all three are within 1 % at 8320 DOFs
+    # the adaptive mixed run settles at 5865 (docs/results.md); all three are within 1 % at
+    # 8320 DOFs
     for name in MEASURED:
         assert values[name, 4][1] == pytest.approx(5865.0, rel=0.01)

@@ -1,6 +1,6 @@
 """User code cannot break the suite: a scene, scene file or plugin that fails to build, raises
 or exits is named once on stderr and left out, and every other scene and command keeps
-working; no command builds every scene to read its tags (README, "Reliability")."""
+working; no command builds every scene to read its tags (docs/reliability.md)."""
 
 import sys
 

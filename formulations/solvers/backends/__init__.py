@@ -15,8 +15,7 @@ so B K^-1 B' = B_C S_C^-1 B_C' is a small dense matrix. A back-end is one module
 * ``splu`` (``splu.py``; scipy's SuperLU, always there): no cheap S_C, so the active-set solver
   factorises the augmented saddle-point system once per iteration (``augmented``).
 
-The measured comparison that fixed this order is in the README ("Solvers, sparse back-ends and
-scaling").
+The measured comparison that fixed this order is in docs/solvers.md.
 """
 
 from __future__ import annotations
