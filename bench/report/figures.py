@@ -8,15 +8,13 @@ from __future__ import annotations
 import textwrap
 
 import numpy as np
-import pandas as pd
 from matplotlib.collections import LineCollection, PolyCollection
 from matplotlib.figure import Figure
 from matplotlib.tri import Triangulation
 
 from bench.sequence.loop import STRATEGIES
-from bench.sequence.rows import phase_time
 from estimators import estimator_names
-from formulations import STATUS_OK, formulation_names
+from formulations import formulation_names
 from formulations.contact import facet_coordinates
 
 COLOUR_CYCLE = [f"C{k}" for k in range(10)]
@@ -43,114 +41,12 @@ def marker(strategy: str) -> str:
     return _from_cycle(strategy, list(STRATEGIES), MARKER_CYCLE)
 
 
-def _line(ax, group: pd.DataFrame, x: str, y: str, key: tuple, label: bool = True):
-    formulation, estimator, strategy = key[:3]
-    ok = group[(group["status"] == STATUS_OK) & (group[y] > 0)].sort_values(x)
-    if ok.empty:
-        return
-    ax.loglog(ok[x], ok[y], color=colour(formulation), linestyle=line_style(estimator),
-              marker=marker(strategy), markersize=3, linewidth=1,
-              label=_name(key) if label else None)
-
-
 def _slope_triangle(ax, x0: float, y0: float, slope: float, text: str):
     x1 = x0 * 10
     y1 = y0 * 10**slope
     ax.loglog([x0, x1, x1, x0], [y0, y0, y1, y0], color="k", linewidth=0.7)
     ax.annotate(text, (x1, np.sqrt(y0 * y1)), fontsize=7, xytext=(3, 0),
                 textcoords="offset points")
-
-
-def _keys(table):
-    """Groups of one sequence's levels: formulation, estimator, strategy (and the order and
-    the cells where the table has several)."""
-    return table.groupby(["formulation", "estimator", "strategy", *_order_key(table)],
-                         sort=True)
-
-
-def _order_key(table) -> list[str]:
-    """The sequence columns beyond the combination that vary in ``table``: order, cell."""
-    return [c for c in ("order", "cell") if c in table and table[c].nunique() > 1]
-
-
-def _name(key: tuple) -> str:
-    """'formulation/estimator/strategy', with '/P<order>' and '/<cell>' when the key carries
-    them."""
-    return "/".join(str(k) for k in key[:3]) + "".join(
-        f"/P{k}" if isinstance(k, (int, np.integer)) else f"/{k}" for k in key[3:])
-
-
-def convergence(table: pd.DataFrame):
-    """Error and eta against ndofs with O(h^1/2) and O(h) triangles (the paper's Figure 2)."""
-    fig = Figure(figsize=(11, 4.5))
-    axes = fig.subplots(1, 2, sharex=True)
-    has_error = table["energy_error"].gt(0).any()
-    for key, group in _keys(table):
-        _line(axes[0], group, "ndofs", "energy_error", key)
-        _line(axes[1], group, "ndofs", "eta", key, label=not has_error)
-    for ax, name in zip(axes, ("energy-norm error ||u - u_h||", "estimator eta"), strict=True):
-        ax.set_xlabel("ndofs")
-        ax.set_title(name, fontsize=10)
-        ax.grid(True, which="both", alpha=0.3)
-        lines = ax.get_lines()
-        if lines:
-            y = np.concatenate([line.get_ydata() for line in lines])
-            x = np.concatenate([line.get_xdata() for line in lines])
-            _slope_triangle(ax, x.min() * 3, y.max() / 2, -0.25, "-1/4: O(h^1/2)")
-            _slope_triangle(ax, x.min() * 3, y.min() * 4, -0.5, "-1/2: O(h)")
-    if not has_error:
-        axes[0].text(0.5, 0.5, "no error measured\n(no exact solution or reference)",
-                     ha="center", va="center", transform=axes[0].transAxes)
-    handles = axes[0].get_legend_handles_labels()[0] or axes[1].get_legend_handles_labels()[0]
-    if handles:
-        fig.legend(loc="center right", fontsize=7)
-    fig.tight_layout(rect=(0, 0, 0.8, 1))
-    return fig
-
-
-def effectivity(table: pd.DataFrame):
-    if not table["effectivity_index"].gt(0).any():
-        return None
-    fig = Figure(figsize=(8, 4))
-    ax = fig.subplots()
-    for key, group in _keys(table):
-        ok = group[group["effectivity_index"] > 0].sort_values("ndofs")
-        look = dict(color=colour(key[0]), linestyle=line_style(key[1]),
-                     marker=marker(key[2]), markersize=3, linewidth=1)
-        ax.semilogx(ok["ndofs"], ok["effectivity_index"], label=_name(key), **look)
-        coarse = ok[ok["reference_too_coarse"].astype(bool)]
-        ax.semilogx(coarse["ndofs"], coarse["effectivity_index"], "x", color="k", markersize=5)
-    ax.axhline(1.0, color="k", linewidth=0.6)
-    ax.set_yscale("log")  # coarse levels can be off by 100x and would flatten the rest
-    ax.set_xlabel("ndofs")
-    ax.set_ylabel("eta / ||u - u_h||")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=6, ncol=2)
-    fig.tight_layout()
-    return fig
-
-
-def work_precision(table: pd.DataFrame):
-    """Error (or eta) against cumulative wall time and against the solve time per level."""
-    y = "energy_error" if table["energy_error"].gt(0).any() else "eta"
-    fig = Figure(figsize=(11, 4.2))
-    axes = fig.subplots(1, 2, sharey=True)
-    for key, group in table.groupby(["formulation", "solver", "estimator", "strategy",
-                                     *_order_key(table)]):
-        group = group[group["status"] == STATUS_OK].sort_values("level")
-        times = phase_time(group)
-        look = dict(color=colour(key[0]), linestyle=line_style(key[2]),
-                     marker=marker(key[3]), markersize=3, linewidth=1)
-        axes[0].loglog(times.cumsum(), group[y], label="/".join(map(str, key)), **look)
-        axes[1].loglog(group["t_solve"], group[y], **look)
-    axes[0].set_xlabel("cumulative wall time of the sequence [s]")
-    axes[1].set_xlabel("solve time of the level [s]")
-    axes[0].set_ylabel(y)
-    for ax in axes:
-        ax.grid(True, which="both", alpha=0.3)
-    axes[0].legend(fontsize=6)
-    fig.tight_layout()
-    return fig
 
 
 def cell_polygons(p: np.ndarray, t: np.ndarray) -> np.ndarray:

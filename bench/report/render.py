@@ -17,7 +17,6 @@ from bench.matrix.artifacts import file_stem
 from bench.matrix.rates import RATE_LEVELS, judged_levels, rates_table
 from bench.matrix.scene_files import load_scene_files
 from bench.report.estimator_figures import ESTIMATOR_CAPTION, estimator_effectivity
-from bench.report.interactive import plotly_js
 from bench.report.orders import order_section
 from bench.report.sections import Figures, scene_section
 from bench.report.summary import first_screen
@@ -121,7 +120,6 @@ def write_report(table: pd.DataFrame, out: str | Path, results: str | Path | Non
         "summary": first_screen(everything, rows, tables["rates"]),
         "hard_verdicts": hard_verdicts(results),
         "numerics": run_info.get("numerics", {}),
-        "plotly_js": plotly_js(),
         "estimator_figure": figs.add(estimator_effectivity(judged_levels(rows))
                                      if len(rows) else None, "estimators", ESTIMATOR_CAPTION),
         "orders": order_section(rows, figs),

@@ -10,8 +10,7 @@ import numpy as np
 import pandas as pd
 
 from bench.matrix.artifacts import artifact_path, file_stem, load_artifact
-from bench.report import figures, figures_3d
-from bench.report.interactive import interactive_figures
+from bench.report import figures, figures_3d, panels
 from bench.sequence.rows import KEYS
 from scenes import get_scene
 
@@ -24,8 +23,7 @@ class Figures:
         self.out.mkdir(parents=True, exist_ok=True)
         self.items: list[dict] = []
 
-    def add(self, figure, name: str, caption: str, interactive: str | None = None) -> dict | None:
-        """``interactive``: an HTML fragment the HTML report shows instead of the PNG."""
+    def add(self, figure, name: str, caption: str) -> dict | None:
         if figure is None:
             return None
         buffer = io.BytesIO()
@@ -33,7 +31,7 @@ class Figures:
         data = buffer.getvalue()
         (self.out / f"{name}.png").write_bytes(data)
         item = {"file": f"figures/{name}.png", "caption": caption,
-                "data": base64.b64encode(data).decode("ascii"), "html": interactive}
+                "data": base64.b64encode(data).decode("ascii")}
         self.items.append(item)
         return item
 
@@ -109,23 +107,23 @@ def scene_section(name: str, group: pd.DataFrame, results: Path | None, figs: Fi
     artifacts = _artifacts(results, group)
     section = {"name": name, "truth": truth.get(name, {"kind": "unknown"}), "figures": []}
     preferred = _first_adaptive(artifacts)
-    live = interactive_figures(group, name)
     for figure, suffix, caption in (
             (figures.scene_picture(scene) if scene is not None and scene.dim == 2 else None,
              "scene",
              "Geometry (initial mesh), boundary parts and the obstacle."),
-            (figures.convergence(group), "convergence",
-             "Error and estimator against ndofs, uniform (squares) and adaptive (circles), with "
-             "O(h^1/2) and O(h) slope triangles (the paper's Figure 2)."),
-            (figures.effectivity(group), "effectivity",
-             "Effectivity index eta / ||u - u_h||; crosses mark rows whose reference is too "
-             "coarse."),
-            (figures.work_precision(group), "work-precision",
-             "Work-precision: error (eta without a truth) against cumulative wall time and "
-             "against the level's solve time."),
+            (panels.convergence(group), "convergence",
+             "One panel per formulation: the error (solid) and eta (dashed) against ndofs, "
+             "colour = estimator, marker = strategy, with O(h^1/2) and O(h) slope triangles "
+             "(the paper's Figure 2)."),
+            (panels.effectivity(group), "effectivity",
+             "Effectivity index eta / ||u - u_h|| per formulation, colour = estimator, marker = "
+             "strategy; crosses mark rows whose reference is too coarse."),
+            (panels.work_precision(group), "work-precision",
+             "Work-precision per formulation: the error (eta without a truth) against the "
+             "cumulative wall time of the sequence."),
             *(field_figures(scene, name, artifacts, preferred) if scene is None
               or scene.dim == 2 else field_figures_3d(artifacts))):
-        item = figs.add(figure, file_stem(name, suffix), caption, live.get(suffix))
+        item = figs.add(figure, file_stem(name, suffix), caption)
         if item is not None:
             section["figures"].append(item)
     if scene is None:

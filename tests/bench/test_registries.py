@@ -13,7 +13,7 @@ from bench.cli import main
 from bench.hard import hard_case, hard_case_names, run_hard, write_hard
 from bench.hard.registry import HARD_CASES
 from bench.matrix import RunConfig, run
-from bench.report import figures, write_report
+from bench.report import figures, panels, write_report
 from conftest import square_scene
 from estimators import residual
 from estimators.base import ESTIMATORS, register_estimator
@@ -84,8 +84,10 @@ def test_the_hard_table_has_the_scene_with_every_formulation(results):
 def test_figures_give_the_new_formulation_its_own_colour_and_legend(results):
     _, result = results
     paper = result.table[result.table["scene"] == "paper"]
-    legend = [t.get_text() for t in figures.convergence(paper).legends[0].get_texts()]
-    assert f"{NEW_FORMULATION}/{NEW_ESTIMATOR}/adaptive" in legend
+    figure = panels.convergence(paper)
+    assert NEW_FORMULATION in [ax.get_title() for ax in figure.axes]  # its own panel
+    assert NEW_ESTIMATOR in [t.get_text() for t in figure.legends[0].get_texts()]
+    assert panels.estimator_colour(NEW_ESTIMATOR) != panels.estimator_colour("residual")
     assert figures.colour(NEW_FORMULATION) != figures.colour("mixed")
     assert figures.line_style(NEW_ESTIMATOR) != figures.line_style("residual")
 
