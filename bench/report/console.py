@@ -9,7 +9,7 @@ from pathlib import Path
 import pandas as pd
 
 from bench.hard import check_expected
-from bench.report.summary import effectivity_ranges, fastest
+from bench.report.summary import effectivity_ranges, fastest, sig3
 from bench.sequence.rows import with_labels
 from bench.verify import load_expected
 
@@ -28,8 +28,9 @@ def headline(scene: str, group: pd.DataFrame) -> str:
     best = fastest(group)
     top = best["ranking"][0] if best["ranking"] else None
     measure = "error" if best["column"] == "energy_error" else "eta"
-    first = (f"{top['combination']} P{top['order']} first to {measure} {best['target']:.3g} "
-             f"({top['seconds']:.3g} s)" if top else "no combination reached the target")
+    first = (f"{top['combination']} P{top['order']} first to {measure} "
+             f"{sig3(best['target'])} ({sig3(top['seconds'])} s)" if top
+             else "no combination reached the target")
     return f"{scene}: {first}; effectivity {effectivity_ranges(group)}"
 
 

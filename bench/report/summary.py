@@ -14,6 +14,12 @@ from formulations import STATUS_FAILED, STATUS_OK
 COMBINATION = ["formulation", "solver", "estimator", "strategy", "order"]
 
 
+def sig3(value: float) -> str:
+    """Three significant figures, never an exponent in prose: 2120, 0.000341, 4.4."""
+    return np.format_float_positional(float(value), precision=3, unique=False,
+                                      fractional=False, trim="-")
+
+
 def _error_column(group: pd.DataFrame) -> str:
     return "energy_error" if group["energy_error"].gt(0).any() else "eta"
 
@@ -59,7 +65,7 @@ def effectivity_ranges(group: pd.DataFrame) -> str:
     judged = judged_levels(group)
     fine = judged[judged["ndofs"] >= EFFECTIVITY_FROM_DOFS]
     judged = fine if len(fine) else judged
-    parts = [f"{name} {eff.min():.2g}..{eff.max():.2g}"
+    parts = [f"{name} {sig3(eff.min())}..{sig3(eff.max())}"
              for name, eff in judged.groupby("estimator")["effectivity_index"]]
     return "; ".join(parts) if parts else "no truth sharp enough"
 

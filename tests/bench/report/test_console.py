@@ -43,3 +43,9 @@ def test_unexpected_hard_rows_are_listed_within_the_ten_lines(tmp_path):
     assert lines[-1].startswith("  UNEXPECTED no-contact/vi/active-set/: failed")
     assert "more in hard.md" in lines[-1]
     assert duration(42.0) == "42.0 s"
+
+
+def test_numbers_in_prose_have_three_significant_figures_and_no_exponent():
+    from bench.report.summary import sig3
+
+    assert [sig3(x) for x in (2123.4, 0.000341, 4.4, 16.0)] == ["2120", "0.000341", "4.4", "16"]
