@@ -184,3 +184,26 @@ def test_first_screen_shows_the_summary_and_no_table_overflows(report, tmp_path)
     from matplotlib.image import imread
 
     assert float(np.std(imread(shot)[..., :3])) > 0.05  # the first screen is not blank
+
+
+@pytest.mark.skipif(CHROMIUM is None, reason="Debian's chromium is not installed "
+                                             "(.ci/run installs it)")
+def test_the_page_renders_within_three_seconds(report, tmp_path):
+    """The page's own render time: a screenshot of it, less one of an empty page (the
+    browser's start)."""
+    import time
+
+    def seconds(url: str) -> float:
+        start = time.perf_counter()
+        subprocess.run([CHROMIUM, "--headless", "--no-sandbox", "--disable-gpu",
+                        "--no-first-run", "--disable-background-networking",
+                        f"--user-data-dir={tmp_path / 'profile'}", "--window-size=1280,2400",
+                        f"--screenshot={tmp_path / 'shot.png'}", url], capture_output=True,
+                       timeout=120)
+        return time.perf_counter() - start
+
+    blank = min(seconds("about:blank") for _ in range(2))
+    page = min(seconds((report / "index.html").as_uri()) for _ in range(2))
+    # the target: 3 s on the 2-core machine (measured 0.3 s for a 1.9 MB page; the 10.5 MB
+    # page with plotly took about 7 s)
+    assert page - blank <= 3.0
