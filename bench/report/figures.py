@@ -56,26 +56,46 @@ def cell_polygons(p: np.ndarray, t: np.ndarray) -> np.ndarray:
 
 
 def meshes(artifacts: dict):
-    """Final adaptive mesh per formulation/estimator (the paper's Figure 1b)."""
-    items = sorted((k, v) for k, v in artifacts.items() if k[2] == "adaptive")
+    """Final adaptive mesh per formulation (the paper's Figure 1b): each cell coloured by its
+    size h_T on one log scale for every panel, so that where the refinement went reads at a
+    glance at any mesh size (edges of 10^4 cells would fill the panel)."""
+    # the residual estimator's mesh where it ran (the seed's), else the first estimator's
+    chosen: dict = {}
+    for key, data in sorted(artifacts.items(), key=lambda kv: (kv[0][1] != "residual", kv[0])):
+        if key[2] == "adaptive":
+            chosen.setdefault((key[0], *key[3:]), (key, data))
+    items = sorted(chosen.values(), key=lambda kv: kv[0])
     if not items:
         return None
-    cols = min(3, len(items))
+    cols = min(4, len(items))
     rows = int(np.ceil(len(items) / cols))
-    fig = Figure(figsize=(4 * cols, 4 * rows))
+    fig = Figure(figsize=(3.2 * cols + 1.0, 3.2 * rows))
     axes = fig.subplots(rows, cols, squeeze=False)
     for ax in axes.ravel():
         ax.set_axis_off()
-    for ax, (key, data) in zip(axes.ravel(), items, strict=False):
-        ax.add_collection(PolyCollection(cell_polygons(data["p"], data["t"]), facecolors="none",
-                                         edgecolors=colour(key[0]), linewidths=0.15))
+    sizes = [np.log10(cell_sizes(data["p"], data["t"])) for _, data in items]
+    low, high = min(s.min() for s in sizes), max(s.max() for s in sizes)
+    art = None
+    for ax, (key, data), size in zip(axes.ravel(), items, sizes, strict=False):
+        art = PolyCollection(cell_polygons(data["p"], data["t"]), array=size, cmap="viridis",
+                             edgecolors="face", linewidths=0.2, antialiased=False)
+        art.set_clim(low, high)
+        ax.add_collection(art)
         ax.autoscale_view()
         order = f"/P{key[3]}" if len(key) > 3 and key[3] != 1 else ""
         cell = f"/{key[4]}" if len(key) > 4 and key[4] != "tri" else ""
         ax.set_title(f"{key[0]}/{key[1]}{order}{cell}: {int(data['ndofs'])} DOFs", fontsize=9)
         ax.set_aspect("equal")
-    fig.tight_layout()
+    fig.colorbar(art, ax=list(axes.ravel()), label="log10 h_T", shrink=0.8)
     return fig
+
+
+def cell_sizes(p: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """The longest distance between two corners of each cell (h_T)."""
+    corners = p[:2, t]  # (2, k, n)
+    k = t.shape[0]
+    return np.max([np.linalg.norm(corners[:, a] - corners[:, b], axis=0)
+                   for a in range(k) for b in range(a + 1, k)], axis=0)
 
 
 def deformed(data: dict, title: str):
@@ -92,7 +112,7 @@ def deformed(data: dict, title: str):
     fig = Figure(figsize=(6, 5))
     ax = fig.subplots()
     art = PolyCollection(cell_polygons(p + scale * u, data["t"]), array=np.minimum(vm, top),
-                         cmap="viridis", edgecolors="face", linewidths=0.1)
+                         cmap="viridis", edgecolors="face", linewidths=0.3, antialiased=False)
     art.set_clim(0, top)
     ax.add_collection(art)
     ax.autoscale_view()

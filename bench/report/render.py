@@ -12,6 +12,7 @@ import jinja2
 import pandas as pd
 
 from bench.hard import LOSS_TOLERANCE, PRESSURE_TOLERANCE, check_expected, hard_display
+from bench.hard.matrix import matrix_html, matrix_markdown, verdict_matrix
 from bench.hard.registry import CASE_FIGURES
 from bench.matrix.artifacts import file_stem
 from bench.matrix.rates import RATE_LEVELS, judged_levels, rates_table
@@ -57,15 +58,20 @@ def _read_json(results: Path | None, name: str) -> dict:
     return json.loads((results / name).read_text())
 
 
-def _hard_section(results: Path | None, figs: Figures) -> tuple[pd.DataFrame | None, list]:
-    """The hard cases' verdict table and figure, if the results folder has hard.csv."""
+def _hard_section(results: Path | None, figs: Figures) -> tuple[pd.DataFrame | None, list,
+                                                                  dict | None]:
+    """The hard cases' full table, figures and verdict matrix (HTML and Markdown), if the
+    results folder has hard.csv."""
     if results is None or not (results / "hard.csv").exists():
-        return None, []
+        return None, [], None
     raw = pd.read_csv(results / "hard.csv")
     items = [figs.add(figure.draw(raw[raw["case"] == case]), file_stem("hard", case),
                       figure.caption)
              for case, figure in CASE_FIGURES.items() if (raw["case"] == case).any()]
-    return hard_display(raw), [item for item in items if item is not None]
+    matrix = verdict_matrix(raw)
+    return (hard_display(raw), [item for item in items if item is not None],
+            {"html": matrix_html(matrix), "markdown": matrix_markdown(matrix),
+             "csv": str(results / "hard.csv"), "rows": len(raw)})
 
 
 def _tables(everything: pd.DataFrame, rows: pd.DataFrame, hard) -> dict:
@@ -104,7 +110,7 @@ def write_report(table: pd.DataFrame, out: str | Path, results: str | Path | Non
     run_info, truth = _read_json(results, "run.json"), _read_json(results, "truth.json")
     _load_scene_files(run_info)
     figs = Figures(out)
-    hard, hard_figures = _hard_section(results, figs)
+    hard, hard_figures, hard_matrix = _hard_section(results, figs)
     head = everything.iloc[0] if len(everything) else pd.Series(dtype=object)
     tables = _tables(everything, rows, hard)
     return _render({
@@ -123,7 +129,7 @@ def write_report(table: pd.DataFrame, out: str | Path, results: str | Path | Non
         "estimator_figure": figs.add(estimator_effectivity(judged_levels(rows))
                                      if len(rows) else None, "estimators", ESTIMATOR_CAPTION),
         "orders": order_section(rows, figs),
-        "hard_run": hard is not None, "hard_figures": hard_figures,
+        "hard_run": hard is not None, "hard_figures": hard_figures, "hard_matrix": hard_matrix,
         "n_rows": len(everything), "n_too_coarse": int(rows["reference_too_coarse"]
                                                         .fillna(False).astype(bool).sum()),
         **_provenance_of_rows(everything, run_info),

@@ -80,7 +80,8 @@ def field_figures(scene, name: str, artifacts: dict, preferred) -> tuple:
     """The 2D figures drawn from the artifacts: meshes, deformed body, pressure curve."""
     return (
         (figures.meshes(artifacts), "meshes",
-         "Final adaptive meshes per formulation/estimator (the paper's Figure 1b)."),
+         "Final adaptive meshes per formulation, refined by the residual estimator where it "
+         "ran, each cell coloured by its size h_T (the paper's Figure 1b)."),
         (figures.deformed(preferred, name), "deformed",
          "Deformed body coloured by von Mises stress; the colour scale is clipped at the "
          f"{figures.VON_MISES_PERCENTILE:g}th percentile because the stress is singular at "
