@@ -19,21 +19,15 @@ from estimators.contact_terms import contact_terms as shared_contact_terms
 from estimators.nitsche_residual import nitsche_estimate
 from formulations.base import DiscreteSolution
 from formulations.contact import gauss_legendre
-from formulations.elasticity import stress_tensor_from_gradient
+from formulations.elasticity import element_diameters, stress_tensor_from_gradient
 from formulations.quad_evaluation import QuadGradient
+from formulations.quad_load import affine_maps
 from formulations.quad_vi import ContactEdges
 from formulations.tensor_stiffness import tensor_rule
 from scenes.quad_hierarchy import edge_keys
 
 EDGE_POINTS = 4  # Gauss points on Neumann and contact edges: q and lambda_h are not polynomials
 CONTACT_POINTS = 10  # w has kinks where u_hn crosses g (as estimators.contact_terms)
-
-
-def cell_diameters(mesh) -> np.ndarray:
-    """The longer diagonal of each quadrilateral."""
-    p = mesh.p[:, mesh.t]
-    return np.maximum(np.linalg.norm(p[:, 2] - p[:, 0], axis=0),
-                      np.linalg.norm(p[:, 3] - p[:, 1], axis=0))
 
 
 class QuadStress:
@@ -77,15 +71,14 @@ def element_residuals(scene, solution, stress: QuadStress) -> np.ndarray:
     parallelogram x = v0 + A xi (dx = |det A| w)."""
     mesh, order = solution.elasticity.basis.mesh, solution.elasticity.order
     X, w = tensor_rule(order + 1)
-    p = mesh.p[:, mesh.t]
-    A = np.array([p[:, 1] - p[:, 0], p[:, 3] - p[:, 0]]).transpose(1, 0, 2)  # (2, 2, nE)
-    x = p[:, 0][:, :, None] + np.einsum("ikE,kq->iEq", A, X)  # (2, nE, nq)
+    origin, A = affine_maps(mesh)  # (2, nE), (2, 2, nE)
+    x = origin[:, :, None] + np.einsum("ikE,kq->iEq", A, X)  # (2, nE, nq)
     residual = stress.divergence_of(stress.field.derivatives_at_reference(X))
     if scene.body_force is not None:
         residual = residual + scene.body_force(x)
     area = np.abs(A[0, 0] * A[1, 1] - A[0, 1] * A[1, 0])
     norm2 = ((residual**2).sum(axis=0) * w).sum(axis=1) * area
-    return (cell_diameters(mesh) / order) ** 2 * norm2
+    return (element_diameters(mesh) / order) ** 2 * norm2
 
 
 def edge_pairs(solution) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:

@@ -17,20 +17,16 @@ from skfem.helpers import dot
 from skfem.models.elasticity import linear_elasticity
 
 from formulations.base import ContactQP
+from formulations.cells import family_for
 from formulations.elasticity import Elasticity, free_dofs
 from formulations.solvers.registry import FAST_SOLVER, SOLVERS
 from scenes import Scene
 
 
 def hex_mesh(scene: Scene, refinements: int = 0) -> MeshHex:
-    """The cubes of a 3D scene's tensor grid (its tetrahedra's vertices), refined uniformly;
-    ValueError for a scene whose starting mesh is not a tensor grid."""
-    p = scene.mesh.p
-    axes = [np.unique(p[k]) for k in range(p.shape[0])]
-    if p.shape[0] != 3 or np.prod([a.size for a in axes]) != p.shape[1]:
-        raise ValueError(f"scene {scene.name!r}: its starting mesh is not a 3D tensor grid, so "
-                         "it has no hexahedral version")
-    return MeshHex.init_tensor(*axes).refined(refinements)
+    """The cubes of a 3D scene's tensor grid (the hexahedral family's starting mesh), refined
+    uniformly; ValueError for a scene whose starting mesh is not a 3D tensor grid."""
+    return family_for("quad", 3).starting_mesh(scene).refined(refinements)
 
 
 def assemble_hex_elasticity(scene: Scene, mesh: MeshHex) -> Elasticity:

@@ -14,6 +14,8 @@ from dataclasses import dataclass
 import numpy as np
 from skfem import Basis
 
+from formulations.quad_load import affine_maps
+
 # tolerance of the parallelogram check, relative to the cell's size
 PARALLELOGRAM_TOLERANCE = 1e-10
 
@@ -68,9 +70,9 @@ class QuadGradient:
         polynomial in xi for every cell (its monomial coefficients found once, on the
         reference square), so no basis is evaluated cell by cell."""
         p = basis.mesh.p[:, basis.mesh.t]  # (2, 4, nE)
-        A = np.array([p[:, 1] - p[:, 0], p[:, 3] - p[:, 0]]).transpose(1, 0, 2)  # (2, 2, nE)
+        origin, A = affine_maps(basis.mesh)  # (2, nE), (2, 2, nE)
         size = np.linalg.norm(A, axis=(0, 1))
-        if np.any(np.linalg.norm(p[:, 0] + A[:, 0] + A[:, 1] - p[:, 2], axis=0)
+        if np.any(np.linalg.norm(origin + A[:, 0] + A[:, 1] - p[:, 2], axis=0)
                   > PARALLELOGRAM_TOLERANCE * size):
             raise ValueError("the quadrilaterals are not all parallelograms: their gradients "
                              "are not polynomials in x")
@@ -80,7 +82,7 @@ class QuadGradient:
         nodal = u[basis.element_dofs].reshape(D.shape[0], 2, -1)  # (nb, component c, nE)
         by_reference = np.einsum("jcE,jrm->Emcr", nodal, D, optimize=True)  # (nE, M, 2, 2)
         coefficients = np.einsum("Emcr,rkE->Emck", by_reference, inverse, optimize=True)
-        return cls(p[:, 0], inverse, exponents,
+        return cls(origin, inverse, exponents,
                    np.ascontiguousarray(coefficients.reshape(-1, exponents.shape[1], 4)))
 
     def reference(self, x: np.ndarray, cells: np.ndarray) -> np.ndarray:

@@ -15,6 +15,7 @@ from matplotlib.tri import Triangulation
 from bench.sequence.loop import STRATEGIES
 from estimators import estimator_names
 from formulations import formulation_names
+from formulations.cells.base import vertex_diameters
 from formulations.contact import facet_coordinates
 
 COLOUR_CYCLE = [f"C{k}" for k in range(10)]
@@ -73,7 +74,7 @@ def meshes(artifacts: dict):
     axes = fig.subplots(rows, cols, squeeze=False)
     for ax in axes.ravel():
         ax.set_axis_off()
-    sizes = [np.log10(cell_sizes(data["p"], data["t"])) for _, data in items]
+    sizes = [np.log10(vertex_diameters(data["p"][:2], data["t"])) for _, data in items]
     low, high = min(s.min() for s in sizes), max(s.max() for s in sizes)
     art = None
     for ax, (key, data), size in zip(axes.ravel(), items, sizes, strict=False):
@@ -88,14 +89,6 @@ def meshes(artifacts: dict):
         ax.set_aspect("equal")
     fig.colorbar(art, ax=list(axes.ravel()), label="log10 h_T", shrink=0.8)
     return fig
-
-
-def cell_sizes(p: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """The longest distance between two corners of each cell (h_T)."""
-    corners = p[:2, t]  # (2, k, n)
-    k = t.shape[0]
-    return np.max([np.linalg.norm(corners[:, a] - corners[:, b], axis=0)
-                   for a in range(k) for b in range(a + 1, k)], axis=0)
 
 
 def deformed(data: dict, title: str):

@@ -22,6 +22,8 @@ from bench.measure.nonnested import energy_difference
 from bench.measure.quad_fields import quad_gradient_field
 from bench.sequence.marking import mark
 from estimators.quad_residual import quad_residual_estimate
+from formulations.cells import family_for
+from formulations.cells.quadrilateral import tensor_axes
 from formulations.elasticity import count_free_dofs
 from formulations.hex_vi import hex_mesh, solve_hex_vi
 from formulations.quad_mixed import solve_quad_mixed
@@ -58,13 +60,12 @@ class QuadRow:
 
 
 def tensor_grid(scene) -> tuple[np.ndarray, np.ndarray]:
-    """The grid lines of a scene whose starting mesh is a tensor grid of triangles; ValueError
-    for any other mesh."""
-    p = scene.mesh.p
-    xs, ys = np.unique(p[0]), np.unique(p[1])
-    if scene.dim != 2 or xs.size * ys.size != p.shape[1]:
-        raise ValueError(f"scene {scene.name!r}: its starting mesh is not a tensor grid, so it "
-                         "has no quadrilateral version")
+    """The grid lines of a scene whose starting mesh is a 2D tensor grid of triangles (the
+    quadrilateral family's root cells); ValueError for any other mesh."""
+    why = family_for("quad", 2).why_no_mesh(scene)
+    if why is not None:
+        raise ValueError(why)
+    xs, ys = tensor_axes(scene)
     return xs, ys
 
 

@@ -103,9 +103,7 @@ class CellFamily:
 
     def diameters(self, mesh) -> np.ndarray:
         """The longest distance between two vertices of each cell (h_T)."""
-        p, k = mesh.p[:, mesh.t], mesh.t.shape[0]
-        return np.max([np.linalg.norm(p[:, i] - p[:, j], axis=0)
-                       for i in range(k) for j in range(i + 1, k)], axis=0)
+        return vertex_diameters(mesh.p, mesh.t)
 
     # --- assembly ---------------------------------------------------------------------------
     def stiffness(self, basis, lam: float, mu: float, order: int) -> sparse.csr_matrix:
@@ -149,6 +147,13 @@ class CellFamily:
         the conforming DOFs and interpolated by P at the others (unchanged on conforming
         meshes)."""
         return values
+
+
+def vertex_diameters(p: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """The longest distance between two corners of each cell t (k, n) of points p (d, m)."""
+    corners, k = p[:, t], t.shape[0]
+    return np.max([np.linalg.norm(corners[:, i] - corners[:, j], axis=0)
+                   for i in range(k) for j in range(i + 1, k)], axis=0)
 
 
 def register_family(family: CellFamily, description: str) -> CellFamily:

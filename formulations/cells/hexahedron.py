@@ -22,7 +22,7 @@ class Hexahedra(CellFamily):
     adaptive = False
 
     def why_no_mesh(self, scene) -> str | None:
-        return not_a_grid(scene, self.shape)
+        return not_a_grid(scene, self.dim, "hexahedral")
 
     def why_no_contact(self) -> str | None:
         return ("the contact surface of hexahedra (quadrilateral faces) is not built; "

@@ -25,11 +25,13 @@ def tensor_axes(scene) -> list[np.ndarray] | None:
     return axes if int(np.prod([a.size for a in axes])) == p.shape[1] else None
 
 
-def not_a_grid(scene, shape: str) -> str | None:
-    """Why ``scene`` has no mesh of ``shape`` made from its starting mesh, or None."""
-    if tensor_axes(scene) is None:
-        return (f"scene {scene.name!r}: its starting mesh is not a tensor grid, so it has no "
-                f"mesh of {shape}")
+def not_a_grid(scene, dim: int, version: str) -> str | None:
+    """Why ``scene`` has no ``version`` (quadrilateral, hexahedral) mesh made from its
+    starting mesh, or None: it must be a tensor grid in ``dim`` dimensions."""
+    axes = tensor_axes(scene)
+    if axes is None or len(axes) != dim:
+        return (f"scene {scene.name!r}: its starting mesh is not a tensor grid in {dim}D, so "
+                f"it has no {version} version")
     return None
 
 
@@ -41,7 +43,7 @@ class Quadrilaterals(CellFamily):
     centroid_rule = (np.full((2, 1), 0.5), np.array([1.0]))  # the unit square
 
     def why_no_mesh(self, scene) -> str | None:
-        return not_a_grid(scene, self.shape)
+        return not_a_grid(scene, self.dim, "quadrilateral")
 
     def starting_mesh(self, scene) -> QuadLeafMesh:
         why = self.why_no_mesh(scene)
