@@ -18,7 +18,7 @@ from scipy import sparse
 from skfem import Basis, ElementVector, MeshTri
 
 from formulations.cells import DEFAULT_CELL, family_for, family_of
-from formulations.cells.triangle import TRIANGLES, predict_uniform_free_dofs  # noqa: F401
+from formulations.cells.triangle import TRIANGLES
 from formulations.dof_basis import DofBasis
 from scenes import Scene
 from scenes.base import is_integer
