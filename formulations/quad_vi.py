@@ -16,6 +16,7 @@ import numpy as np
 from scipy import sparse
 
 from formulations.base import ContactQP
+from formulations.contact import outer_normals
 from formulations.elasticity import Elasticity, assemble_elasticity
 from formulations.solvers.registry import FAST_SOLVER, SOLVERS
 from scenes import Scene
@@ -78,13 +79,10 @@ def contact_edges(scene: Scene, elasticity: Elasticity) -> ContactEdges:
     """The leaf edges on Gamma_C with their outer normals (from each edge's cell)."""
     mesh = elasticity.basis.mesh
     facets = scene.contact_facets(mesh)
-    a, b = mesh.p[:, mesh.facets[0, facets]], mesh.p[:, mesh.facets[1, facets]]
+    v0, v1 = mesh.facets[:, facets]
     cells = mesh.f2t[0, facets]
-    normal = np.array([(b - a)[1], -(b - a)[0]])
-    inward = mesh.p[:, mesh.t[:, cells]].mean(axis=1) - a
-    normal *= np.where((normal * inward).sum(axis=0) > 0, -1.0, 1.0)
-    length = np.linalg.norm(b - a, axis=0)
-    return ContactEdges(facets, a, b, normal / np.maximum(length, 1e-300), length, cells)
+    length, normal = outer_normals(mesh, v0, v1, cells)  # as on triangles
+    return ContactEdges(facets, mesh.p[:, v0], mesh.p[:, v1], normal, length, cells)
 
 
 def failed(elasticity: Elasticity, edges: ContactEdges, rows: int, answer,
