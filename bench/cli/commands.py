@@ -4,6 +4,7 @@
 
 from __future__ import annotations
 
+import json
 import os
 import sys
 import time
@@ -188,7 +189,9 @@ def print_summary(readme: Path, table: pd.DataFrame, results, seconds: float | N
     """The console's last lines (``bench.report.console``)."""
     hard_csv = Path(results) / "hard.csv"
     hard = pd.read_csv(hard_csv) if hard_csv.exists() else None
-    print("\n" + "\n".join(console_summary(readme, table, hard, seconds)))
+    truth_json = Path(results) / "truth.json"
+    truth = json.loads(truth_json.read_text()) if truth_json.exists() else {}
+    print("\n" + "\n".join(console_summary(readme, table, hard, seconds, truth)))
 
 
 def report_command(args) -> int:

@@ -39,9 +39,11 @@ def verdict_matrix(table: pd.DataFrame) -> VerdictMatrix:
     lines = tuple(f"{len(names)} skipped ({', '.join(sorted(set(names)))}): {reason}"
                   for reason, names in skips.items())
     judged = rows[~skipped]
-    finding = (judged.get("finding", pd.Series("", index=judged.index)).fillna("").astype(str)
-               + judged.get("reason", pd.Series("", index=judged.index)).fillna("")
-               .astype(str).map(lambda r: f" ({r})" if r else ""))
+    def text(column: str) -> pd.Series:
+        return judged.get(column, pd.Series("", index=judged.index)).astype(object).fillna("")\
+            .astype(str)
+
+    finding = text("finding") + text("reason").map(lambda r: f" ({r})" if r else "")
     judged = judged.assign(finding_text=finding)
     verdicts = judged.pivot_table(index="row", columns="column", values="verdict",
                                   aggfunc="first", sort=True).fillna("")

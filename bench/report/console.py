@@ -1,6 +1,6 @@
 """The last lines ``compare`` and ``report`` print: at most MAX_LINES, where the report is, how
-long it took, one headline per scene and the hard cases as counts plus the rows that were not
-as expected (the README, "Reading the report")."""
+long it took, one headline per scene (from the verdict box) and the hard cases as counts plus
+the rows that were not as expected (the README, "Reading the report")."""
 
 from __future__ import annotations
 
@@ -9,7 +9,15 @@ from pathlib import Path
 import pandas as pd
 
 from bench.hard import check_expected
-from bench.report.summary import effectivity_ranges, fastest, sig3
+from bench.report.norms import scene_norm
+from bench.report.verdict import (
+    RELATIVE_TARGETS,
+    TimingNoise,
+    cheapest,
+    sharpest_text,
+    sig3,
+    timing_noise,
+)
 from bench.sequence.rows import with_labels
 from bench.verify import load_expected
 
@@ -22,16 +30,21 @@ def duration(seconds: float) -> str:
     return f"{int(minutes)} min {rest:.0f} s" if minutes else f"{rest:.1f} s"
 
 
-def headline(scene: str, group: pd.DataFrame) -> str:
-    """The scene's first combination to the report's target accuracy, and the estimators'
-    effectivity ranges."""
-    best = fastest(group)
-    top = best["ranking"][0] if best["ranking"] else None
-    measure = "error" if best["column"] == "energy_error" else "eta"
-    first = (f"{top['combination']} P{top['order']} first to {measure} "
-             f"{sig3(best['target'])} ({sig3(top['seconds'])} s)" if top
-             else "no combination reached the target")
-    return f"{scene}: {first}; effectivity {effectivity_ranges(group)}"
+def headline(scene: str, group: pd.DataFrame, norm: float | None,
+             noise: TimingNoise | None) -> str:
+    """The scene's cheapest combination to a relative error of 1e-2 (its ties counted) and its
+    sharpest estimator, as in the report's verdict box."""
+    target = RELATIVE_TARGETS[0]
+    best = cheapest(group, norm, target, noise) if norm else None
+    if best is None:
+        first = "no truth, errors not measured"
+    elif best["ranking"]:
+        top = best["ranking"][0]
+        first = (f"cheapest to {sig3(target)}: {top['combination']} {sig3(top['seconds'])} s"
+                 + (f" ({best['ties']} tied)" if best["ties"] else ""))
+    else:
+        first = f"none reached {sig3(target)}"
+    return f"{scene}: {first}; sharpest {sharpest_text(group).split(',')[0]}"
 
 
 def hard_lines(hard: pd.DataFrame, room: int) -> list[str]:
@@ -49,8 +62,9 @@ def hard_lines(hard: pd.DataFrame, room: int) -> list[str]:
 
 
 def console_summary(readme: Path, table: pd.DataFrame, hard: pd.DataFrame | None = None,
-                    seconds: float | None = None) -> list[str]:
-    """The last lines of ``compare`` (with its wall time) and ``report``."""
+                    seconds: float | None = None, truth: dict | None = None) -> list[str]:
+    """The last lines of ``compare`` (with its wall time) and ``report``; ``truth`` is the
+    results' truth.json (the scale of relative errors)."""
     readme = Path(readme)
     lines = [f"report: {readme.parent / 'index.html'} (open in a browser), {readme}"]
     rows = with_labels(table)
@@ -58,8 +72,9 @@ def console_summary(readme: Path, table: pd.DataFrame, hard: pd.DataFrame | None
     if seconds is not None:
         lines.append(f"{len(table)} rows, {rows['sequence_key'].nunique()} sequences; "
                      f"wall time {duration(seconds)}")
+    noise = timing_noise(rows)
     for scene, group in rows.groupby("scene", sort=True):
-        lines.append(headline(scene, group))
+        lines.append(headline(scene, group, scene_norm(scene, truth or {}), noise))
     if hard is not None and len(hard):
         lines += hard_lines(hard, MAX_LINES - len(lines))
     return lines[:MAX_LINES]

@@ -6,30 +6,13 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
-from skfem import Basis, ElementTriP1
 
-from bench.measure.discretisation_error import energy_density
 from bench.report.figures import marker
+from bench.report.norms import exact_energy_norm
 from bench.sequence.rows import phase_time
 from formulations import STATUS_OK
-from scenes import get_scene
 
 TARGET = 1e-3  # relative energy-norm error
-NORM_REFINEMENTS = 5  # uniform refinements of the scene's mesh for ||u|| (exact scenes)
-
-
-def exact_energy_norm(scene_name: str) -> float | None:
-    """||u|| = a(u, u)^(1/2) of a scene's exact solution (None without one), integrated with a
-    rule of order 10 on its mesh refined NORM_REFINEMENTS times."""
-    try:
-        scene = get_scene(scene_name)
-    except KeyError:
-        return None
-    if scene.exact is None:
-        return None
-    basis = Basis(scene.mesh.refined(NORM_REFINEMENTS), ElementTriP1(), intorder=10)
-    grad = scene.exact.gradient(np.asarray(basis.global_coordinates()))
-    return float(np.sqrt((energy_density(grad, *scene.material.lame) * basis.dx).sum()))
 
 
 ORDER_COLOURS = ["tab:blue", "tab:orange", "tab:green", "tab:red"]

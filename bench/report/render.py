@@ -19,6 +19,7 @@ from bench.matrix.rates import RATE_LEVELS, judged_levels, rates_table
 from bench.matrix.scene_files import load_scene_files
 from bench.report.estimator_figures import ESTIMATOR_CAPTION, estimator_effectivity
 from bench.report.orders import order_section
+from bench.report.questions import questions
 from bench.report.sections import Figures, scene_section
 from bench.report.summary import first_screen
 from bench.report.tables import (
@@ -30,6 +31,7 @@ from bench.report.tables import (
     rate_verdicts,
     timing_table,
 )
+from bench.report.verdict import EFFECTIVITY_FROM_DOFS
 from bench.sequence.rows import COLUMNS, INTERRUPTED, KEYS, with_labels
 from bench.verify import load_expected
 
@@ -113,6 +115,7 @@ def write_report(table: pd.DataFrame, out: str | Path, results: str | Path | Non
     hard, hard_figures, hard_matrix = _hard_section(results, figs)
     head = everything.iloc[0] if len(everything) else pd.Series(dtype=object)
     tables = _tables(everything, rows, hard)
+    orders = order_section(rows, figs)
     return _render({
         "command": command or run_info.get("command", "(not recorded)"),
         "configuration": run_info.get("configuration", {}),
@@ -123,12 +126,14 @@ def write_report(table: pd.DataFrame, out: str | Path, results: str | Path | Non
         "scenes": [scene_section(name, group, results, figs, truth)
                    for name, group in rows.groupby("scene", sort=True)],
         "tables": tables,
-        "summary": first_screen(everything, rows, tables["rates"]),
+        "summary": first_screen(everything, rows, tables["rates"], truth),
+        "effectivity_from": EFFECTIVITY_FROM_DOFS,
+        "questions": questions(tables, hard_verdicts(results), orders),
         "hard_verdicts": hard_verdicts(results),
         "numerics": run_info.get("numerics", {}),
         "estimator_figure": figs.add(estimator_effectivity(judged_levels(rows))
                                      if len(rows) else None, "estimators", ESTIMATOR_CAPTION),
-        "orders": order_section(rows, figs),
+        "orders": orders,
         "hard_run": hard is not None, "hard_figures": hard_figures, "hard_matrix": hard_matrix,
         "n_rows": len(everything), "n_too_coarse": int(rows["reference_too_coarse"]
                                                         .fillna(False).astype(bool).sum()),

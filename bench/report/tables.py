@@ -6,6 +6,7 @@ import numpy as np
 import pandas as pd
 
 from bench.matrix.rates import judged_levels
+from bench.report.verdict import EFFECTIVITY_FROM_DOFS
 from bench.sequence.rows import KEYS, LABELS, phase_time
 from bench.verify import claims
 from estimators import guaranteed_estimators
@@ -86,7 +87,7 @@ def estimator_summary(rows: pd.DataFrame) -> pd.DataFrame:
     out = []
     for name, group in judged.groupby("estimator", sort=True):
         eff = group["effectivity_index"]
-        late = group.loc[group["ndofs"] >= 1000, "effectivity_index"]
+        late = group.loc[group["ndofs"] >= EFFECTIVITY_FROM_DOFS, "effectivity_index"]
         out.append({"estimator": name,
                     "guaranteed bound": "yes" if name in guaranteed_estimators() else "no",
                     "levels": len(eff), "min": _fmt(eff.min()), "median": _fmt(eff.median()),

@@ -15,7 +15,7 @@ from bench.matrix import RunConfig, run
 from bench.report import write_report
 from formulations import formulation_names, solver_names
 
-SECTIONS = ["summary", "contents", "what-was-run", "scenes", "results-per-scene",
+SECTIONS = ["summary", "questions", "contents", "what-was-run", "scenes", "results-per-scene",
             "summary-across-scenes", "failures-and-skips", "hard-cases", "known-limitations"]
 PNG = b"\x89PNG\r\n\x1a\n"
 
@@ -24,6 +24,7 @@ class Collector(HTMLParser):
     def __init__(self):
         super().__init__()
         self.ids, self.images, self.external, self.scripts = [], [], [], 0
+        self.anchors = []
 
     def handle_starttag(self, tag, attrs):
         attrs = dict(attrs)
@@ -31,6 +32,8 @@ class Collector(HTMLParser):
             self.ids.append(attrs["id"])
         if tag == "img":
             self.images.append(attrs.get("src", ""))
+        if tag == "a" and attrs.get("href", "").startswith("#"):
+            self.anchors.append(attrs["href"][1:])
         if (tag == "script" and "src" in attrs) or tag == "link" or (
                 tag == "img" and not attrs.get("src", "").startswith("data:")):
             self.external.append(tag)
@@ -59,6 +62,7 @@ def test_html_is_self_contained_with_every_section_and_figure(report):
     parser = Collector()
     parser.feed(html)
     assert [s for s in SECTIONS if s not in parser.ids] == []
+    assert [a for a in parser.anchors if a not in parser.ids] == []  # every link lands
     assert parser.external == []  # no linked scripts, stylesheets or images
     assert parser.scripts == 0  # static: nothing to load or run
     # PNG: 2 scenes x (scene, convergence, work-precision, meshes, deformed, pressure), the
@@ -92,11 +96,13 @@ def test_markdown_links_every_figure_file(report):
     for name in figures:
         assert f"figures/{name}" in text
     assert "test command" in text and "agrees" in text  # rates verdicts against the claims
-    summary = text.split("## Summary", 1)[1].split("## Contents", 1)[0]
-    assert "| free-boundary | mixed/active-set/residual/" in summary or \
-        "| free-boundary | vi/active-set/residual/" in summary  # the fastest, with its time
-    assert "| paper " in summary and " s (" in summary and "slopes agree" in summary
-    assert text.index("## Summary") < text.index("## Appendix: what was run")
+    verdict = text.split("## Verdict", 1)[1].split("## Questions you may bring", 1)[0]
+    assert "| free-boundary | " in verdict and "| paper " in verdict
+    assert "slopes agree" in verdict and "reach" in verdict  # "k of n reach it" or "none"
+    questions = text.split("## Questions you may bring", 1)[1].split("## Contents", 1)[0]
+    assert questions.count("### ") >= 5 and "](#estimators)" in questions
+    assert '<a id="estimators"></a>' in text  # where the link lands
+    assert text.index("## Verdict") < text.index("## Appendix: what was run")
     assert "numerical stack" in text and "threads" in text  # the appendix's versions
 
 
@@ -153,7 +159,8 @@ window.addEventListener('load', () => {
     t => !t.parentElement.classList.contains('table-scroll')
          && t.scrollWidth > t.parentElement.clientWidth).length;
   document.body.setAttribute('data-layout', JSON.stringify({
-    summaryTop: summary.top, viewport: window.innerHeight, cut: cut,
+    summaryTop: summary.top, summaryBottom: summary.bottom, viewport: window.innerHeight,
+    cut: cut, headers: [...document.querySelectorAll('#summary th')].map(t => t.textContent),
     pageOverflow: document.documentElement.scrollWidth - window.innerWidth,
     rows: document.querySelectorAll('#summary tbody tr').length}));
 });
@@ -162,7 +169,7 @@ window.addEventListener('load', () => {
 
 @pytest.mark.skipif(CHROMIUM is None, reason="Debian's chromium is not installed "
                                              "(.ci/run installs it)")
-def test_first_screen_shows_the_summary_and_no_table_overflows(report, tmp_path):
+def test_first_screen_shows_the_verdict_box_and_no_table_overflows(report, tmp_path):
     import json
     import re
 
@@ -177,8 +184,12 @@ def test_first_screen_shows_the_summary_and_no_table_overflows(report, tmp_path)
                          text=True, timeout=120).stdout
     layout = json.loads(re.search(r"data-layout=\"([^\"]*)\"", dom).group(1)
                         .replace("&quot;", '"'))
-    assert 0 <= layout["summaryTop"] < layout["viewport"] / 2  # on the first screen
+    # the verdict box, whole, on the first screen of a 1280 x 900 window
+    assert 0 <= layout["summaryTop"] and layout["summaryBottom"] <= layout["viewport"]
     assert layout["rows"] == 2  # one row per scene
+    assert any(h.startswith("sharpest estimator") for h in layout["headers"])
+    assert any(h.startswith("guaranteed bound") for h in layout["headers"])
+    assert any(h.startswith("cheapest to relative error 0.01") for h in layout["headers"])
     assert layout["cut"] == 0 and layout["pageOverflow"] <= 0  # wide tables scroll in a box
     shot = tmp_path / "first-screen.png"
     subprocess.run([*browser, f"--screenshot={shot}", (report / "index.html").as_uri()],
