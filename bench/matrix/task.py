@@ -6,7 +6,7 @@ from __future__ import annotations
 import sys
 import traceback
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from bench.matrix.artifacts import level_artifact_path, publish_last_level, save_artifact
 from bench.matrix.spec import SequenceSpec, build_scene, check_formulation_options
@@ -100,6 +100,7 @@ def run_spec(spec: SequenceSpec, run: dict, out, truth_of: Callable[[Scene], obj
             if result.solution is not None:
                 save_artifact(level_artifact_path(out, result.row), result, scene)
 
+        warm_up(scene, spec)
         end, last = drain(run_sequence(
             scene, spec.formulation, spec.solver, spec.estimator,
             spec.loop_config(max_memory_gib), run_columns(spec, run),
@@ -117,6 +118,28 @@ def run_spec(spec: SequenceSpec, run: dict, out, truth_of: Callable[[Scene], obj
         else:  # a fault of the code: its traceback is what finds it
             traceback.print_exc()
         return STATUS_FAILED
+
+
+WARM_UP_LEVELS = 2  # a level and a refinement: every code path a sequence times
+_warmed: set = set()  # the combinations this process has already run once
+
+
+def warm_up(scene: Scene, spec: SequenceSpec) -> None:
+    """Run the first WARM_UP_LEVELS levels of the combination once per process, untimed and
+    unrecorded, so that one-off start-up costs (imports, first factorisations, caches) are not
+    charged to whichever sequence happens to run first (docs/report.md, "Ties and the timing
+    noise"). A failure here is left to the timed run, which records it."""
+    key = (spec.formulation, spec.solver, spec.estimator, spec.order, spec.cell, scene.dim)
+    if key in _warmed:
+        return
+    _warmed.add(key)
+    loop = replace(spec.loop_config(), max_levels=WARM_UP_LEVELS, target_error=None)
+    try:
+        for _ in run_sequence(scene, spec.formulation, spec.solver, spec.estimator, loop, {},
+                              formulation_options=dict(spec.formulation_options)):
+            pass
+    except Exception:  # noqa: BLE001 - the timed run meets it again and records it
+        return
 
 
 def whole_sequence_row(names: dict, status: str, reason: str) -> LevelResult:

@@ -11,7 +11,7 @@ import pandas as pd
 from bench.hard import check_expected
 from bench.report.norms import scene_norm
 from bench.report.verdict import (
-    RELATIVE_TARGETS,
+    MAIN_TARGET,
     TimingNoise,
     cheapest,
     sharpest_text,
@@ -34,7 +34,7 @@ def headline(scene: str, group: pd.DataFrame, norm: float | None,
              noise: TimingNoise | None) -> str:
     """The scene's cheapest combination to a relative error of 1e-2 (its ties counted) and its
     sharpest estimator, as in the report's verdict box."""
-    target = RELATIVE_TARGETS[0]
+    target = MAIN_TARGET
     best = cheapest(group, norm, target, noise) if norm else None
     if best is None:
         first = "no truth, errors not measured"
@@ -42,8 +42,10 @@ def headline(scene: str, group: pd.DataFrame, norm: float | None,
         top = best["ranking"][0]
         first = (f"cheapest to {sig3(target)}: {top['combination']} {sig3(top['seconds'])} s"
                  + (f" ({best['ties']} tied)" if best["ties"] else ""))
+    elif best["smallest"] is not None:
+        first = f"none reached {sig3(target)} (smallest {sig3(best['smallest'][0])})"
     else:
-        first = f"none reached {sig3(target)}"
+        first = "no error measured against a sharp enough truth"
     return f"{scene}: {first}; sharpest {sharpest_text(group).split(',')[0]}"
 
 

@@ -7,9 +7,9 @@ import pandas as pd
 
 from bench.report.norms import scene_norm
 from bench.report.verdict import (
-    RELATIVE_TARGETS,
     cheapest,
     noise_text,
+    shown_targets,
     sig3,
     timing_noise,
     verdict_row,
@@ -46,13 +46,15 @@ def first_screen(everything: pd.DataFrame, rows: pd.DataFrame, rates: pd.DataFra
     """The verdict box (one row per scene, ``bench.report.verdict``), the timing noise its ties
     use, and per scene the cheapest combinations to each relative error (the detail)."""
     noise = timing_noise(rows)
+    norms = {scene: scene_norm(scene, truth) for scene in rows["scene"].unique()}
+    targets = shown_targets(rows, norms)
     table, detail = [], []
     for scene, group in rows.groupby("scene", sort=True):
-        norm = scene_norm(scene, truth)
-        table.append({**verdict_row(scene, group, norm, noise),
+        norm = norms[scene]
+        table.append({**verdict_row(scene, group, norm, noise, targets),
                       "seed paper's rates": claim_verdicts(rates, scene),
                       "failures and flags": flags(everything[everything["scene"] == scene])})
-        for target in RELATIVE_TARGETS if norm else ():
+        for target in targets if norm else ():
             ranking = pd.DataFrame(cheapest(group, norm, target, noise)["ranking"][:5])
             if len(ranking):
                 ranking["seconds"] = ranking["seconds"].map(sig3)
