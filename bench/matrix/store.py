@@ -4,7 +4,8 @@
 Each sequence writes only its own partition, ``sequences/<sequence key>.parquet``, rewritten
 atomically (a temporary file of the writing process, then a rename) after every finished level,
 so concurrent runs and Dask workers never write the same file and an interrupted run loses no
-finished level. ``consolidate`` rebuilds the two tables from all partitions under a file lock,
+finished level. ``consolidate`` (when a sequence ends) rebuilds the two tables from all
+partitions under a file lock,
 each atomically: no row is lost or duplicated, and a rerun of a sequence replaces its own
 partition. Rows of earlier runs are kept unless ``overwrite`` is set; a folder written by an
 older version (tables, no partitions) is taken over as one partition.
@@ -209,12 +210,14 @@ class ResultStore:
         return SequenceWriter(self.partitions / f"{key}.parquet")
 
     def append(self, row: ResultRow) -> None:
-        """Store one finished row in its sequence's partition and consolidate."""
+        """Store one finished row in its sequence's partition, the durable record; the tables
+        are consolidated when the sequence ends (``finish``). Consolidating after every row
+        re-read every partition each time, quadratic in the run; meanwhile a reader finds the
+        tables stale by their checksums and rebuilds them (``read_results``)."""
         key = row.sequence_key or "unkeyed"
         if key not in self.writers:
             self.writers[key] = self.sequence(key)
         self.writers[key].append(row)
-        self.consolidate()
 
     def finish(self, key: str, end: str) -> None:
         """Record why the sequence ``key`` ended, in its partition."""

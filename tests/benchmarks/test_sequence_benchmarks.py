@@ -1,5 +1,5 @@
 """pytest-benchmark benchmarks of adaptive refinement (marking included) and of whole
-sequences at ~10^4 and 10^5 DOFs (10^6 marked slow): the paper scene, mixed method, active set,
+sequences at ~10^4 and 10^5 DOFs (10^6 marked long): the paper scene, mixed method, active set,
 residual estimator, the workloads of ``python -m bench scaling --sequence`` without the error
 against the reference. Run and compared as docs/solvers.md, "Benchmarks", says."""
 
@@ -12,7 +12,7 @@ from formulations import get_formulation, solve
 from formulations.solvers.registry import FAST_SOLVER
 from scenes import get_scene
 
-SIZES = ["1e4", "1e5", pytest.param("1e6", marks=pytest.mark.slow)]
+SIZES = ["1e4", "1e5", pytest.param("1e6", marks=pytest.mark.long)]
 BUDGETS = {"1e4": 10_000, "1e5": 100_000, "1e6": 1_000_000}
 ROUNDS = {"1e4": 5, "1e5": 3, "1e6": 1}
 ADAPTIVE = LoopConfig(strategy="adaptive")  # Doerfler, theta = 0.5, contact grading

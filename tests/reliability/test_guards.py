@@ -14,6 +14,7 @@ import pytest
 import bench.sequence.loop as loop_module
 from bench.cli import main
 from bench.matrix.artifacts import file_stem
+from bench.matrix.store import partition_table
 from bench.report import write_report
 from bench.sequence.loop import LoopConfig, run_sequence
 from bench.sequence.memory import available_gib, memory_line, predict_peak_gib
@@ -244,9 +245,8 @@ def test_sigint_ends_with_one_line_and_keeps_every_finished_row(tmp_path):
     process = interruptible_bench("run", "--strategy", "uniform", "--max-dofs", "2000000",
                                   "--solver", "reference", "--out", str(out), cwd=tmp_path)
     deadline = time.time() + 120
-    while time.time() < deadline:  # wait for three finished rows
-        csv = out / "results.csv"
-        if csv.exists() and len(csv.read_text().splitlines()) >= 4:
+    while time.time() < deadline:  # wait for three finished rows, in the sequence's partition
+        if (out / "sequences").exists() and len(partition_table(out / "sequences")) >= 3:
             break
         time.sleep(0.2)
     process.send_signal(signal.SIGINT)
@@ -257,7 +257,7 @@ def test_sigint_ends_with_one_line_and_keeps_every_finished_row(tmp_path):
     assert len(table) >= 3 and (table["status"] == "ok").all()
 
 
-@pytest.mark.slow
+@pytest.mark.long
 def test_a_uniform_run_to_twice_the_machine_stops_at_the_last_level_that_fits(tmp_path):
     # measured on a 24 GiB machine: levels to 2 099 200 DOFs (peak 11.2 GiB), then level 9
     # (8 392 704 DOFs, ~40 GiB predicted) refused; takes about 3 minutes

@@ -8,6 +8,7 @@ from estimators.base import ESTIMATORS, register_estimator
 from formulations import formulation_names
 
 
+@pytest.mark.slow  # about 30 s: every combination with the reference solver
 def test_full_matrix_on_the_paper_scene_has_no_failed_rows(tmp_path):
     rows = run(RunConfig(formulations=tuple(formulation_names()), solvers=("reference",),
                          estimators=tuple(estimator_names()),

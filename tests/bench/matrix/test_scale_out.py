@@ -76,6 +76,7 @@ def test_the_report_prefers_a_finished_sequence_over_a_cut_short_rerun(tmp_path)
     same_rows(table, shown)
 
 
+@pytest.mark.slow  # about 30 s: six sequences run until a signal ends the run, then resumed
 def test_an_interrupted_run_is_resumed(tmp_path):
     out = tmp_path / "r"
     # six sequences: after the first two, four are left (seconds of work), so the interrupt
@@ -135,6 +136,7 @@ def test_two_dask_workers_give_the_rows_of_the_in_process_run(tmp_path):
     assert len(pd.read_parquet(tmp_path / "dask" / "results.parquet")) == len(here)
 
 
+@pytest.mark.slow  # about 15 s: a Dask cluster whose worker is killed mid-run
 def test_a_killed_worker_loses_and_duplicates_nothing(tmp_path):
     from dask.distributed import Client, LocalCluster
 

@@ -30,7 +30,7 @@ def test_p1_error_against_a_p3_reference_is_its_exact_error(tmp_path, monkeypatc
     assert ref.estimated_error < 0.05 * exact.energy_error  # not too coarse to judge it
 
 
-@pytest.mark.slow
+@pytest.mark.long
 def test_a_two_million_dof_solution_is_measured_to_one_percent(tmp_path, monkeypatch):
     # the scale target: P1 at 2 099 200 DOFs against a 90 000-DOF P3 reference
     ref, measured, exact = measured_and_exact(8, 100000, tmp_path, monkeypatch)

@@ -56,6 +56,7 @@ def test_nearly_half_range_finds_where_the_local_slope_is_minus_a_quarter():
     assert found["last_local_slope"] == pytest.approx(-0.37)
 
 
+@pytest.mark.slow  # about a minute: the study end to end on its reduced grid
 def test_the_reduced_study_reports_every_sequence(tmp_path):
     config = dataclasses.replace(QUICK, out=str(tmp_path / "s"), report=str(tmp_path / "r"))
     table, report, verdicts = run_study(config)
@@ -84,7 +85,7 @@ def test_two_term_fit_recovers_the_singular_share_and_crossover():
     assert np.isnan(two_term_fit(n, n ** -0.5, 1.2)[0])  # lambda >= p: no singular part
 
 
-@pytest.mark.slow
+@pytest.mark.long
 def test_the_full_study_passes_its_gates(tmp_path):
     # about an hour on 2 cores (README, "The rate study"); every [[study_gate]] must pass
     config = dataclasses.replace(StudyConfig(), out=str(tmp_path / "s"),
