@@ -16,7 +16,7 @@ ROOT = Path(__file__).parents[2]  # the project's pytest configuration and impor
 
 def _pytest(tmp_path, *options):
     command = [sys.executable, "-m", "pytest", BENCHMARKS, "-q", "-p", "no:cacheprovider",
-               "--benchmark-enable", "--benchmark-only", "-n", "0",
+               "--benchmark-enable", "--benchmark-only", "-n", "0", "--dist", "no",
                "-k", "1e4 and (linear or fast)",
                f"--benchmark-storage={tmp_path / 'store'}", *options]
     return subprocess.run(command, capture_output=True, text=True, cwd=ROOT)

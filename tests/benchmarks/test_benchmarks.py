@@ -3,9 +3,9 @@ method, uniform mesh; the workloads of ``python -m bench scaling``).
 
 The default test run executes the 10^4 size once (``--benchmark-disable`` in pyproject) so the
 benchmarks cannot rot. To measure (10^5 is marked slow, 10^6 long; ``-m ""`` selects all, and
-``-n 0`` runs them in one process, since pytest-benchmark measures nothing under xdist)::
+``-n 0 --dist no`` runs them in one process: pytest-benchmark measures nothing under xdist)::
 
-    python -m pytest tests/benchmarks -n 0 --benchmark-enable --benchmark-only -m "" \
+    python -m pytest tests/benchmarks -n 0 --dist no --benchmark-enable --benchmark-only -m "" \
         --benchmark-json=benchmarks.json
 
 The reference solver is benchmarked at 10^4 and 10^5 only: at 10^6 DOFs one Clarabel solve
