@@ -4,7 +4,6 @@
 
 from __future__ import annotations
 
-import json
 import os
 import sys
 import time
@@ -35,6 +34,7 @@ from bench.matrix.scene_files import load_scene_files, scene_files_in
 from bench.matrix.store import ResultsError, read_results
 from bench.report import write_report
 from bench.report.console import console_summary
+from bench.report.render import read_json
 from bench.sequence.loop import LevelResult
 from bench.sequence.rows import KEYS, level_time
 from bench.verify import load_expected, verdict_table, verify
@@ -189,8 +189,7 @@ def print_summary(readme: Path, table: pd.DataFrame, results, seconds: float | N
     """The console's last lines (``bench.report.console``)."""
     hard_csv = Path(results) / "hard.csv"
     hard = pd.read_csv(hard_csv) if hard_csv.exists() else None
-    truth_json = Path(results) / "truth.json"
-    truth = json.loads(truth_json.read_text()) if truth_json.exists() else {}
+    truth = read_json(Path(results), "truth.json")
     print("\n" + "\n".join(console_summary(readme, table, hard, seconds, truth)))
 
 

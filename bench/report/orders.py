@@ -3,12 +3,12 @@ order, and which order reaches a relative energy-norm error of 1e-3 first, at wh
 
 from __future__ import annotations
 
-import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
 from bench.report.figures import marker
 from bench.report.norms import exact_energy_norm
+from bench.report.verdict import cheapest
 from bench.sequence.rows import phase_time
 from formulations import STATUS_OK
 
@@ -47,25 +47,18 @@ def order_work_precision(table: pd.DataFrame, norm: float | None = None):
 
 
 def first_to_target(rows: pd.DataFrame, norm: float) -> pd.DataFrame:
-    """Per order and strategy, the sequence (formulation/estimator) whose relative error first
-    falls to TARGET, with its DOFs and the cumulative wall time of its sequence up to there;
-    'not reached' within the budget otherwise."""
+    """Per order and strategy, the sequence whose relative error first falls to TARGET in the
+    least cumulative wall time (``bench.report.verdict.cheapest``), with its DOFs; 'not
+    reached' within the budget otherwise."""
     out = []
     for (order, strategy), group in rows.groupby(["order", "strategy"], sort=True):
-        best = None
-        for key, sequence in group.groupby(["formulation", "estimator"], sort=True):
-            sequence = sequence[sequence["status"] == STATUS_OK].sort_values("level")
-            times = phase_time(sequence).cumsum()
-            hit = np.flatnonzero(sequence["energy_error"].to_numpy() / norm <= TARGET)
-            if hit.size and (best is None or times.iloc[hit[0]] < best[1]):
-                best = ("/".join(key), float(times.iloc[hit[0]]),
-                        int(sequence["ndofs"].iloc[hit[0]]))
-        smallest = (group["energy_error"] / norm).min()
+        ranking = cheapest(group, norm, TARGET, None)["ranking"]
+        best = ranking[0] if ranking else None
         out.append({"order": int(order), "strategy": strategy,
-                    "first to 1e-3": best[0] if best else "not reached",
-                    "ndofs": best[2] if best else "",
-                    "wall time [s]": f"{best[1]:.2f}" if best else "",
-                    "smallest relative error": f"{smallest:.2e}"})
+                    "first to 1e-3": best["combination"] if best else "not reached",
+                    "ndofs": best["ndofs"] if best else "",
+                    "wall time [s]": f"{best['seconds']:.2f}" if best else "",
+                    "smallest relative error": f"{(group['energy_error'] / norm).min():.2e}"})
     return pd.DataFrame(out)
 
 

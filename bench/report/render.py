@@ -54,7 +54,8 @@ def latest_run(table: pd.DataFrame) -> pd.DataFrame:
     return table[rank == best]
 
 
-def _read_json(results: Path | None, name: str) -> dict:
+def read_json(results: Path | None, name: str) -> dict:
+    """A JSON file of the results folder (run.json, truth.json); {} where it is absent."""
     if results is None or not (results / name).exists():
         return {}
     return json.loads((results / name).read_text())
@@ -109,7 +110,7 @@ def write_report(table: pd.DataFrame, out: str | Path, results: str | Path | Non
     table = table.reindex(columns=list(dict.fromkeys([*COLUMNS, *table.columns])))
     everything = latest_run(table) if len(table) else table
     rows = everything[everything["level"] >= 0]
-    run_info, truth = _read_json(results, "run.json"), _read_json(results, "truth.json")
+    run_info, truth = read_json(results, "run.json"), read_json(results, "truth.json")
     _load_scene_files(run_info)
     figs = Figures(out)
     hard, hard_figures, hard_matrix = _hard_section(results, figs)
