@@ -28,8 +28,9 @@ def test_a_saved_baseline_is_compared_and_gates_regressions(tmp_path):
     [baseline] = (tmp_path / "store").rglob("0001_baseline.json")
     names = {b["name"] for b in json.loads(baseline.read_text())["benchmarks"]}
     assert {"test_linear_solve[1e4]", "test_fast_contact_solve[1e4]"} <= names
-    # the same code again: within the threshold of docs/solvers.md (median +100 %: three runs of
-    # these 10^4 workloads spread by 7 to 46 % on the 2-core machine)
-    same = _pytest(tmp_path, "--benchmark-compare=0001", "--benchmark-compare-fail=median:100%")
+    # the same code again must pass the gate. Four runs of these 10^4 workloads (5 rounds each)
+    # on the 2-core machine put the fast contact solve's median between 60 and 128 ms, a factor
+    # 2.1; +300 % leaves room for a loaded CI machine while still catching a 4x regression
+    same = _pytest(tmp_path, "--benchmark-compare=0001", "--benchmark-compare-fail=median:300%")
     assert same.returncode == 0, same.stdout + same.stderr
     assert "0001_baseli" in same.stdout and "(NOW)" in same.stdout  # both rows in the table
