@@ -13,6 +13,7 @@ import pandas as pd
 
 from bench.cli.compare_block import check_readme, write_compare_block
 from bench.cli.diff import diff_command
+from bench.cli.generated import run_values
 from bench.cli.guards import InputError, check_compare_out, check_output_folders
 from bench.cli.listing import list_command
 from bench.cli.parser import build_parser
@@ -28,6 +29,12 @@ from bench.hard import (
     write_hard,
 )
 from bench.matrix import RunConfig, run
+from bench.matrix.config_files import (
+    COMPARE_KEYS,
+    compare_settings,
+    read_run_file,
+    save_run_file,
+)
 from bench.matrix.plugins import load_plugins
 from bench.matrix.run import RunRefused, compare_reference_dofs
 from bench.matrix.scene_files import load_scene_files, scene_files_in
@@ -37,10 +44,10 @@ from bench.report.console import console_summary
 from bench.report.render import read_json
 from bench.sequence.loop import LevelResult
 from bench.sequence.rows import KEYS, level_time
+from bench.study.run import StudyConfig, read_study_file
 from bench.verify import load_expected, verdict_table, verify
 from estimators import estimator_names
 from formulations import formulation_names
-from formulations.solvers.registry import FAST_SOLVER
 from scenes import get_scene, scene_names
 from scenes.registry import SCENES, scene_dim
 
@@ -92,18 +99,19 @@ def run_config(config: RunConfig | None, quiet: bool = False) -> int:
     return 1 if result.failed else 0
 
 
+def command_line(args) -> str:
+    return " ".join(["python -m bench", *args.argv])
+
+
+def save_config(config: RunConfig | None, args) -> None:
+    """``--save-config FILE``: the run's full configuration as a run file."""
+    if config is not None and getattr(args, "save_config", None):
+        print(f"wrote {save_run_file(config, args.save_config, command_line(args))}")
+
+
 def run_command(args) -> int:
-    config = configured(
-        scenes=args.scene, formulations=args.formulation, solvers=args.solver,
-        estimators=args.estimator, strategies=args.strategy, orders=args.order,
-        cells=args.cell, max_dofs=args.max_dofs,
-        max_levels=args.max_levels, marking=args.marking, theta=args.theta,
-        backend=args.backend, nested=not args.cold_start, reference_dofs=args.reference_dofs,
-        reference_crosscheck=args.reference_crosscheck, crosscheck_dofs=args.crosscheck_dofs,
-        max_memory_gib=args.max_memory, out=args.out,
-        overwrite=args.overwrite, workers=args.workers, scheduler=args.scheduler,
-        cache=args.cache, scene_files=tuple(args.scene_file), target_error=args.target_error,
-        command=" ".join(["python -m bench", *args.argv]))
+    config = configured(**run_values(args, RunConfig), command=command_line(args))
+    save_config(config, args)
     return run_config(config)
 
 
@@ -151,20 +159,26 @@ def compared_scenes(dim: int) -> list[str]:
     return names
 
 
+def compare_fields(args) -> dict:
+    """compare's run: its package settings, then the run file's keys (``--config``), then
+    its options; scenes, formulations and estimators not given are every registered one."""
+    fields = {k: v for k, v in {**compare_settings(), **args.file_fields}.items()
+              if k not in COMPARE_KEYS}
+    fields.update(run_values(args, RunConfig))
+    fields.setdefault("scenes", compared_scenes(args.dim))
+    fields.setdefault("formulations", formulation_names())
+    fields.setdefault("estimators", estimator_names())
+    fields["reference_dofs"] = compare_reference_dofs(fields.get("reference_dofs"), args.dim)
+    return {**fields, "overwrite": True}  # its own folder: check_compare_out decided
+
+
 def compare_command(args) -> int:
     """The default comparison: every scene not tagged hard x every formulation x every
-    estimator x {uniform, adaptive} with the active-set solver, then the hard cases into the
-    same folder, then the report."""
+    estimator x {uniform, adaptive} with the active-set solver (``compare.toml``), then the
+    hard cases into the same folder, then the report."""
     check_compare_out(args.out, args.overwrite)
-    config = configured(
-        scenes=compared_scenes(args.dim),
-        formulations=formulation_names(), solvers=(FAST_SOLVER,),
-        estimators=estimator_names(), strategies=("uniform", "adaptive"), cells=args.cell,
-        max_dofs=args.max_dofs,
-        reference_dofs=compare_reference_dofs(args.reference_dofs, args.dim),
-        crosscheck_dofs=args.crosscheck_dofs, max_memory_gib=args.max_memory, out=args.out,
-        overwrite=True, workers=args.workers, scheduler=args.scheduler, cache=args.cache,
-        scene_files=tuple(args.scene_file), command=" ".join(["python -m bench", *args.argv]))
+    config = configured(**compare_fields(args), command=command_line(args))
+    save_config(config, args)
     if args.readme is not None:
         try:
             check_readme(args.readme)
@@ -235,6 +249,22 @@ COMMANDS = {"run": run_command, "compare": compare_command, "report": report_com
             "diff": diff_command}
 
 
+def run_file_defaults(argv: list[str]) -> dict:
+    """``--config FILE`` of run or compare, read before the parser is built: the file's values
+    become the command's defaults (so options given override them) and its scene files
+    are loaded (their scenes are valid names)."""
+    command = next((a for a in argv if not a.startswith("-")), None)
+    path = next((argv[k + 1] for k, a in enumerate(argv[:-1]) if a == "--config"),
+                next((a.split("=", 1)[1] for a in argv if a.startswith("--config=")), None))
+    if path is None or command not in ("run", "compare", "study"):
+        return {}
+    if command == "study":
+        return {"study": StudyConfig(**read_study_file(path)[0])}
+    fields = read_run_file(path, COMPARE_KEYS if command == "compare" else ())
+    load_scene_files(fields.get("scene_files", ()))
+    return {command: fields}
+
+
 def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     load_plugins()  # before the parser too: its lists include the plugins' units
@@ -243,8 +273,14 @@ def main(argv: list[str] | None = None) -> int:
     except ValueError as error:  # a path that is not a scene file
         print(f"error: {error}", file=sys.stderr)
         return 2
-    args = build_parser().parse_args(argv)
+    try:
+        defaults = run_file_defaults(argv)
+    except ValueError as error:  # a run file that cannot be read, an unknown key
+        print(f"error: {error}", file=sys.stderr)
+        return 2
+    args = build_parser(defaults).parse_args(argv)
     args.argv = argv
+    args.file_fields = defaults.get(args.command, {})
     try:
         check_output_folders(args.command, args)
         return COMMANDS[args.command](args)

@@ -25,7 +25,10 @@ DEFAULTS = StudyConfig()
 HEX_SCENE = "free-boundary-3d"  # the 3D scene with an exact solution
 
 
-def add_study_parser(sub) -> None:
+def add_study_parser(sub, settings: StudyConfig | None = None) -> None:
+    """The study's options, their defaults from ``settings`` (a study file's, ``--config``) or
+    the package's study.toml."""
+    d = settings or DEFAULTS
     study = sub.add_parser(
         "study", help="the rate study: uniform sequences to 2e6 DOFs, adaptive to 1e6, every "
         "formulation x estimator, against sharp references; writes its own report",
@@ -35,26 +38,26 @@ def add_study_parser(sub) -> None:
         "sequence.")
     study.add_argument("--scene", type=options.name_list("scene", scene_names()),
                        default=None,
-                       help=f"scene(s) (default: {','.join(DEFAULTS.scenes)}; with --cell hex: "
+                       help=f"scene(s) (default: {','.join(d.scenes)}; with --cell hex: "
                             f"{HEX_SCENE})")
-    study.add_argument("--order", type=options.order_list, default=list(DEFAULTS.orders),
+    study.add_argument("--order", type=options.order_list, default=list(d.orders),
                        help="polynomial order(s) (default: 1)")
     study.add_argument("--uniform-max-dofs", type=options.positive_int("uniform_max_dofs"),
-                       default=DEFAULTS.uniform_max_dofs,
+                       default=d.uniform_max_dofs,
                        help=f"DOF budget of the uniform sequences "
-                            f"(default: {DEFAULTS.uniform_max_dofs})")
+                            f"(default: {d.uniform_max_dofs})")
     study.add_argument("--adaptive-max-dofs", type=options.positive_int("adaptive_max_dofs"),
-                       default=DEFAULTS.adaptive_max_dofs,
+                       default=d.adaptive_max_dofs,
                        help=f"DOF budget of the adaptive sequences "
-                            f"(default: {DEFAULTS.adaptive_max_dofs})")
+                            f"(default: {d.adaptive_max_dofs})")
     study.add_argument("--reference-dofs", type=options.positive_int("reference_dofs"),
-                       default=DEFAULTS.reference_dofs,
-                       help=f"P3 reference budget (default: {DEFAULTS.reference_dofs})")
+                       default=d.reference_dofs,
+                       help=f"P3 reference budget (default: {d.reference_dofs})")
     study.add_argument("--workers", type=options.non_negative_int("workers"),
-                       default=DEFAULTS.workers,
+                       default=d.workers,
                        help=f"adaptive sequences run in parallel on a local Dask cluster of "
                             f"this many processes; uniform ones one at a time "
-                            f"(default: {DEFAULTS.workers})")
+                            f"(default: {d.workers})")
     study.add_argument("--cell", choices=("tri", "quad", "hex"), default="tri",
                        help="tri (default): the matrix's formulations on triangles; quad: the "
                             "seed's own discretisation, Q1 (Q2 with --order 2) on hierarchical "
@@ -63,15 +66,22 @@ def add_study_parser(sub) -> None:
                             "estimator (REPORT/quads.md); hex: Q1 on the 3D scenes' cubes, "
                             "vi, uniform (REPORT/hexes.md)")
     study.add_argument("--quick", action="store_true",
-                       help="the reduced study of the default tests: paper, uniform to 9000 "
-                            "and adaptive to 5000 DOFs, in this process")
+                       help=f"the reduced study of the default tests ([quick] of study.toml): "
+                            f"{','.join(QUICK.scenes)}, uniform to {QUICK.uniform_max_dofs} and "
+                            f"adaptive to {QUICK.adaptive_max_dofs} DOFs, {QUICK.workers} "
+                            "workers")
     study.add_argument("--report-only", action="store_true",
                        help="write the report of the sequences finished so far in OUT, "
                             "without running anything")
-    study.add_argument("--out", default=DEFAULTS.out,
-                       help=f"results folder (default: {DEFAULTS.out})")
-    study.add_argument("--report", default=DEFAULTS.report,
-                       help=f"report folder (default: {DEFAULTS.report})")
+    study.add_argument("--out", default=d.out,
+                       help=f"results folder (default: {d.out})")
+    study.add_argument("--report", default=d.report,
+                       help=f"report folder (default: {d.report})")
+    study.add_argument("--config", default=None, metavar="FILE",
+                       help="read the study's settings from FILE, a copy of the package's "
+                            "bench/study/study.toml (its keys: scenes, orders, "
+                            "uniform-max-dofs, ...); options given override them")
+    study.set_defaults(study_scenes=d.scenes, study_crosscheck=d.crosscheck)
 
 
 def quad_study_command(args) -> int:
@@ -141,9 +151,10 @@ def study_command(args) -> int:
     if args.cell == "hex":
         return hex_study_command(args)
     base = QUICK if args.quick else StudyConfig(
-        scenes=tuple(args.scene or DEFAULTS.scenes), orders=tuple(args.order),
+        scenes=tuple(args.scene or args.study_scenes), orders=tuple(args.order),
         uniform_max_dofs=args.uniform_max_dofs, adaptive_max_dofs=args.adaptive_max_dofs,
-        reference_dofs=args.reference_dofs, workers=args.workers)
+        reference_dofs=args.reference_dofs, workers=args.workers,
+        crosscheck=args.study_crosscheck)
     config = dataclasses.replace(base, out=args.out, report=args.report,
                                  command=" ".join(["python -m bench", *args.argv]))
     if args.report_only:

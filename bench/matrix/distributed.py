@@ -83,8 +83,6 @@ def sequence_task(spec: SequenceSpec, out: str, run: dict, cache: str | None,
                   max_memory_gib: float | None, scene_files: tuple[str, ...] = ()) -> Outcome:
     """One sequence on a worker: its rows go to its own partition as they finish (the user's
     plugins and scene files imported first, as in the driver)."""
-    if cache is not None:
-        os.environ["SIGNORINI_BENCH_CACHE"] = cache
     load_plugins()
     load_scene_files(scene_files)
     writer = SequenceWriter(Path(out) / "sequences" / f"{spec.key}.parquet")
@@ -95,7 +93,8 @@ def sequence_task(spec: SequenceSpec, out: str, run: dict, cache: str | None,
         rows.append(result.row)
 
     end = run_spec(spec, run, out, lambda scene: truth_for(scene, spec.reference_dofs,
-                                                           spec.max_dofs, spec.order),
+                                                           spec.max_dofs, spec.order,
+                                                           cache=cache),
                    record, max_memory_gib)
     writer.finish(end)
     return Outcome(spec.key, end, tuple(replace(r, sequence_end=end) for r in rows))
@@ -124,7 +123,8 @@ def run_on_dask(specs: list[SequenceSpec], store: ResultStore, run: dict, config
     memory = config.max_memory_gib
     if memory is None and not config.scheduler:  # the local workers share this machine
         memory = available_gib() / workers
-    cache = config.cache or os.environ.get("SIGNORINI_BENCH_CACHE")
+    # the driver's cache folder, given to each task (None: each worker's own default)
+    cache = config.cache if config.cache is not None else os.environ.get("SIGNORINI_BENCH_CACHE")
     try:
         files = tuple(str(Path(f).expanduser().resolve()) for f in config.scene_files)
         futures = {client.submit(sequence_task, spec, str(store.out), run, cache, memory, files,

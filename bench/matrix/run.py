@@ -8,45 +8,30 @@ recomputed, unless ``overwrite``."""
 
 from __future__ import annotations
 
-import os
 import sys
 from collections.abc import Callable
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 
 import pandas as pd
 
-from bench.matrix.distributed import SchedulerError, check_scheduler, scheduler_endpoint
+from bench.matrix.config import RunConfig
+from bench.matrix.distributed import SchedulerError, check_scheduler
 from bench.matrix.local import new_run_identity, run_specs, truth_name, write_truth_summary
-from bench.matrix.plugins import load_plugins
 from bench.matrix.provenance import write_run_record
 from bench.matrix.rates import write_rates
-from bench.matrix.scene_files import load_scene_files, source_digest
 from bench.matrix.spec import (
     SequenceSpec,
     build_scene,
     check_formulation_options,
     check_level_zero,
-    cross_product,
-    parse_item,
 )
 from bench.matrix.store import ResultStore
-from bench.sequence.loop import STRATEGIES, LevelResult, LoopConfig
+from bench.sequence.loop import LevelResult
 from bench.sequence.rows import COLUMNS, ResultRow
 from bench.truth import truth_for
 from bench.truth.cache import check_cache_folder
-from estimators import estimator_names, guaranteed_estimators
-from formulations import STATUS_FAILED, formulation_names, solver_names
-from formulations.cells import DEFAULT_CELL, cell_names, check_cell
-from formulations.elasticity import ORDERS, check_order
-from formulations.solvers.backends import check_backend
-from formulations.solvers.registry import REFERENCE_SOLVER
-from scenes import scene_names
-from scenes.base import is_integer
+from formulations import STATUS_FAILED
 
-NAME_LISTS = {"scenes": scene_names, "formulations": formulation_names,
-              "solvers": solver_names, "estimators": estimator_names,
-              "strategies": lambda: list(STRATEGIES)}
-SWEPT = ("scenes", "formulations")  # lists whose items may carry name:key=v1|v2 sweeps
 COMPARE_REFERENCE_DOFS = 200000  # the default comparison's reference budget
 # ... and in 3D, where the reference is P2 (docs/theory.md, section 14.6): measured, 268 806
 # and 206 736 DOFs on paper-3d and hertz-3d, error bars 0.98 % and 1.47 % of the energy norm,
@@ -60,107 +45,6 @@ def compare_reference_dofs(given: int | None, dim: int) -> int:
     if given is not None:
         return given
     return COMPARE_REFERENCE_DOFS_3D if dim == 3 else COMPARE_REFERENCE_DOFS
-
-
-@dataclass(frozen=True)
-class RunConfig:
-    """Everything that determines a run of the matrix (the options of ``python -m bench run``).
-    Name lists are checked against the registries on construction; a scene or formulation may
-    carry a sweep, ``paper:poisson_ratio=0.3|0.45`` (docs/command-line.md)."""
-
-    scenes: tuple[str, ...] = ("paper",)
-    formulations: tuple[str, ...] = ("mixed",)
-    solvers: tuple[str, ...] = (REFERENCE_SOLVER,)
-    estimators: tuple[str, ...] = ("residual",)
-    strategies: tuple[str, ...] = ("adaptive",)
-    orders: tuple[int, ...] = (1,)  # polynomial orders of the displacements, a matrix dimension
-    cells: tuple[str, ...] = (DEFAULT_CELL,)  # cell shapes (formulations.cells), a dimension
-    max_dofs: int = 20000
-    max_levels: int = 40
-    marking: str = "doerfler"
-    theta: float = 0.5
-    backend: str | None = None
-    nested: bool = True
-    reference_dofs: int | None = None
-    reference_crosscheck: bool = False  # also build the second recipe's reference, compare
-    crosscheck_dofs: int = 0
-    max_memory_gib: float | None = None  # None: what the machine has available, minus a margin
-    out: str = "results"
-    overwrite: bool = False
-    workers: int = 0  # > 0: a local Dask cluster of this many processes
-    scheduler: str | None = None  # the address of an existing Dask cluster
-    cache: str | None = None  # reference cache folder (default $SIGNORINI_BENCH_CACHE)
-    scene_files: tuple[str, ...] = ()  # Python files that register scenes (--scene-file)
-    target_error: float | None = None  # stop each sequence once its guaranteed eta is below
-    command: str = ""  # how the run was asked for, recorded in run.json
-
-    def __post_init__(self):
-        object.__setattr__(self, "scene_files", tuple(str(f) for f in self.scene_files))
-        load_plugins()
-        load_scene_files(self.scene_files)  # their scenes are valid names from here on
-        for name, valid in NAME_LISTS.items():
-            items = tuple(getattr(self, name))
-            object.__setattr__(self, name, items)
-            names = [item.split(":")[0] for item in items] if name in SWEPT else list(items)
-            unknown = [n for n in names if n not in valid()]
-            if not items or unknown:
-                raise ValueError(f"{name}={list(items)!r}: unknown "
-                                 f"{', '.join(unknown) or '(none)'}; valid: {', '.join(valid())}")
-            if len(set(items)) < len(items):
-                raise ValueError(f"{name}={list(items)!r} names an item twice")
-            if name in SWEPT:
-                for item in items:
-                    parse_item(item, name)
-        self._check_axis("orders", "order", list(map(str, ORDERS)), check_order)
-        self._check_axis("cells", "cell", cell_names(), check_cell)
-        for name in ("reference_dofs", "crosscheck_dofs", "workers"):
-            value = getattr(self, name)
-            if value is not None and not (is_integer(value) and value >= 0):
-                raise ValueError(f"{name}={value!r} is not an integer >= 0")
-        if self.backend is not None:
-            check_backend(self.backend)
-        if not str(self.out).strip():
-            raise ValueError(f"out={self.out!r} is empty; give an output folder")
-        if self.scheduler is not None:
-            scheduler_endpoint(self.scheduler)
-        unsafe = [e for e in self.estimators if e not in guaranteed_estimators()]
-        if self.target_error is not None and unsafe:
-            raise ValueError(f"target_error={self.target_error!r} needs estimators whose eta is "
-                             f"a guaranteed bound ({', '.join(guaranteed_estimators())}); "
-                             f"{', '.join(unsafe)} bound the error only up to a constant")
-        self.loop()  # validates the loop's options
-
-    def _check_axis(self, name: str, one: str, allowed: list[str], check) -> None:
-        """A matrix axis (orders, cells): a non-empty tuple naming each value once, each one
-        passing ``check``."""
-        values = tuple(getattr(self, name))
-        object.__setattr__(self, name, values)
-        if not values or len(set(values)) < len(values):
-            raise ValueError(f"{name}={list(values)!r}: give each {one} once, from "
-                             f"{', '.join(allowed)}")
-        for value in values:
-            check(value)
-
-    def specs(self) -> list[SequenceSpec]:
-        return cross_product(
-            [s for item in self.scenes for s in parse_item(item, "scenes")],
-            [f for item in self.formulations for f in parse_item(item, "formulations")],
-            self.solvers, self.estimators, self.strategies, self.orders, self.loop(),
-            cells=self.cells,
-            reference_dofs=self.reference_dofs, crosscheck_dofs=self.crosscheck_dofs,
-            scene_source=source_digest(self.scene_files))
-
-    def loop(self) -> LoopConfig:
-        """The loop settings every sequence shares (LoopConfig validates them)."""
-        return LoopConfig(strategy=self.strategies[0], order=self.orders[0],
-                          max_dofs=self.max_dofs, max_levels=self.max_levels,
-                          marking=self.marking, theta=self.theta, nested=self.nested,
-                          target_error=self.target_error, max_memory_gib=self.max_memory_gib,
-                          solver_options={"backend": self.backend} if self.backend else {})
-
-    def record(self) -> dict:
-        """The configuration as written to run.json."""
-        return {f.name: getattr(self, f.name) for f in fields(self) if f.name != "command"}
 
 
 @dataclass(frozen=True, eq=False)
@@ -181,17 +65,17 @@ class RunRefused(ValueError):
 
 
 def prepare_truths(specs: list[SequenceSpec], crosscheck: bool = False,
-                   max_memory_gib: float | None = None) -> dict:
+                   max_memory_gib: float | None = None, cache=None) -> dict:
     """Every truth the specs need, built (or loaded) before any sequence runs, so that a bad
     scene parameter or formulation option, a starting mesh over the budgets, or a reference
     that cannot judge the runs, is refused first (RunRefused). Nothing is written."""
     try:
-        return _truths(specs, crosscheck, max_memory_gib)
+        return _truths(specs, crosscheck, max_memory_gib, cache)
     except ValueError as error:  # SceneError, TruthError, unknown parameters
         raise RunRefused(str(error)) from None
 
 
-def _truths(specs: list[SequenceSpec], crosscheck: bool, max_memory_gib) -> dict:
+def _truths(specs: list[SequenceSpec], crosscheck: bool, max_memory_gib, cache) -> dict:
     judged = {}  # per truth: the largest budget and order it judges, and a spec to build it
     scenes, checked = {}, set()
     for spec in specs:
@@ -209,7 +93,7 @@ def _truths(specs: list[SequenceSpec], crosscheck: bool, max_memory_gib) -> dict
     truths = {}
     for name, (dofs, order, spec) in judged.items():
         truths[name] = truth_for(scenes[spec.scene, spec.scene_parameters],
-                                 spec.reference_dofs, dofs, order, crosscheck)
+                                 spec.reference_dofs, dofs, order, crosscheck, cache)
         if truths[name] is None:
             print(f"note: scene {spec.scene!r} has no exact solution and no reference budget "
                   "was given, so its errors and effectivity indices are not measured (NaN); "
@@ -231,7 +115,8 @@ def check_before_running(config: RunConfig, specs: list[SequenceSpec]) -> dict:
             check_scheduler(config.scheduler)
     except (SchedulerError, ValueError) as error:
         raise RunRefused(str(error)) from None
-    return prepare_truths(specs, config.reference_crosscheck, config.max_memory_gib)
+    return prepare_truths(specs, config.reference_crosscheck, config.max_memory_gib,
+                          config.cache)
 
 
 def run(config: RunConfig, on_level: Callable[[LevelResult], None] | None = None,
@@ -243,8 +128,6 @@ def run(config: RunConfig, on_level: Callable[[LevelResult], None] | None = None
     deleted only once a sequence of this run has finished, and kept if it fails before."""
     specs = config.specs()
     truths = check_before_running(config, specs)
-    if config.cache is not None:
-        os.environ["SIGNORINI_BENCH_CACHE"] = str(config.cache)
     store = ResultStore(config.out, overwrite=config.overwrite)
     try:
         rows, reused = _run_into(store, config, specs, truths, on_level, on_sequence)
@@ -254,7 +137,7 @@ def run(config: RunConfig, on_level: Callable[[LevelResult], None] | None = None
     store.keep_new()
     table = store.consolidate()
     write_rates(table, store.out)  # every sequence in the folder, earlier runs' too
-    keys = {s.key for s in specs}
+    keys = {s.key for s in specs} | set(reused)
     table = table[table["sequence_key"].isin(keys)].reindex(columns=COLUMNS)
     return RunResult(rows, table.reset_index(drop=True), store, reused)
 
@@ -262,8 +145,14 @@ def run(config: RunConfig, on_level: Callable[[LevelResult], None] | None = None
 def _run_into(store: ResultStore, config: RunConfig, specs, truths, on_level, on_sequence):
     """The sequences of ``specs`` not finished in ``store`` yet: (rows, reused keys)."""
     finished = store.finished_keys()
-    todo = [s for s in specs if s.key not in finished]
-    reused = tuple(s.key for s in specs if s.key in finished)
+    stored = {s.key: s.key if s.key in finished else s.legacy_key for s in specs}
+    todo = [s for s in specs if stored[s.key] not in finished]
+    reused = tuple(stored[s.key] for s in specs if stored[s.key] in finished)
+    legacy = sum(stored[s.key] != s.key for s in specs if s not in todo)
+    if legacy:
+        print(f"note: {legacy} finished sequences in {store.out} are stored under the key of "
+              "an earlier version of the package; they are reused as they are",
+              file=sys.stderr)
     identity = new_run_identity()
     for name, truth in truths.items():  # truth.json then describes the whole table
         write_truth_summary(store.out, name, truth)

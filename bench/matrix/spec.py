@@ -9,7 +9,7 @@ import hashlib
 import inspect
 import itertools
 import json
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, fields, replace
 
 from bench.sequence.loop import LoopConfig, memory_refusal
 from formulations import get_formulation
@@ -44,27 +44,39 @@ class SequenceSpec:
     order = property(lambda self: self.loop.order)
     cell = property(lambda self: self.loop.cell)
     max_dofs = property(lambda self: self.loop.max_dofs)
-    backend = property(lambda self: self.loop.solver_options.get("backend"))
+    backend = property(lambda self: self.loop.options().get("backend"))
 
     @property
     def key(self) -> str:
-        """A hash of every field that determines the rows (the same flat fields, and so the
-        same keys, as before the loop settings moved into ``loop``)."""
+        """A hash of every field that determines the rows: the spec's own and every field of
+        its loop but where it runs (``max_memory_gib``), so a new loop field is keyed
+        without an edit here."""
+        loop = {f.name: getattr(self.loop, f.name) for f in fields(self.loop)
+                if f.name != "max_memory_gib"}
+        own = {f.name: getattr(self, f.name) for f in fields(self) if f.name != "loop"}
+        text = json.dumps({**own, "loop": loop, "version": SPEC_VERSION}, sort_keys=True,
+                          default=str)
+        return hashlib.sha256(text.encode()).hexdigest()[:20]
+
+    @property
+    def legacy_key(self) -> str:
+        """The key of the same spec before it hashed its loop's fields (results folders
+        written then are still read: ``bench.matrix.run``)."""
         loop = self.loop
-        fields = {"scene": self.scene, "formulation": self.formulation, "solver": self.solver,
-                  "estimator": self.estimator, "strategy": loop.strategy, "order": loop.order,
-                  "scene_parameters": self.scene_parameters,
-                  "formulation_options": self.formulation_options, "max_dofs": loop.max_dofs,
-                  "max_levels": loop.max_levels, "marking": loop.marking, "theta": loop.theta,
-                  "nested": loop.nested, "backend": self.backend,
-                  "reference_dofs": self.reference_dofs, "crosscheck_dofs": self.crosscheck_dofs}
-        if self.scene_source:  # keys without them stay as they were
-            fields["scene_source"] = self.scene_source
+        flat = {"scene": self.scene, "formulation": self.formulation, "solver": self.solver,
+                "estimator": self.estimator, "strategy": loop.strategy, "order": loop.order,
+                "scene_parameters": self.scene_parameters,
+                "formulation_options": self.formulation_options, "max_dofs": loop.max_dofs,
+                "max_levels": loop.max_levels, "marking": loop.marking, "theta": loop.theta,
+                "nested": loop.nested, "backend": self.backend,
+                "reference_dofs": self.reference_dofs, "crosscheck_dofs": self.crosscheck_dofs}
+        if self.scene_source:
+            flat["scene_source"] = self.scene_source
         if loop.target_error:
-            fields["target_error"] = loop.target_error
+            flat["target_error"] = loop.target_error
         if loop.cell != DEFAULT_CELL:
-            fields["cell"] = loop.cell
-        text = json.dumps({**fields, "version": SPEC_VERSION}, sort_keys=True, default=str)
+            flat["cell"] = loop.cell
+        text = json.dumps({**flat, "version": SPEC_VERSION}, sort_keys=True, default=str)
         return hashlib.sha256(text.encode()).hexdigest()[:20]
 
     def loop_config(self, max_memory_gib: float | None = None) -> LoopConfig:
@@ -77,14 +89,14 @@ class SequenceSpec:
                 "formulation_options": label(self.formulation_options)}
 
 
-def cross_product(scenes, formulations, solvers, estimators, strategies, orders, loop: LoopConfig,
+def cross_product(scenes, formulations, solvers, estimators, strategies, orders, loop: dict,
                   cells=(DEFAULT_CELL,), **settings) -> list[SequenceSpec]:
     """Every combination as a spec; ``scenes`` and ``formulations`` are (name, parameter
-    pairs) as ``parse_item`` gives them, ``loop`` the loop settings every spec shares (its
-    strategy, order and cell replaced per spec), ``settings`` the remaining fields."""
+    pairs) as ``parse_item`` gives them, ``loop`` the ``LoopSettings`` values every spec
+    shares (with its own strategy, order and cell), ``settings`` the remaining fields."""
     return [SequenceSpec(scene=scene, formulation=formulation, solver=solver,
                          estimator=estimator,
-                         loop=replace(loop, strategy=strategy, order=order, cell=cell),
+                         loop=LoopConfig(**loop, strategy=strategy, order=order, cell=cell),
                          scene_parameters=tuple(sorted(parameters)),
                          formulation_options=tuple(sorted(options)), **settings)
             for (scene, parameters), (formulation, options), solver, estimator, strategy, order,

@@ -43,7 +43,7 @@ def measure_sequence(strategy: str, max_dofs: int, backend: str | None = None,
     scene = get_scene("paper")
     truth = truth_for(scene, reference_dofs, max_dofs)
     config = LoopConfig(strategy=strategy, max_dofs=max_dofs, max_levels=60, cell=cell,
-                        solver_options={"backend": backend})
+                        backend=backend)
     rows, t_store, last = [], 0.0, None
     with tempfile.TemporaryDirectory() as folder:
         store = ResultStore(folder)

@@ -6,7 +6,7 @@ from __future__ import annotations
 import functools
 import time
 from collections.abc import Generator
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 
 from skfem import MeshTri
 
@@ -16,15 +16,16 @@ from bench.sequence.columns import (
     error_columns,
     solver_columns,
 )
-from bench.sequence.marking import check_marking, grade_contact_trace, mark
+from bench.sequence.marking import MARKINGS, check_marking, grade_contact_trace, mark
 from bench.sequence.memory import available_gib, predict_peak_gib, route
+from bench.sequence.options import option
 from bench.sequence.rows import ResultRow, identity_columns
 from estimators.base import estimator_on
 from formulations import STATUS_FAILED, get_formulation, solve
 from formulations.cells import DEFAULT_CELL, check_cell, family_for
 from formulations.cells.base import Plan
 from formulations.elasticity import check_order, element_diameters
-from formulations.solvers.backends import check_backend
+from formulations.solvers.backends import backend_names, check_backend
 from formulations.solvers.registry import REFERENCE_SOLVER
 from scenes import Scene
 from scenes.base import is_integer, is_number
@@ -33,34 +34,42 @@ STRATEGIES = ("uniform", "adaptive")
 
 
 @dataclass(frozen=True)
-class LoopConfig:
-    """How a refinement sequence is run; validated on construction."""
+class LoopSettings:
+    """How every sequence of a run is run: the loop's settings that are also options of the
+    command line and keys of a run file (``bench.sequence.options``); validated on
+    construction."""
 
-    strategy: str = "adaptive"
-    order: int = 1  # polynomial order p of the displacements (formulations.elasticity.ORDERS)
-    cell: str = DEFAULT_CELL  # the cell family's shape (formulations.cells): tri or quad
-    max_dofs: int = 20000
-    max_levels: int = 40
-    marking: str = "doerfler"
-    theta: float = 0.5
-    nested: bool = True
-    grade_contact: bool = True  # 2:1 grading closure along Gamma_C (bench.sequence.marking)
-    # the inf-sup constant: free with the active-set solver on cholmod (its condensed system),
-    # else a factorisation and m solves per level
-    diagnostics: bool = True
-    solver_options: dict = field(default_factory=dict)
+    max_dofs: int = option(20000, "DOF budget: stop before a level with more unknowns",
+                           flag="max-dofs", kind="int>0", section="how")
+    max_levels: int = option(40, "maximum number of levels", flag="max-levels", kind="int>0",
+                             section="how")
+    target_error: float | None = option(
+        None, "stop each sequence at the first level whose guaranteed error bound is at most "
+        "TOL (energy norm; needs a guaranteed estimator such as equilibrated)",
+        flag="target-error", kind="float>0", section="how", metavar="TOL", default_text="off")
+    marking: str = option("doerfler", "adaptive marking: doerfler (bulk) or maximum",
+                          flag="marking", kind="choice", section="how",
+                          choices=lambda: list(MARKINGS))
+    theta: float = option(0.5, "marking parameter in (0, 1]", flag="theta", kind="theta",
+                          section="how")
+    backend: str | None = option(
+        None, "sparse direct back-end of the active-set solver: pardiso (MKL, installed with "
+        "the package on x86_64), cholmod (needs scikit-sparse) or splu (scipy)",
+        flag="backend", kind="choice", section="how", choices=backend_names,
+        default_text="the first of these that is available")
+    nested: bool = option(
+        True, "solve every level from scratch instead of starting from the previous level's "
+        "contact zone (nested iteration, the default)", flag="cold-start", kind="switch-off",
+        section="how")
     # refuse a level whose predicted peak memory exceeds this (GiB); None: what the machine has
     # available minus a margin (bench.sequence.memory)
-    max_memory_gib: float | None = None
-    # stop at the first level whose guaranteed bound eta is at most this (needs an estimator
-    # whose Estimate is guaranteed)
-    target_error: float | None = None
+    max_memory_gib: float | None = option(
+        None, "refuse (status failed) a level whose predicted peak memory exceeds this many "
+        "GiB, before building it", flag="max-memory", kind="gib", section="where",
+        metavar="GIB", default_text="the memory the machine has available, minus 10 % and "
+        "at least 1 GiB")
 
     def __post_init__(self):
-        if self.strategy not in STRATEGIES:
-            raise ValueError(f"strategy={self.strategy!r} is not one of {', '.join(STRATEGIES)}")
-        check_order(self.order)
-        check_cell(self.cell)
         for name in ("max_dofs", "max_levels"):
             value = getattr(self, name)
             if not (is_integer(value) and value > 0):
@@ -72,6 +81,38 @@ class LoopConfig:
         if self.max_memory_gib is not None and not (
                 is_number(self.max_memory_gib) and self.max_memory_gib > 0):
             raise ValueError(f"max_memory_gib={self.max_memory_gib!r} is not a number > 0")
+        if self.backend is not None:
+            check_backend(self.backend)
+
+    def settings(self) -> dict:
+        """The values of ``LoopSettings``' own fields (what a ``LoopConfig`` inherits)."""
+        return {f.name: getattr(self, f.name) for f in fields(LoopSettings)}
+
+
+@dataclass(frozen=True)
+class LoopConfig(LoopSettings):
+    """How one refinement sequence is run: the run's ``LoopSettings`` and the sequence's own
+    strategy, order and cell; validated on construction."""
+
+    strategy: str = "adaptive"
+    order: int = 1  # polynomial order p of the displacements (formulations.elasticity.ORDERS)
+    cell: str = DEFAULT_CELL  # the cell family's shape (formulations.cells): tri or quad
+    grade_contact: bool = True  # 2:1 grading closure along Gamma_C (bench.sequence.marking)
+    # the inf-sup constant: free with the active-set solver on cholmod (its condensed system),
+    # else a factorisation and m solves per level
+    diagnostics: bool = True
+    solver_options: dict = field(default_factory=dict)  # more keywords of the solver
+
+    def __post_init__(self):
+        super().__post_init__()
+        if self.strategy not in STRATEGIES:
+            raise ValueError(f"strategy={self.strategy!r} is not one of {', '.join(STRATEGIES)}")
+        check_order(self.order)
+        check_cell(self.cell)
+
+    def options(self) -> dict:
+        """The solver's keywords: ``solver_options`` and the back-end."""
+        return {**({"backend": self.backend} if self.backend else {}), **self.solver_options}
 
 
 @dataclass(frozen=True, eq=False)
@@ -126,7 +167,7 @@ def memory_refusal(level: int, ndofs: int, solver: str, config: LoopConfig,
                    dim: int = 2) -> str | None:
     """Why a level of ``ndofs`` unknowns must not be built (its predicted peak memory does not
     fit), or None."""
-    backend = check_backend(config.solver_options.get("backend"))
+    backend = check_backend(config.options().get("backend"))
     need = predict_peak_gib(ndofs, solver, backend, config.order, dim)
     limit = config.max_memory_gib if config.max_memory_gib is not None else available_gib()
     if need <= limit:
@@ -180,7 +221,7 @@ def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
         start = time.perf_counter()
         disc = discretise(scene, mesh)
         t_assemble = time.perf_counter() - start
-        options = dict(config.solver_options)
+        options = config.options()
         if config.nested and previous is not None and previous.ok:
             options["warm_start"] = disc.warm_start(previous, solver)  # nested iteration
         sol = previous = solve(disc, solver, **options)
@@ -193,7 +234,7 @@ def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
                        **(solver_columns(sol.diagnostics) if failed else {}))
         if not failed:
             numbers.update(diagnostic_columns(disc, sol, config.diagnostics,
-                                              config.solver_options.get("backend")))
+                                              config.options().get("backend")))
             numbers.update(eta=est.eta, eta_0=est.eta_0, eta_geometric=est.eta_geometric,
                            eta_complementarity=est.eta_complementarity)
             if truth is not None:

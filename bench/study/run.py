@@ -7,10 +7,12 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
+from pathlib import Path
 
 import pandas as pd
 
 from bench.matrix import RunConfig, run
+from bench.matrix.config_files import dataclass_fields, read_toml
 from bench.matrix.store import ResultStore
 from bench.sequence.rows import FINISHED
 from bench.study.report import write_study_report
@@ -19,18 +21,36 @@ from estimators import estimator_names
 from formulations import formulation_names
 from formulations.solvers.registry import FAST_SOLVER
 
+STUDY_SETTINGS = Path(__file__).with_name("study.toml")  # the defaults, and [quick]
+STUDY_KEYS = ["scenes", "orders", "uniform_max_dofs", "adaptive_max_dofs", "reference_dofs",
+              "workers", "crosscheck", "out", "report"]
+
+
+def read_study_file(path: str | Path = STUDY_SETTINGS) -> tuple[dict, dict]:
+    """A study file's settings and its ``[quick]`` table's, as ``StudyConfig`` fields."""
+    data = read_toml(path, "a study file")
+    quick = data.pop("quick", {})
+    where = f"config={str(path)!r}"
+    return (dataclass_fields(data, STUDY_KEYS, where),
+            dataclass_fields(quick, STUDY_KEYS, f"{where} [quick]"))
+
+
+_SETTINGS, _QUICK = read_study_file()
+
 
 @dataclass(frozen=True)
 class StudyConfig:
-    scenes: tuple[str, ...] = ("paper", "free-boundary", "hertz")
-    orders: tuple[int, ...] = (1,)
-    uniform_max_dofs: int = 2_100_000
-    adaptive_max_dofs: int = 1_000_000
-    reference_dofs: int = 200_000
-    workers: int = 2  # adaptive sequences in parallel; uniform ones run one at a time
-    crosscheck: bool = True  # build the P2 references too; truth.json records the agreement
-    out: str = "study"
-    report: str = "reports/study"
+    """The rate study's settings; the defaults are the package's ``study.toml``."""
+
+    scenes: tuple[str, ...] = _SETTINGS["scenes"]
+    orders: tuple[int, ...] = _SETTINGS["orders"]
+    uniform_max_dofs: int = _SETTINGS["uniform_max_dofs"]
+    adaptive_max_dofs: int = _SETTINGS["adaptive_max_dofs"]
+    reference_dofs: int = _SETTINGS["reference_dofs"]
+    workers: int = _SETTINGS["workers"]  # adaptive sequences in parallel; uniform one by one
+    crosscheck: bool = _SETTINGS["crosscheck"]  # the P2 references too, compared in truth.json
+    out: str = _SETTINGS["out"]
+    report: str = _SETTINGS["report"]
     command: str = "python -m bench study"
 
     def run_configs(self) -> list[RunConfig]:
@@ -48,8 +68,7 @@ class StudyConfig:
 
 
 # the default tests' version: the paper scene to a few thousand DOFs
-QUICK = StudyConfig(scenes=("paper",), uniform_max_dofs=9000, adaptive_max_dofs=5000,
-                    workers=0, crosscheck=False)
+QUICK = StudyConfig(**_QUICK)
 
 
 def study_gates(config: StudyConfig) -> list[dict] | None:
@@ -81,10 +100,11 @@ def run_study(config: StudyConfig, on_level=None) -> tuple[pd.DataFrame, object,
 def finished_table(config: StudyConfig) -> tuple[pd.DataFrame, int]:
     """The rows of the study's sequences finished so far in ``config.out`` (another process may
     still be running the rest), and how many sequences the study plans."""
-    keys = {spec.key for run_config in config.run_configs() for spec in run_config.specs()}
+    specs = [spec for run_config in config.run_configs() for spec in run_config.specs()]
+    keys = {spec.key for spec in specs} | {spec.legacy_key for spec in specs}
     table = ResultStore(config.out).table()
     done = table["sequence_key"].isin(keys) & table["sequence_end"].isin(FINISHED)
-    return table[done].reset_index(drop=True), len(keys)
+    return table[done].reset_index(drop=True), len(specs)
 
 
 def report_study(config: StudyConfig) -> tuple[pd.DataFrame, object, list]:

@@ -21,7 +21,11 @@ class CorruptCache(Exception):
     """A cached reference that must not be used (the message says why)."""
 
 
-def cache_folder() -> Path:
+def cache_folder(given: str | Path | None = None) -> Path:
+    """The folder of the cached references: ``given`` (a run's ``cache``), else
+    ``$SIGNORINI_BENCH_CACHE``, else ``.cache/references``."""
+    if given is not None:
+        return Path(given).expanduser()
     return Path(os.environ.get("SIGNORINI_BENCH_CACHE", ".cache/references"))
 
 
@@ -98,12 +102,14 @@ def _mesh(p: np.ndarray, t: np.ndarray):
     return (MeshTet if p.shape[0] == 3 else MeshTri)(p, t)
 
 
-def load_or_build(scene, max_dofs: int, recipe: str | None = None) -> Reference:
-    """The cached reference for (scene, max_dofs, recipe), built and stored if missing or
-    corrupt; ``recipe`` None: the primary recipe of the scene's dimension."""
+def load_or_build(scene, max_dofs: int, recipe: str | None = None,
+                  cache: str | Path | None = None) -> Reference:
+    """The cached reference for (scene, max_dofs, recipe) in ``cache_folder(cache)``, built and
+    stored if missing or corrupt; ``recipe`` None: the primary recipe of the scene's
+    dimension."""
     recipe = recipes_for(scene)[0] if recipe is None else recipe
     key = reference_key(scene, max_dofs, recipe)
-    path = cache_folder() / f"{key}.npz"
+    path = cache_folder(cache) / f"{key}.npz"
     if path.exists():
         try:
             return load_reference(path, key)

@@ -74,17 +74,19 @@ def check_reference(reference, scene, judged_max_dofs: int | None, judged_order:
 
 
 def truth_for(scene, reference_dofs: int | None, judged_max_dofs: int | None = None,
-              judged_order: int = 1, crosscheck: bool = False):
+              judged_order: int = 1, crosscheck: bool = False, cache=None):
     """Exact if the scene has an exact solution; else the cached reference with
-    ``reference_dofs`` DOFs (None: no error measurement), refused (TruthError) if it cannot
-    judge runs up to ``judged_max_dofs`` DOFs of order ``judged_order``; with ``crosscheck``
-    also the second recipe's reference, compared with the first."""
+    ``reference_dofs`` DOFs (None: no error measurement) from the folder ``cache``
+    (``bench.truth.cache.cache_folder``), refused (TruthError) if it cannot judge runs up to
+    ``judged_max_dofs`` DOFs of order ``judged_order``; with ``crosscheck`` also the second
+    recipe's reference, compared with the first."""
     if scene.exact is not None:
         return ExactTruth(scene)
     if reference_dofs is None:
         return None
-    reference = load_or_build(scene, reference_dofs)
+    reference = load_or_build(scene, reference_dofs, cache=cache)
     check_reference(reference, scene, judged_max_dofs, judged_order)
-    check = (cross_check(reference, load_or_build(scene, reference_dofs, recipes_for(scene)[1]))
+    second = recipes_for(scene)[1] if crosscheck else None
+    check = (cross_check(reference, load_or_build(scene, reference_dofs, second, cache))
              if crosscheck else None)
     return ReferenceTruth(reference, check)

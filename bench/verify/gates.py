@@ -15,12 +15,12 @@ import pandas as pd
 
 from bench.hard import check_expected, run_hard, write_hard
 from bench.matrix import RunConfig, run
+from bench.matrix.config_files import run_fields
 from bench.matrix.rates import rates_table
 from bench.sequence.rows import KEYS
 from bench.verify.closed_form import closed_form_table
 from bench.verify.expected import EXPECTED, load_expected
 from bench.verify.truth_checks import error_bar_table, truth_table
-from formulations.cells import DEFAULT_CELL
 
 
 @dataclass(frozen=True)
@@ -40,14 +40,9 @@ def run_gate_matrices(expected: dict, out: str | Path, on_level=None,
     """The result rows of every ``[[run]]`` of expected.toml (stored together in ``out``);
     ``workers`` > 0 runs each on a local Dask cluster of that many processes."""
     tables = []
-    for k, entry in enumerate(expected["run"]):
-        config = RunConfig(scenes=(entry["scene"],), formulations=entry["formulations"],
-                           solvers=(entry["solver"],), estimators=entry["estimators"],
-                           strategies=entry["strategies"], orders=entry.get("orders", (1,)),
-                           cells=entry.get("cells", (DEFAULT_CELL,)),
-                           max_dofs=entry["max_dofs"],
-                           reference_dofs=entry.get("reference_dofs"), out=str(out),
-                           overwrite=k == 0, workers=workers,
+    for k, entry in enumerate(expected["run"]):  # run-file keys (bench.matrix.config_files)
+        fields = run_fields(entry, f"{EXPECTED.name} [[run]] {k + 1}")
+        config = RunConfig(**fields, out=str(out), overwrite=k == 0, workers=workers,
                            command="python -m bench verify")
         tables.append(run(config, on_level=on_level).table)
     return pd.concat(tables, ignore_index=True)

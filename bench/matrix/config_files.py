@@ -1,0 +1,127 @@
+"""Run files: a run described in TOML whose keys are the command line's options
+(``max-dofs = 9000``, ``scene = ["paper"]``), or a results folder's run.json, read into
+``RunConfig`` fields, and a ``RunConfig`` written back as such a file (docs/command-line.md,
+"Run files"). The settings of ``compare`` are such a file in the package, ``compare.toml``."""
+
+from __future__ import annotations
+
+import json
+import tomllib
+from pathlib import Path
+
+from bench.matrix.config import RunConfig
+from bench.sequence.options import SECTIONS, option_fields
+
+COMPARE_SETTINGS = Path(__file__).with_name("compare.toml")
+SECTION_TITLES = {"what": "what runs", "how": "how each sequence runs",
+                  "where": "where it runs"}
+
+
+class RunFileError(ValueError):
+    """A run file that cannot be read or names a key that is not an option."""
+
+
+def read_run_file(path: str | Path, extra: tuple[str, ...] = ()) -> dict:
+    """The ``RunConfig`` fields a run file sets (a TOML run file, or the run.json of a results
+    folder), and the keys of ``extra`` as they are (a command's own options)."""
+    path = Path(path)
+    try:
+        text = path.read_text()
+        data = json.loads(text) if path.suffix == ".json" else tomllib.loads(text)
+    except (OSError, ValueError) as error:  # TOMLDecodeError and JSONDecodeError included
+        raise RunFileError(f"config={str(path)!r} cannot be read as a run file "
+                           f"(TOML, or a results folder's run.json): {error}") from None
+    if path.suffix == ".json":
+        data = data.get("configuration", data)  # run.json records it under this key
+    return run_fields(data, f"config={str(path)!r}", extra)
+
+
+def run_fields(data: dict, where: str, extra: tuple[str, ...] = ()) -> dict:
+    """``data``'s keys (options, ``max-dofs``, or field names, ``max_dofs``) as ``RunConfig``
+    fields; a key of ``extra`` is kept as written. A list field given one value gets a list
+    of one."""
+    options = {f.name: (f, o) for f, o in option_fields(RunConfig)}
+    by_flag = {o.flag: name for name, (_, o) in options.items()}
+    out: dict = {}
+    for key, value in data.items():
+        name = by_flag.get(key, key if key in options else None)
+        if name is None and key in extra:
+            out[key] = value
+            continue
+        if name is None:
+            valid = ", ".join(sorted([*by_flag, *extra]))
+            raise RunFileError(f"{where}: unknown key {key!r}; valid keys: {valid}")
+        if name in out:
+            raise RunFileError(f"{where}: {key!r} sets {name} a second time")
+        field, opt = options[name]
+        if opt.kind == "switch-off" and key == opt.flag:
+            value = not value  # cold-start = true is nested = false
+        if str(field.type).startswith("tuple") and isinstance(value, (str, int)):
+            value = (value,)
+        out[name] = tuple(value) if isinstance(value, list) else value
+    return out
+
+
+def dataclass_fields(data: dict, names: list[str], where: str) -> dict:
+    """``data``'s keys as the field ``names`` of a dataclass (``uniform-max-dofs`` or
+    ``uniform_max_dofs``); an unknown key is refused naming the valid ones. Lists become
+    tuples."""
+    out = {}
+    for key, value in data.items():
+        name = key.replace("-", "_")
+        if name not in names:
+            valid = ", ".join(n.replace("_", "-") for n in names)
+            raise RunFileError(f"{where}: unknown key {key!r}; valid keys: {valid}")
+        out[name] = tuple(value) if isinstance(value, list) else value
+    return out
+
+
+def read_toml(path: str | Path, what: str) -> dict:
+    try:
+        return tomllib.loads(Path(path).read_text())
+    except (OSError, ValueError) as error:
+        raise RunFileError(f"config={str(path)!r} cannot be read as {what}: {error}") from None
+
+
+def compare_settings(path: str | Path = COMPARE_SETTINGS) -> dict:
+    """The settings of ``compare`` (fields, plus ``dim``, ``reports`` and ``readme``)."""
+    return read_run_file(path, extra=COMPARE_KEYS)
+
+
+COMPARE_KEYS = ("dim", "reports", "readme")  # compare's own keys beside run's
+
+
+def run_file_text(config: RunConfig, command: str = "") -> str:
+    """``config`` as a TOML run file, every option written (an unset one as a comment), by
+    section; reading it back gives the same ``RunConfig``."""
+    lines = ["# a run of signorini-bench; repeat it with: python -m bench run --config FILE"]
+    if command:
+        lines.append(f"# written by: {command}")
+    for section in SECTIONS:
+        lines.append(f"\n# {SECTION_TITLES[section]}")
+        for field, opt in option_fields(config):
+            if opt.section != section:
+                continue
+            value = getattr(config, field.name)
+            if opt.kind == "switch-off":
+                value = not value
+            lines.append(f"# {opt.flag}: not set" if value is None
+                         else f"{opt.flag} = {_toml_value(value)}")
+    return "\n".join(lines) + "\n"
+
+
+def _toml_value(value) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, (int, float)):
+        return repr(value)
+    if isinstance(value, (tuple, list)):
+        return "[" + ", ".join(_toml_value(v) for v in value) + "]"
+    return json.dumps(str(value))  # a TOML basic string: JSON's escapes are TOML's
+
+
+def save_run_file(config: RunConfig, path: str | Path, command: str = "") -> Path:
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(run_file_text(config, command))
+    return path
