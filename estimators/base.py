@@ -51,12 +51,9 @@ def planar_only(name: str, why: str):
 
 
 ESTIMATORS = Registry("estimator")
-_GUARANTEED: set[str] = set()
-
-
+# "estimator@family" -> the estimate function of an estimator on other cells
+ESTIMATOR_VARIANTS = Registry("estimator variant")
 SIMPLICES = ("tri", "tet")  # the cell families (formulations.cells) most estimators are built on
-_FAMILIES: dict[str, tuple[str, ...]] = {}  # estimator -> families its own function runs on
-_VARIANTS: dict[tuple[str, str], object] = {}  # (estimator, family) -> estimate function
 
 
 def register_estimator(name: str, description: str, applies=None, guaranteed: bool = False,
@@ -65,37 +62,36 @@ def register_estimator(name: str, description: str, applies=None, guaranteed: bo
     eta is an upper bound of the energy error with every constant computed (what
     ``--target-error`` needs); ``families``: the cell families it runs on (others can add
     their own ``register_cell_variant``)."""
-    if guaranteed:
-        _GUARANTEED.add(name)
-    _FAMILIES[name] = tuple(families)
-    return ESTIMATORS.register(name, description, applies)
+    return ESTIMATORS.register(name, description, applies,
+                               meta={"guaranteed": bool(guaranteed),
+                                     "families": tuple(families)})
 
 
 def register_cell_variant(name: str, family: str):
     """Register ``estimate(scene, solution)`` as estimator ``name`` on the cells of
     ``family`` (a family name of ``formulations.cells``): one module, one registration."""
-    def decorate(function):
-        _VARIANTS[(name, family)] = function
-        return function
-
-    return decorate
+    return ESTIMATOR_VARIANTS.register(f"{name}@{family}", f"{name} on {family} cells")
 
 
 def estimator_on(name: str, family: str):
     """The estimate function of ``name`` on ``family``'s cells."""
-    return _VARIANTS.get((name, family)) or ESTIMATORS.get(name)
+    variant = f"{name}@{family}"
+    if variant in ESTIMATOR_VARIANTS.names():
+        return ESTIMATOR_VARIANTS.get(variant)
+    return ESTIMATORS.get(name)
 
 
 def why_not_on(name: str, family) -> str | None:
     """Why estimator ``name`` does not run on ``family``'s cells (a ``CellFamily``), or
     None."""
-    if family.name in _FAMILIES.get(name, SIMPLICES) or (name, family.name) in _VARIANTS:
+    if (family.name in ESTIMATORS.meta(name, "families", SIMPLICES)
+            or f"{name}@{family.name}" in ESTIMATOR_VARIANTS.names()):
         return None
     return f"{name} is not built on {family.shape}"
 
 
 def guaranteed_estimators() -> list[str]:
-    return sorted(n for n in _GUARANTEED if n in ESTIMATORS.names())
+    return [n for n in ESTIMATORS.names() if ESTIMATORS.meta(n, "guaranteed", False)]
 
 
 estimator_names = ESTIMATORS.names

@@ -8,7 +8,8 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from types import MappingProxyType
 from typing import Any
 
 from scenes.base import SceneError
@@ -44,7 +45,8 @@ def broken_units() -> list[tuple[str, Broken]]:
 class Entry:
     """One registration: the object, its one line of description, where it came from, the
     optional ``applies(**context)`` check and what is known of it without building it
-    (``tags``, ``dim``: None when the registration does not say)."""
+    (``tags``, ``dim``: None when the registration does not say; ``meta``: what a kind of
+    unit declares besides, e.g. whether an estimator is guaranteed)."""
 
     item: Any
     description: str
@@ -52,6 +54,7 @@ class Entry:
     applies: Callable[..., str | None] | None = None
     tags: tuple[str, ...] = ()
     dim: int | None = None
+    meta: MappingProxyType = field(default_factory=lambda: MappingProxyType({}))
 
 
 @dataclass(frozen=True)
@@ -76,15 +79,17 @@ class Registry:
 
     def register(self, name: str, description: str,
                  applies: Callable[..., str | None] | None = None, *,
-                 tags: tuple[str, ...] = (), dim: int | None = None) -> Callable[[Any], Any]:
+                 tags: tuple[str, ...] = (), dim: int | None = None,
+                 meta: dict | None = None) -> Callable[[Any], Any]:
         """``applies(**context)`` (optional) returns why ``name`` cannot be combined with the
-        context (e.g. scene=..., formulation=...), or None when it can; ``tags`` and ``dim``
-        are what a command may know of the unit without building it."""
+        context (e.g. scene=..., formulation=...), or None when it can; ``tags``, ``dim`` and
+        ``meta`` are what a command may know of the unit without building it (kept with the
+        entry, so unregistering it forgets them too)."""
         def decorate(item: Any) -> Any:
             if name in self._entries:
                 raise ValueError(f"{self.kind} {name!r} is already registered")
             self._entries[name] = Entry(item, description, _ORIGINS[-1], applies,
-                                        tuple(tags), dim)
+                                        tuple(tags), dim, MappingProxyType(dict(meta or {})))
             self._broken.pop(name, None)
             return item
 
@@ -119,6 +124,13 @@ class Registry:
 
     def names(self) -> list[str]:
         return sorted(self._entries)
+
+    def meta(self, name: str, key: str, default=None):
+        """What ``name``'s registration declared under ``key`` (``default`` if nothing)."""
+        return self.entry(name).meta.get(key, default)
+
+    def items(self) -> list[tuple[str, Any]]:
+        return [(name, self._entries[name].item) for name in self.names()]
 
     def descriptions(self) -> dict[str, str]:
         return {name: self._entries[name].description for name in self.names()}

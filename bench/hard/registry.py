@@ -25,13 +25,13 @@ class CaseFigure:
     caption: str
 
 
-CASE_FIGURES: dict[str, CaseFigure] = {}
+CASE_FIGURES = Registry("hard case figure")  # case name -> its CaseFigure
 
 
 def case_figure(case: str, caption: str):
     """Register ``draw`` as the figure of ``case`` (the report shows it with ``caption``)."""
     def decorate(draw: Callable) -> Callable:
-        CASE_FIGURES[case] = CaseFigure(draw, caption)
+        CASE_FIGURES.register(case, caption)(CaseFigure(draw, caption))
         return draw
     return decorate
 
