@@ -53,13 +53,16 @@ def _shown(value) -> str:
     return str(value)
 
 
-def _help(opt: Option, default, help: str | None) -> str:
-    text = help or opt.help
+def _help(opt: Option, default, help: str | tuple[str, str] | None) -> str:
+    """The option's help and its default; ``help``: a command's own help, or its help and the
+    words for its default."""
+    text, words = help if isinstance(help, tuple) else (help or opt.help, None)
     if opt.kind in NAME_LISTS:
         text += f"; one of: {', '.join(NAME_LISTS[opt.kind]())}"
     if opt.kind not in ("switch", "switch-off"):
         unset = default is None or default == ()
-        text += f" (default: {opt.default_text if unset and opt.default_text else _shown(default)})"
+        words = words or (opt.default_text if unset and opt.default_text else _shown(default))
+        text += f" (default: {words})"
     return text.replace("%", "%%")
 
 

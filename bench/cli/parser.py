@@ -55,7 +55,9 @@ COMPARE_HELPS = {
     "overwrite": "replace the results of a folder that compare did not write (kept until the "
                  "new run has finished a sequence)",
     "crosscheck_dofs": "cross-check levels up to this size with the reference solver",
-    "reference_dofs": "DOF budget of the overkill references",
+    "reference_dofs": ("DOF budget of the overkill references",
+                       f"{COMPARE_REFERENCE_DOFS} for the P3 references in 2D, "
+                       f"{COMPARE_REFERENCE_DOFS_3D} for the P2 references in 3D"),
     "cells": "cell shape(s), comma-separated: tri, quad; the whole comparison runs on each"}
 COMPARE_OPTIONS = ("max_dofs", "cells", "reference_dofs", "max_memory_gib", "workers",
                    "scheduler", "cache", "scene_files", "crosscheck_dofs", "out", "overwrite")

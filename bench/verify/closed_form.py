@@ -6,40 +6,47 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from bench.matrix.config import RunConfig
+from bench.matrix.config_files import run_fields
+from bench.matrix.spec import build_scene
 from bench.measure.contact import contact_zone
-from bench.sequence.loop import LoopConfig, run_sequence
-from scenes import get_scene
+from bench.sequence.loop import run_sequence
 
 PEAK_SAMPLES = 8001  # points over +-4 half-widths where the computed peak pressure is sought
 PEAK_GRID_3D = 201  # 3D: a grid of 201 x 201 points over +-2 contact radii
 
 
 def closed_form_table(run: dict) -> pd.DataFrame:
-    """One row per formulation: computed and predicted half-width (the contact radius in 3D, that
-    of the disc of the contact zone's area) and peak pressure, and their relative errors
-    (``run``: the ``[closed_form]`` entry of expected.toml)."""
-    scene = get_scene(run["scene"])
+    """One row per sequence of ``run`` (the ``[closed_form]`` entry of expected.toml, a run
+    file's keys: one per formulation and order): computed and predicted half-width (the contact
+    radius in 3D, that of the disc of the contact zone's area) and peak pressure, and their
+    relative errors, at the last level."""
     rows = []
-    for formulation in run["formulations"]:
-        *_, result = run_sequence(scene, formulation, run["solver"], run["estimator"],
-                                  LoopConfig(strategy="adaptive", max_dofs=run["max_dofs"]))
-        sol = result.solution
-        force = sol.contact_force()
-        predicted = scene.predict_contact(force)
-        start, end = contact_zone(sol)
-        b = predicted.half_width
-        s = np.linspace(predicted.centre - 4 * b, predicted.centre + 4 * b, PEAK_SAMPLES)
-        if scene.dim == 3:  # a square grid over the disc's surroundings
-            line = np.linspace(predicted.centre - 2 * b, predicted.centre + 2 * b,
-                               PEAK_GRID_3D)
-            s = np.array(np.meshgrid(line, line - predicted.centre)).reshape(2, -1)
-        rows.append({"scene": scene.name, "formulation": formulation, "dim": scene.dim,
-                     "ndofs": result.row.ndofs, "contact_force": force,
-                     "half_width": 0.5 * (end - start), "predicted_half_width": b,
-                     "peak_pressure": float(sol.pressure_at(s).max()),
-                     "predicted_peak_pressure": predicted.peak_pressure})
+    for spec in RunConfig(**run_fields(run, "[closed_form]")).specs():
+        scene = build_scene(spec)
+        *_, result = run_sequence(scene, spec.formulation, spec.solver, spec.estimator,
+                                  spec.loop)
+        rows.append(_compare(scene, spec, result))
     table = pd.DataFrame(rows)
     table["half_width_error"] = table["half_width"] / table["predicted_half_width"] - 1
     table["peak_pressure_error"] = (table["peak_pressure"] / table["predicted_peak_pressure"]
                                     - 1)
     return table
+
+
+def _compare(scene, spec, result) -> dict:
+    """The computed contact of ``result``'s last level against the scene's prediction."""
+    sol = result.solution
+    force = sol.contact_force()
+    predicted = scene.predict_contact(force)
+    start, end = contact_zone(sol)
+    b = predicted.half_width
+    s = np.linspace(predicted.centre - 4 * b, predicted.centre + 4 * b, PEAK_SAMPLES)
+    if scene.dim == 3:  # a square grid over the disc's surroundings
+        line = np.linspace(predicted.centre - 2 * b, predicted.centre + 2 * b, PEAK_GRID_3D)
+        s = np.array(np.meshgrid(line, line - predicted.centre)).reshape(2, -1)
+    return {"scene": scene.name, "formulation": spec.formulation, "order": spec.order,
+            "dim": scene.dim, "ndofs": result.row.ndofs, "contact_force": force,
+            "half_width": 0.5 * (end - start), "predicted_half_width": b,
+            "peak_pressure": float(sol.pressure_at(s).max()),
+            "predicted_peak_pressure": predicted.peak_pressure}
