@@ -9,6 +9,24 @@ import numpy as np
 from scenes.registry import Registry
 
 
+@dataclass(frozen=True)
+class BoundTerms:
+    """The parts of a guaranteed bound's A and N (docs/theory.md, 13.1), each in energy-norm
+    units, so that a user sees which one dominates: ``symmetric`` the compliance norm of
+    sym sigma* - sigma_h, ``skew`` C_K ||skw sigma*||, ``oscillation`` C_G osc, ``load``
+    C_F ||rho||, ``negative_traction`` C_T ||lambda*_-||."""
+
+    symmetric: float
+    skew: float
+    oscillation: float
+    load: float
+    negative_traction: float
+
+    def columns(self) -> dict[str, float]:
+        """As result columns: eta_symmetric, eta_skew, ..."""
+        return {f"eta_{name}": float(value) for name, value in vars(self).items()}
+
+
 @dataclass(frozen=True, eq=False)
 class Estimate:
     """Global estimate and per-element indicators.
@@ -26,6 +44,7 @@ class Estimate:
     eta_complementarity: float
     indicators: np.ndarray
     guaranteed: bool = False  # eta is an upper bound of ||u - u_h|| with no unknown constant
+    bound: BoundTerms | None = None  # a guaranteed bound's parts
 
 
 def combine(estimator: str, volume: np.ndarray, contact) -> Estimate:

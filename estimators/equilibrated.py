@@ -21,7 +21,7 @@ import numpy as np
 from skfem import Basis, ElementDG, FacetBasis
 
 from estimators.averaging import compliance_energy, element_areas
-from estimators.base import Estimate, planar_only, register_estimator
+from estimators.base import BoundTerms, Estimate, planar_only, register_estimator
 from estimators.constants import domain_constants
 from estimators.equilibration import (
     BoundaryData,
@@ -30,8 +30,12 @@ from estimators.equilibration import (
     reconstruct,
 )
 from estimators.guaranteed_contact import (
+    ContactTraction,
+    FacetPolynomial,
     balanced_traction,
     contact_bound,
+    negative_part,
+    projected_pressure,
     traction_at,
 )
 from estimators.patch_data import interior_data, rebalanced
@@ -63,10 +67,14 @@ def estimate(scene, solution: DiscreteSolution) -> Estimate:
     skew = ((rec.values[0, 1] - rec.values[1, 0]) ** 2 / 2 * rec.basis.dx).sum(axis=1)
     osc = oscillation(scene, rec.basis, boundary)
     grad_constant = np.sqrt(1 / (2 * mu) + constants.korn**2)
-    A = (np.sqrt(compliance.sum()) + constants.korn * np.sqrt(skew.sum())
-         + grad_constant * np.sqrt((osc**2).sum()) + constants.friedrichs * np.sqrt(load.sum()))
     bound = contact_bound(scene, solution, lam_star, clamped)
-    a = A + bound.extension + constants.trace * bound.negative
+    terms = BoundTerms(symmetric=np.sqrt(compliance.sum()),
+                       skew=constants.korn * np.sqrt(skew.sum()),
+                       oscillation=grad_constant * np.sqrt((osc**2).sum()),
+                       load=constants.friedrichs * np.sqrt(load.sum()),
+                       negative_traction=constants.trace * bound.negative)
+    A = terms.symmetric + terms.skew + terms.oscillation + terms.load
+    a = A + bound.extension + terms.negative_traction
     b = A * bound.extension + bound.complementarity
     eta = 0.5 * (a + np.sqrt(a * a + 4 * b))
     local = (np.sqrt(compliance) + constants.korn * np.sqrt(skew) + grad_constant * osc
@@ -76,7 +84,7 @@ def estimate(scene, solution: DiscreteSolution) -> Estimate:
     return Estimate(estimator="equilibrated", eta=float(eta), eta_0=float(A),
                     eta_geometric=bound.extension,
                     eta_complementarity=float(np.sqrt(bound.complementarity)), indicators=local,
-                    guaranteed=True)
+                    guaranteed=True, bound=terms)
 
 
 def equilibrate(scene, solution: DiscreteSolution):
@@ -97,11 +105,9 @@ def equilibrate(scene, solution: DiscreteSolution):
     trace = solution.trace
     n_v = mesh.p.shape[1]
     neumann = BoundaryData(scene.neumann_facets(mesh), scene.traction or (lambda x: 0.0 * x))
-    raw = BoundaryData(trace.facets, lambda x: traction_at(trace, solution.pressure, x))
     neumann_flux = boundary_fluxes(interior, [neumann])
-    defect = interior.total - boundary_balance(n_v, neumann_flux
-                                               + boundary_fluxes(interior, [raw]))[0]
-    lam_star = balanced_traction(trace, solution.pressure, defect, clamped)
+    reaction = interior.total - boundary_balance(n_v, neumann_flux)[0]
+    lam_star = contact_traction(interior, trace, solution.pressure, order, reaction, clamped)
     contact = BoundaryData(trace.facets, lambda x: traction_at(trace, lam_star, x))
     fluxes = neumann_flux + boundary_fluxes(interior, [contact])
     interior, load = rebalanced(interior, interior.total - boundary_balance(n_v, fluxes)[0],
@@ -111,6 +117,24 @@ def equilibrate(scene, solution: DiscreteSolution):
         raise NotEquilibrated(f"the patch data do not balance (relative imbalance "
                               f"{rec.imbalance:.1e} > {BALANCE_TOLERANCE:g}): no bound")
     return rec, interior, load, lam_star, [neumann, contact], clamped
+
+
+def contact_traction(interior, trace, pressure, order: int, reaction: np.ndarray,
+                     clamped: np.ndarray) -> ContactTraction:
+    """lambda* (docs/theory.md, 13.3): of two tractions that balance u_h on the contact
+    patches, the one with the smaller negative part. (i) lambda_h projected onto P_k per
+    facet plus the P1 correction of what u_h does not balance (the mixed method balances
+    lambda_h exactly); (ii) the correction alone, the L2 representative of u_h's discrete
+    reaction on Gamma_C (for the penalty and Nitsche, whose pressure formula peaks between
+    the Gauss points that their own equations see)."""
+    n_v = reaction.shape[0]
+    projected = projected_pressure(pressure, order)
+    raw = BoundaryData(trace.facets, lambda x: traction_at(trace, projected, x))
+    defect = reaction - boundary_balance(n_v, boundary_fluxes(interior, [raw]))[0]
+    zero = FacetPolynomial(np.zeros((trace.facets.size, order + 1)))
+    candidates = [balanced_traction(trace, projected, defect, clamped),
+                  balanced_traction(trace, zero, reaction, clamped)]
+    return min(candidates, key=lambda traction: negative_part(trace, traction))
 
 
 def oscillation(scene, rt: Basis, boundary: list[BoundaryData]) -> np.ndarray:

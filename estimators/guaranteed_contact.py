@@ -27,13 +27,41 @@ QUADRATURE = 10     # Gauss points per contact facet for the kinked integrands
 
 @dataclass(frozen=True, eq=False)
 class ContactTraction:
-    """lambda*(t) = lambda_h(t) + delta_start (1 - t) + delta_end t on each contact facet."""
+    """lambda*(t) = lambda(t) + delta_start (1 - t) + delta_end t on each contact facet, lambda
+    the formulation's pressure projected onto P_k per facet (``projected_pressure``)."""
 
     pressure: object            # the formulation's lambda_h(t), (n_f, len(t))
     delta: np.ndarray           # (2, n_f): the correction at the start and end of each facet
 
     def __call__(self, t: np.ndarray) -> np.ndarray:
         return self.pressure(t) + self.delta[0][:, None] * (1 - t) + self.delta[1][:, None] * t
+
+
+PROJECTION_POINTS = 24  # Gauss points per facet for projecting a kinked lambda_h onto P_k
+
+
+@dataclass(frozen=True, eq=False)
+class FacetPolynomial:
+    """A function on the contact facets that is a polynomial of degree k on each: Legendre
+    coefficients (n_f, k + 1) on [0, 1]; called like ``DiscreteSolution.pressure``."""
+
+    coefficients: np.ndarray
+
+    def __call__(self, t: np.ndarray) -> np.ndarray:
+        shifted = np.polynomial.legendre.legvander(2 * np.asarray(t) - 1,
+                                                   self.coefficients.shape[1] - 1)
+        return self.coefficients @ shifted.T
+
+
+def projected_pressure(pressure, k: int) -> FacetPolynomial:
+    """The L2 projection of ``pressure(t)`` onto P_k on each facet (docs/theory.md, 13.3): as a
+    part of lambda* it keeps every moment against the hat functions (P_1 within P_k), and the
+    auxiliary problem's contact traction becomes one the RT_k stress meets exactly, so it adds
+    no oscillation; a kinked penalty or Nitsche pressure otherwise does."""
+    t, w = gauss_legendre(PROJECTION_POINTS)
+    legendre = np.polynomial.legendre.legvander(2 * t - 1, k)        # (nq, k + 1)
+    norms = 2 * np.arange(k + 1) + 1                                  # 1 / ||P_j||^2 on [0, 1]
+    return FacetPolynomial((pressure(t) * w) @ legendre * norms)
 
 
 def facet_parameter(trace, x: np.ndarray) -> np.ndarray:
@@ -114,10 +142,17 @@ def contact_bound(scene, solution, traction: ContactTraction, clamped: np.ndarra
     lam = traction(t)
     slack = trace.integrate(np.maximum(lam, 0.0) * (_gap_minus_displacement(scene, solution, t)
                                                     - d_n), w)
-    negative = float(np.sqrt(trace.integrate(np.minimum(lam, 0.0) ** 2, w).sum()))
+    negative = negative_part(trace, traction)
     per_element = energy + np.bincount(trace.element, np.abs(slack), mesh.t.shape[1])
     return ContactBound(extension=float(np.sqrt(energy.sum())), negative=negative,
                         complementarity=float(max(slack.sum(), 0.0)), per_element=per_element)
+
+
+def negative_part(trace, traction: ContactTraction) -> float:
+    """||lambda*_-||_{0,Gamma_C} (QUADRATURE Gauss points per facet: the negative part has
+    kinks)."""
+    t, w = gauss_legendre(QUADRATURE)
+    return float(np.sqrt(trace.integrate(np.minimum(traction(t), 0.0) ** 2, w).sum()))
 
 
 def _gap_minus_displacement(scene, solution, t: np.ndarray) -> np.ndarray:

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import fields
+
 import numpy as np
 import pandas as pd
 
@@ -10,6 +12,7 @@ from bench.report.verdict import EFFECTIVITY_FROM_DOFS
 from bench.sequence.rows import KEYS, LABELS, phase_time
 from bench.verify import claims
 from estimators import guaranteed_estimators
+from estimators.base import BoundTerms
 from formulations import STATUS_OK
 
 CLAIM_TOLERANCE = 0.1  # |measured - claimed| slope within which we say "agrees"
@@ -95,8 +98,21 @@ def estimator_summary(rows: pd.DataFrame) -> pd.DataFrame:
                     "range from 1e3 DOFs": f"{_fmt(late.min())} .. {_fmt(late.max())}"
                     if len(late) else "",
                     "levels with eta < error": f"{int((eff < 1).sum())} "
-                                               f"({100 * float((eff < 1).mean()):.0f} %)"})
+                                               f"({100 * float((eff < 1).mean()):.0f} %)",
+                    "parts of the bound from 1e3 DOFs": bound_parts_text(group)})
     return pd.DataFrame(out)
+
+
+def bound_parts_text(group: pd.DataFrame) -> str:
+    """The median share of each part of a guaranteed bound's A + N (``BoundTerms``) over the
+    levels from 1e3 DOFs, largest first ('' for an estimator without parts)."""
+    columns = [f"eta_{f.name}" for f in fields(BoundTerms) if f"eta_{f.name}" in group]
+    late = group.loc[group["ndofs"] >= EFFECTIVITY_FROM_DOFS, columns].dropna()
+    if late.empty:
+        return ""
+    shares = late.div(late.sum(axis=1), axis=0).median().sort_values(ascending=False)
+    return ", ".join(f"{name.removeprefix('eta_').replace('_', ' ')} {100 * share:.0f} %"
+                     for name, share in shares.items() if share >= 0.005)
 
 
 def _total_time(group: pd.DataFrame) -> float:

@@ -236,7 +236,8 @@ def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
             numbers.update(diagnostic_columns(disc, sol, config.diagnostics,
                                               config.options().get("backend")))
             numbers.update(eta=est.eta, eta_0=est.eta_0, eta_geometric=est.eta_geometric,
-                           eta_complementarity=est.eta_complementarity)
+                           eta_complementarity=est.eta_complementarity,
+                           **(est.bound.columns() if est.bound is not None else {}))
             if truth is not None:
                 numbers.update(error_columns(truth, sol, est))
             if solver != REFERENCE_SOLVER and disc.ndofs <= crosscheck_dofs:

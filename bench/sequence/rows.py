@@ -34,6 +34,11 @@ class ResultRow:
     eta_0: float = math.nan
     eta_geometric: float = math.nan
     eta_complementarity: float = math.nan
+    eta_symmetric: float = math.nan  # the parts of a guaranteed bound (estimators.BoundTerms)
+    eta_skew: float = math.nan
+    eta_oscillation: float = math.nan
+    eta_load: float = math.nan
+    eta_negative_traction: float = math.nan
     violation: float = math.nan
     dual_violation: float = math.nan
     complementarity: float = math.nan

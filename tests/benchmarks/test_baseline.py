@@ -2,6 +2,7 @@
 baseline JSON, then compare a second run against it with a regression threshold."""
 
 import json
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -19,7 +20,10 @@ def _pytest(tmp_path, *options):
                "--benchmark-enable", "--benchmark-only", "-n", "0", "--dist", "no",
                "-k", "1e4 and (linear or fast)",
                f"--benchmark-storage={tmp_path / 'store'}", *options]
-    return subprocess.run(command, capture_output=True, text=True, cwd=ROOT)
+    # a pytest-xdist worker's variables would make pytest-benchmark in the child think it runs
+    # under xdist too (PYTEST_XDIST_WORKER), and turn itself off
+    env = {k: v for k, v in os.environ.items() if not k.startswith("PYTEST_XDIST")}
+    return subprocess.run(command, capture_output=True, text=True, cwd=ROOT, env=env)
 
 
 def test_a_saved_baseline_is_compared_and_gates_regressions(tmp_path):

@@ -136,3 +136,18 @@ def test_target_error_needs_a_guaranteed_estimator():
     assert guaranteed_estimators() == ["equilibrated"]
     with pytest.raises(ValueError, match="target_error=0.1 needs estimators"):
         RunConfig(estimators=("residual",), target_error=0.1)
+
+
+def test_the_bound_reports_its_parts_and_they_sum_to_its_volume_term():
+    """eta_0 (A) is the sum of the symmetric, skew, oscillation and load parts; each is a
+    result column, NaN for an estimator without a bound."""
+    scene = get_scene("free-boundary")
+    rows = [r.row for r in run_sequence(scene, "mixed", "active-set", "equilibrated",
+                                        LoopConfig(strategy="uniform", max_dofs=600))]
+    for row in rows:
+        parts = (row.eta_symmetric, row.eta_skew, row.eta_oscillation, row.eta_load)
+        assert min(parts) >= 0 and row.eta_negative_traction >= 0
+        assert sum(parts) == pytest.approx(row.eta_0, rel=1e-12)  # one sum, reordered
+    [plain] = [r.row for r in run_sequence(scene, "mixed", "active-set", "residual",
+                                           LoopConfig(strategy="uniform", max_dofs=50))]
+    assert np.isnan(plain.eta_symmetric)
