@@ -39,7 +39,7 @@ def _phi(y):
                 tags=("exact",), dim=2)
 def free_boundary(young_modulus: float = 1.0, poisson_ratio: float = 0.3, plane: str = "strain",
                   push: float = 0.01, half_width: float = 0.4, gap_curvature: float = 0.1,
-                  initial_divisions: int = 4) -> Scene:
+                  initial_divisions: int = 4, align_jump: int = 0) -> Scene:
     material = Material(young_modulus, poisson_ratio, plane)
     lam, mu = material.lame
     stiff = lam + 2 * mu
@@ -79,19 +79,40 @@ def free_boundary(young_modulus: float = 1.0, poisson_ratio: float = 0.3, plane:
     if not (0 < a < 1):
         raise ValueError(f"half_width={a!r} is not in (0, 1)")
     grid = np.linspace(-1.0, 1.0, initial_divisions + 1)
+    if align_jump not in (0, 1):
+        raise ValueError(f"align_jump={align_jump!r} is not 0 or 1")
+    x_grid = aligned(grid, (-a, a)) if align_jump else grid
     return Scene(
         name="free-boundary",
         description="manufactured exact Signorini solution, contact zone |x| < a inside Gamma_C",
-        mesh=tensor_mesh(grid, grid), material=material,
+        mesh=tensor_mesh(x_grid, grid), material=material,
         is_dirichlet=lambda x: np.abs(x[1] - 1.0) < _TOL,
         is_contact=lambda x: np.abs(x[1] + 1.0) < _TOL,
         gap=lambda x: -c + k * np.clip(np.abs(x[0]) - a, 0.0, None) ** 2,
         contact_coordinate=lambda x: x[0], body_force=body_force, traction=traction,
         parameters={"young_modulus": young_modulus, "poisson_ratio": poisson_ratio,
                     "plane": plane, "push": push, "half_width": half_width,
-                    "gap_curvature": gap_curvature, "initial_divisions": initial_divisions},
+                    "gap_curvature": gap_curvature, "initial_divisions": initial_divisions,
+                    "align_jump": align_jump},
         tags=("exact",),
         exact=ExactSolution(displacement=displacement, gradient=gradient,
                             pressure=lambda s: p(np.asarray(s, dtype=float))[0],
                             contact_zone=(-a, a), source="manufactured (module docstring)"),
     )
+
+
+def aligned(grid: np.ndarray, lines: tuple[float, ...]) -> np.ndarray:
+    """``grid`` with its interior point nearest to each of ``lines`` moved onto it, so that the
+    lines where the body force jumps are mesh lines on every refinement (bisection keeps them):
+    f is then smooth on every element, and its oscillation is that of a smooth function
+    (docs/theory.md, 13.2)."""
+    out = grid.copy()
+    for line in lines:
+        inner = np.arange(1, len(out) - 1)
+        nearest = inner[np.abs(out[inner] - line).argmin()]
+        out[nearest] = line
+    if np.any(np.diff(out) <= 0) or not all(np.isin(lines, out)):
+        raise ValueError(f"initial_divisions={len(grid) - 1}: too few grid lines to align "
+                         f"with x = {', '.join(f'{v:g}' for v in lines)}")
+    return out
+
