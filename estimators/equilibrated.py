@@ -34,7 +34,6 @@ from estimators.guaranteed_contact import (
     FacetPolynomial,
     balanced_traction,
     contact_bound,
-    negative_part,
     projected_pressure,
     traction_at,
 )
@@ -107,7 +106,7 @@ def equilibrate(scene, solution: DiscreteSolution):
     neumann = BoundaryData(scene.neumann_facets(mesh), scene.traction or (lambda x: 0.0 * x))
     neumann_flux = boundary_fluxes(interior, [neumann])
     reaction = interior.total - boundary_balance(n_v, neumann_flux)[0]
-    lam_star = contact_traction(interior, trace, solution.pressure, order, reaction, clamped)
+    lam_star = contact_traction(scene, solution, interior, reaction, clamped)
     contact = BoundaryData(trace.facets, lambda x: traction_at(trace, lam_star, x))
     fluxes = neumann_flux + boundary_fluxes(interior, [contact])
     interior, load = rebalanced(interior, interior.total - boundary_balance(n_v, fluxes)[0],
@@ -119,22 +118,29 @@ def equilibrate(scene, solution: DiscreteSolution):
     return rec, interior, load, lam_star, [neumann, contact], clamped
 
 
-def contact_traction(interior, trace, pressure, order: int, reaction: np.ndarray,
+def contact_traction(scene, solution, interior, reaction: np.ndarray,
                      clamped: np.ndarray) -> ContactTraction:
     """lambda* (docs/theory.md, 13.3): of two tractions that balance u_h on the contact
-    patches, the one with the smaller negative part. (i) lambda_h projected onto P_k per
-    facet plus the P1 correction of what u_h does not balance (the mixed method balances
-    lambda_h exactly); (ii) the correction alone, the L2 representative of u_h's discrete
-    reaction on Gamma_C (for the penalty and Nitsche, whose pressure formula peaks between
+    patches, the one with the smaller contact terms C_T ||lambda*_-|| + sqrt(B) (no patch
+    problem is solved for either). (i) lambda_h projected onto P_k per facet plus the P1
+    correction of what u_h does not balance (the mixed method balances lambda_h exactly);
+    (ii) the correction alone, the L2 representative of u_h's discrete reaction on Gamma_C
+    (for the penalty and Nitsche on coarse contact zones, whose pressure formula peaks between
     the Gauss points that their own equations see)."""
-    n_v = reaction.shape[0]
-    projected = projected_pressure(pressure, order)
+    trace, order = solution.trace, solution.elasticity.order
+    projected = projected_pressure(solution.pressure, order)
     raw = BoundaryData(trace.facets, lambda x: traction_at(trace, projected, x))
-    defect = reaction - boundary_balance(n_v, boundary_fluxes(interior, [raw]))[0]
+    defect = reaction - boundary_balance(reaction.shape[0], boundary_fluxes(interior, [raw]))[0]
     zero = FacetPolynomial(np.zeros((trace.facets.size, order + 1)))
     candidates = [balanced_traction(trace, projected, defect, clamped),
                   balanced_traction(trace, zero, reaction, clamped)]
-    return min(candidates, key=lambda traction: negative_part(trace, traction))
+    trace_constant = domain_constants(scene).trace
+
+    def contact_terms(traction: ContactTraction) -> float:
+        bound = contact_bound(scene, solution, traction, clamped)
+        return trace_constant * bound.negative + np.sqrt(bound.complementarity)
+
+    return min(candidates, key=contact_terms)
 
 
 def oscillation(scene, rt: Basis, boundary: list[BoundaryData]) -> np.ndarray:
