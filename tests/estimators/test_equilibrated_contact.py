@@ -15,6 +15,7 @@ def hertz_truth(tmp_path_factory):
     return truth_for(get_scene("hertz"), 12000, 1100, 1, cache=tmp_path_factory.mktemp("c"))
 
 
+@pytest.mark.slow  # builds a 12 000-DOF P3 hertz reference: ~20 s
 @pytest.mark.parametrize("formulation", ["penalty", "nitsche"])
 def test_a_coarse_contact_zone_gets_a_consistent_traction(formulation, hertz_truth):
     """hertz, uniform, 1056 DOFs: the contact zone is two facets wide and the penalty's pressure

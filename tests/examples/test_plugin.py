@@ -95,6 +95,7 @@ def test_list_names_each_plugin_unit_and_the_broken_plugin(site, tmp_path):
             in done.stderr) and "Traceback" not in done.stderr
 
 
+@pytest.mark.slow  # run, report and export end to end: ~27 s
 def test_plugin_units_run_in_the_matrix_the_report_and_export(site, tmp_path):
     done = bench(site, "run", "--scene", "paper,punch", "--formulation", "mixed,penalty-soft",
                  "--solver", "active-set,active-set-again", "--estimator",

@@ -2,9 +2,12 @@
 
 import json
 
+import pytest
+
 from bench.matrix import RunConfig, run
 
 
+@pytest.mark.slow  # solves against a paper reference built on a fresh clone: ~37 s
 def test_nitsche_energy_is_as_close_to_the_reference_as_the_mixed_methods(tmp_path):
     result = run(RunConfig(scenes=("paper",), formulations=("mixed", "nitsche"),
                            solvers=("active-set",), strategies=("adaptive",), max_dofs=20000,

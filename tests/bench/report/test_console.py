@@ -2,6 +2,7 @@
 verdicts as counts and only the rows that were not as expected."""
 
 import pandas as pd
+import pytest
 
 import bench.cli.commands as commands
 from bench.cli import main
@@ -17,6 +18,7 @@ def test_report_ends_with_the_report_paths_and_a_headline(finished_run, tmp_path
     assert last[2].startswith("free-boundary: ") and "sharpest" in last[2]
 
 
+@pytest.mark.slow  # a whole (small) compare run: ~32 s on a fresh clone
 def test_compare_ends_with_at_most_ten_lines_naming_index_html(tmp_path, capsys, monkeypatch):
     # the whole comparison on one scene and one hard case (the wiring, not the catalogue)
     monkeypatch.setattr(commands, "compared_scenes", lambda dim: ["free-boundary"])
