@@ -30,6 +30,7 @@ from estimators.equilibration import (
     reconstruct,
 )
 from estimators.guaranteed_contact import (
+    ContactBound,
     ContactTraction,
     FacetPolynomial,
     balanced_traction,
@@ -57,7 +58,7 @@ class NotEquilibrated(RuntimeError):
                     applies=planar_only("equilibrated", "the Raviart-Thomas patch "
                                                          "equilibration is built on triangles"))
 def estimate(scene, solution: DiscreteSolution) -> Estimate:
-    rec, interior, load, lam_star, boundary, clamped = equilibrate(scene, solution)
+    rec, interior, load, bound, boundary, clamped = equilibrate(scene, solution)
     lam, mu = solution.elasticity.lame
     constants = domain_constants(scene)
     diff = rec.values - interior.sigma_h
@@ -66,7 +67,6 @@ def estimate(scene, solution: DiscreteSolution) -> Estimate:
     skew = ((rec.values[0, 1] - rec.values[1, 0]) ** 2 / 2 * rec.basis.dx).sum(axis=1)
     osc = oscillation(scene, rec.basis, boundary)
     grad_constant = np.sqrt(1 / (2 * mu) + constants.korn**2)
-    bound = contact_bound(scene, solution, lam_star, clamped)
     terms = BoundTerms(symmetric=np.sqrt(compliance.sum()),
                        skew=constants.korn * np.sqrt(skew.sum()),
                        oscillation=grad_constant * np.sqrt((osc**2).sum()),
@@ -87,8 +87,9 @@ def estimate(scene, solution: DiscreteSolution) -> Estimate:
 
 
 def equilibrate(scene, solution: DiscreteSolution):
-    """sigma* (a ``Reconstruction``), the patch data, ||rho||_T^2, lambda*, the Neumann data
-    of the auxiliary problem and the clamped vertices (docs/theory.md, 13.2 and 13.3)."""
+    """sigma* (a ``Reconstruction``), the patch data, ||rho||_T^2, the contact terms of
+    lambda* (a ``ContactBound``), the Neumann data of the auxiliary problem and the clamped
+    vertices (docs/theory.md, 13.2 and 13.3)."""
     elasticity = solution.elasticity
     mesh, order = elasticity.mesh, elasticity.order
     lam, mu = elasticity.lame
@@ -106,7 +107,7 @@ def equilibrate(scene, solution: DiscreteSolution):
     neumann = BoundaryData(scene.neumann_facets(mesh), scene.traction or (lambda x: 0.0 * x))
     neumann_flux = boundary_fluxes(interior, [neumann])
     reaction = interior.total - boundary_balance(n_v, neumann_flux)[0]
-    lam_star = contact_traction(scene, solution, interior, reaction, clamped)
+    lam_star, bound = contact_traction(scene, solution, interior, reaction, clamped)
     contact = BoundaryData(trace.facets, lambda x: traction_at(trace, lam_star, x))
     fluxes = neumann_flux + boundary_fluxes(interior, [contact])
     interior, load = rebalanced(interior, interior.total - boundary_balance(n_v, fluxes)[0],
@@ -115,18 +116,18 @@ def equilibrate(scene, solution: DiscreteSolution):
     if rec.imbalance > BALANCE_TOLERANCE:
         raise NotEquilibrated(f"the patch data do not balance (relative imbalance "
                               f"{rec.imbalance:.1e} > {BALANCE_TOLERANCE:g}): no bound")
-    return rec, interior, load, lam_star, [neumann, contact], clamped
+    return rec, interior, load, bound, [neumann, contact], clamped
 
 
 def contact_traction(scene, solution, interior, reaction: np.ndarray,
-                     clamped: np.ndarray) -> ContactTraction:
+                     clamped: np.ndarray) -> tuple[ContactTraction, ContactBound]:
     """lambda* (docs/theory.md, 13.3): of two tractions that balance u_h on the contact
     patches, the one with the smaller contact terms C_T ||lambda*_-|| + sqrt(B) (no patch
     problem is solved for either). (i) lambda_h projected onto P_k per facet plus the P1
     correction of what u_h does not balance (the mixed method balances lambda_h exactly);
     (ii) the correction alone, the L2 representative of u_h's discrete reaction on Gamma_C
     (for the penalty and Nitsche on coarse contact zones, whose pressure formula peaks between
-    the Gauss points that their own equations see)."""
+    the Gauss points that their own equations see). Returns it with its ``ContactBound``."""
     trace, order = solution.trace, solution.elasticity.order
     projected = projected_pressure(solution.pressure, order)
     raw = BoundaryData(trace.facets, lambda x: traction_at(trace, projected, x))
@@ -135,12 +136,10 @@ def contact_traction(scene, solution, interior, reaction: np.ndarray,
     candidates = [balanced_traction(trace, projected, defect, clamped),
                   balanced_traction(trace, zero, reaction, clamped)]
     trace_constant = domain_constants(scene).trace
-
-    def contact_terms(traction: ContactTraction) -> float:
-        bound = contact_bound(scene, solution, traction, clamped)
-        return trace_constant * bound.negative + np.sqrt(bound.complementarity)
-
-    return min(candidates, key=contact_terms)
+    bounds = [contact_bound(scene, solution, traction, clamped) for traction in candidates]
+    terms = [trace_constant * b.negative + np.sqrt(b.complementarity) for b in bounds]
+    best = int(np.argmin(terms))
+    return candidates[best], bounds[best]
 
 
 def oscillation(scene, rt: Basis, boundary: list[BoundaryData]) -> np.ndarray:

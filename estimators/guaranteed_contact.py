@@ -142,17 +142,10 @@ def contact_bound(scene, solution, traction: ContactTraction, clamped: np.ndarra
     lam = traction(t)
     slack = trace.integrate(np.maximum(lam, 0.0) * (_gap_minus_displacement(scene, solution, t)
                                                     - d_n), w)
-    negative = negative_part(trace, traction)
+    negative = float(np.sqrt(trace.integrate(np.minimum(lam, 0.0) ** 2, w).sum()))
     per_element = energy + np.bincount(trace.element, np.abs(slack), mesh.t.shape[1])
     return ContactBound(extension=float(np.sqrt(energy.sum())), negative=negative,
                         complementarity=float(max(slack.sum(), 0.0)), per_element=per_element)
-
-
-def negative_part(trace, traction: ContactTraction) -> float:
-    """||lambda*_-||_{0,Gamma_C} (QUADRATURE Gauss points per facet: the negative part has
-    kinks)."""
-    t, w = gauss_legendre(QUADRATURE)
-    return float(np.sqrt(trace.integrate(np.minimum(traction(t), 0.0) ** 2, w).sum()))
 
 
 def _gap_minus_displacement(scene, solution, t: np.ndarray) -> np.ndarray:

@@ -12,7 +12,7 @@ from bench.matrix.distributed import scheduler_endpoint
 from bench.matrix.plugins import load_plugins
 from bench.matrix.scene_files import load_scene_files, source_digest
 from bench.matrix.spec import SequenceSpec, cross_product, parse_item
-from bench.sequence.loop import STRATEGIES, LoopConfig, LoopSettings
+from bench.sequence.loop import STRATEGIES, LoopSettings
 from bench.sequence.options import option
 from estimators import estimator_names, guaranteed_estimators
 from formulations import formulation_names, solver_names
@@ -155,11 +155,6 @@ class RunConfig(LoopSettings):
             cells=self.cells,
             reference_dofs=self.reference_dofs, crosscheck_dofs=self.crosscheck_dofs,
             scene_source=source_digest(self.scene_files))
-
-    def loop(self, strategy: str = "adaptive", order: int = 1,
-             cell: str = DEFAULT_CELL) -> LoopConfig:
-        """The loop of one sequence: the run's settings with its strategy, order and cell."""
-        return LoopConfig(**self.settings(), strategy=strategy, order=order, cell=cell)
 
     def record(self) -> dict:
         """The configuration as written to run.json (every field but ``command``; a run file

@@ -13,6 +13,7 @@ from bench.matrix.config import RunConfig
 from bench.sequence.options import SECTIONS, option_fields
 
 COMPARE_SETTINGS = Path(__file__).with_name("compare.toml")
+COMPARE_KEYS = ("dim", "reports", "readme")  # compare's own keys beside run's
 SECTION_TITLES = {"what": "what runs", "how": "how each sequence runs",
                   "where": "where it runs"}
 
@@ -86,9 +87,6 @@ def read_toml(path: str | Path, what: str) -> dict:
 def compare_settings(path: str | Path = COMPARE_SETTINGS) -> dict:
     """The settings of ``compare`` (fields, plus ``dim``, ``reports`` and ``readme``)."""
     return read_run_file(path, extra=COMPARE_KEYS)
-
-
-COMPARE_KEYS = ("dim", "reports", "readme")  # compare's own keys beside run's
 
 
 def run_file_text(config: RunConfig, command: str = "") -> str:
