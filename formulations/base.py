@@ -39,6 +39,9 @@ class ContactQP:
     G: np.ndarray
     row_scale: np.ndarray
     objective_scale: float
+    # K's rigid-body modes (``Elasticity.rigid_modes``): the near-null space of the ``amg``
+    # back-end (None: none known; the back-end is then slower, not wrong)
+    near_null: np.ndarray | None = None
 
     @property
     def n(self) -> int:
@@ -86,6 +89,7 @@ class SolverDiagnostics:
     condition_estimate: float = float("nan")  # of the last linear system, solver's scaling
     condensed: np.ndarray | None = None  # B K^-1 B' when the solver formed it (pardiso, cholmod)
     phases: tuple[tuple[str, float], ...] = ()  # (phase, seconds) of the solve, in order
+    krylov_iterations: tuple[int, ...] = ()  # per linear solve, on an iterative back-end
 
 
 @dataclass(frozen=True, eq=False)

@@ -119,6 +119,12 @@ class Elasticity:
         u[self.free] = u_free
         return u
 
+    @functools.cached_property
+    def rigid_modes(self) -> np.ndarray:
+        """The rigid-body motions on the unknowns, (n, 3) in 2D or (n, 6) in 3D: the
+        near-null space an algebraic multigrid needs (``rigid_body_modes``)."""
+        return rigid_body_modes(self.basis)[self.free]
+
     def energy(self, u: np.ndarray) -> float:
         """E(u) = 1/2 u'Ku - F'u (the energy functional of docs/theory.md, section 1)."""
         return float(0.5 * u @ (self.K @ u) - self.F @ u)
@@ -147,6 +153,22 @@ def dof_basis(mesh: MeshTri, order: int = 1) -> Basis:
     cost more than K)."""
     family = family_of(mesh)
     return DofBasis(mesh, ElementVector(family.elements[order]()), family.centroid_rule)
+
+
+def rigid_body_modes(basis: Basis) -> np.ndarray:
+    """The translations and the infinitesimal rotations about the DOFs' centroid at every DOF
+    of a vector Lagrange basis (exact: the DOFs are point values, the motions linear)."""
+    x = basis.doflocs - basis.doflocs.mean(axis=1, keepdims=True)
+    components = basis.split_indices()
+    d = len(components)
+    pairs = [(0, 1)] if d == 2 else [(0, 1), (1, 2), (2, 0)]
+    modes = np.zeros((basis.N, d + len(pairs)))
+    for c, dofs in enumerate(components):
+        modes[dofs, c] = 1.0
+    for k, (a, b) in enumerate(pairs):  # u_a = -x_b, u_b = x_a
+        modes[components[a], d + k] = -x[b, components[a]]
+        modes[components[b], d + k] = x[a, components[b]]
+    return modes
 
 
 def element_diameters(mesh: MeshTri) -> np.ndarray:

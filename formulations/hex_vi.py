@@ -103,7 +103,8 @@ def solve_hex_vi(scene: Scene, mesh: MeshHex, solver: str = FAST_SOLVER,
     free = elasticity.free
     qp = ContactQP(K=elasticity.K_free, F=elasticity.F[free], B=B[:, free].tocsr(),
                    G=np.asarray(scene.gap(mesh.p[:, vertices]), dtype=float),
-                   row_scale=np.ones(m), objective_scale=float(scene.material.young_modulus))
+                   row_scale=np.ones(m), objective_scale=float(scene.material.young_modulus),
+                   near_null=elasticity.rigid_modes)
     answer = SOLVERS.get(solver)(qp, **options)
     if answer.u is None or answer.multipliers is None or not np.all(np.isfinite(answer.u)):
         return HexContactSolution(elasticity, np.full(elasticity.basis.N, np.nan),

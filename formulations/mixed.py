@@ -170,7 +170,8 @@ def discretise(scene: Scene, mesh: MeshTri, h_over_H: float = 0.5, order: int = 
         scene.gap(trace.points(t)))
     qp = ContactQP(K=elasticity.K_free, F=elasticity.F_free,
                    B=elasticity.restrict(B), G=G, row_scale=np.repeat(H, degree + 1),
-                   objective_scale=float(scene.material.young_modulus))
+                   objective_scale=float(scene.material.young_modulus),
+                   near_null=elasticity.rigid_modes)
     # each coefficient sits at its Greville point k / q of the segment (the middle for q = 0)
     greville = np.array([0.5]) if degree == 0 else np.linspace(0.0, 1.0, degree + 1)
     row_coordinate = (breaks[:-1, None] + np.diff(breaks)[:, None] * greville).ravel()
@@ -218,7 +219,8 @@ def discretise_surface(scene: Scene, mesh, h_over_H: float, order: int,
                                         * np.outer(surface.measure, w)).ravel()
     qp = ContactQP(K=elasticity.K_free, F=elasticity.F_free,
                    B=drop_roundoff(elasticity.restrict(B)), G=G, row_scale=area,
-                   objective_scale=float(scene.material.young_modulus))
+                   objective_scale=float(scene.material.young_modulus),
+                   near_null=elasticity.rigid_modes)
     centroid = np.array([np.bincount(patch, weights=c * surface.measure) / area
                          for c in surface.coordinate.mean(axis=1)])
 

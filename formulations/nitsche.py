@@ -110,7 +110,8 @@ def nitsche_system(scene: Scene, elasticity, trace, gap_h, t: np.ndarray, w: np.
         gap=gap_h(t).ravel(),
         weight=np.tile(w, trace.size) * np.repeat(trace.measure, nq),
         gamma=np.repeat(gamma_facet, nq), theta=float(theta),
-        objective_scale=float(scene.material.young_modulus))
+        objective_scale=float(scene.material.young_modulus),
+        near_null=elasticity.rigid_modes)
 
 
 @register_formulation("nitsche", "Nitsche's method, theta = 1 (symmetric, default), 0 or -1 "

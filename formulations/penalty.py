@@ -147,7 +147,8 @@ def discretise(scene: Scene, mesh: MeshTri, epsilon_0: float = DEFAULT_EPSILON_0
     system = SemismoothSystem(K=elasticity.K_free, F=elasticity.F_free,
                               S=sparse.csr_matrix((0, n)), N=P, gap=gap.ravel(),
                               weight=row_length, gamma=1.0 / row_epsilon, theta=0.0,
-                              objective_scale=young)
+                              objective_scale=young,
+                              near_null=elasticity.rigid_modes)
     # D_q = w_q |e| / eps_e = p^2 E w_q / eps_0 (|e| / h_e: 1 in 2D, exactly)
     qp = slack_qp(elasticity.K_free, elasticity.F_free, P, gap.ravel(),
                   order**2 * young / epsilon_0 * np.tile(w, nf)

@@ -74,7 +74,8 @@ def mixed_problem(scene: Scene, hierarchy: QuadHierarchy, order: int = 1,
     H = np.bincount(group, length, m)
     qp = ContactQP(K=elasticity.K_free, F=elasticity.F_free, B=elasticity.restrict(B), G=G,
                    row_scale=H,
-                   objective_scale=float(scene.material.young_modulus))
+                   objective_scale=float(scene.material.young_modulus),
+                   near_null=elasticity.rigid_modes)
     return QuadMixedProblem(elasticity, edges, group, H, qp)
 
 

@@ -133,7 +133,8 @@ def solve_quad_vi(scene: Scene, hierarchy: QuadHierarchy, order: int = 1,
     B, gap, weight, edge_nodes = contact_rows(scene, elasticity, edges)
     qp = ContactQP(K=elasticity.K_free, F=elasticity.F_free, B=elasticity.restrict(B), G=gap,
                    row_scale=np.ones(gap.size),
-                   objective_scale=float(scene.material.young_modulus))
+                   objective_scale=float(scene.material.young_modulus),
+                   near_null=elasticity.rigid_modes)
     answer = SOLVERS.get(solver)(qp, **options)
     if answer.u is None or answer.multipliers is None or not np.all(np.isfinite(answer.u)):
         return failed(elasticity, edges, gap.size, answer, order + 1)

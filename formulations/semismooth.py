@@ -46,6 +46,9 @@ class SemismoothSystem:
     gamma: np.ndarray  # the Nitsche parameter at the quadrature points (a stress per length)
     theta: float
     objective_scale: float  # Young's modulus: the scale of K
+    # K's rigid-body modes (``Elasticity.rigid_modes``): the near-null space of the ``amg``
+    # back-end (None: none known; the back-end is then slower, not wrong)
+    near_null: np.ndarray | None = None
 
     @property
     def n(self) -> int:

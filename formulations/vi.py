@@ -114,7 +114,8 @@ def discretise(scene: Scene, mesh: MeshTri, order: int = 1) -> Discretisation:
     # rows of B are dimensionless (a normal), so the multipliers are forces; row_scale 1
     qp = ContactQP(K=elasticity.K_free, F=elasticity.F_free,
                    B=elasticity.restrict(B), G=G, row_scale=np.ones(m),
-                   objective_scale=float(scene.material.young_modulus))
+                   objective_scale=float(scene.material.young_modulus),
+                   near_null=elasticity.rigid_modes)
     coordinate = np.asarray(scene.contact_coordinate(nodes.points), dtype=float)
     pieces = elasticity.order  # lambda_h is linear between consecutive nodes of a facet
 

@@ -43,8 +43,14 @@ from scipy import sparse
 
 from formulations.base import STATUS_OK, ContactQP, QPSolution, SolverDiagnostics
 from formulations.solvers.augmented import initial_active_set, solve_augmented
-from formulations.solvers.backends import check_backend, condenses, factorise_condensed
+from formulations.solvers.backends import (
+    check_backend,
+    condenses,
+    factorise_condensed,
+    iterative,
+)
 from formulations.solvers.lcp import CYCLING_EXAMPLE, condition_1, least_index_pivoting, pdas
+from formulations.solvers.projected import solve_projected
 from formulations.solvers.reference import solve_reference
 from formulations.solvers.registry import FAST_SOLVER, register_solver
 
@@ -62,20 +68,23 @@ def _fallback(qp: ContactQP, why: str, diagnostics: SolverDiagnostics,
 
 
 @register_solver(FAST_SOLVER, "primal-dual active set (semismooth Newton): condensed "
-                              "B K^-1 B' from one factorisation (pardiso, cholmod) or the "
-                              "augmented saddle-point system (splu); nested iteration")
+                              "B K^-1 B' from one factorisation (pardiso, cholmod), the "
+                              "augmented saddle-point system (splu) or projected CG with "
+                              "multigrid (amg); nested iteration")
 def solve_active_set(qp: ContactQP, warm_start: np.ndarray | None = None,
                      max_iter: int = 100, backend: str | None = None) -> QPSolution:
-    """``backend``: 'pardiso' or 'cholmod' (condensed iteration) or 'splu' (augmented
-    iteration, see ``augmented``); default: the fastest available, see ``backends``."""
+    """``backend``: 'pardiso' or 'cholmod' (condensed iteration), 'splu' (augmented
+    iteration, see ``augmented``) or 'amg' (projected CG, see ``projected``); default: the
+    fastest available, see ``backends``."""
     start = time.perf_counter()
     backend = check_backend(backend)
     if warm_start is not None and np.shape(warm_start) != (qp.m,):
         raise ValueError(f"warm_start has shape {np.shape(warm_start)}, not ({qp.m},)")
     if not condenses(backend):
         active = (np.asarray(warm_start) > 0) if warm_start is not None else \
-            initial_active_set(qp)
-        u, lam, iterations, status, reason, diagnostics = solve_augmented(qp, active, max_iter)
+            initial_active_set(qp, backend)
+        route = solve_projected if iterative(backend) else solve_augmented
+        u, lam, iterations, status, reason, diagnostics = route(qp, active, max_iter, backend)
         if status != STATUS_OK:
             return _fallback(qp, f"plain active set failed ({reason})", diagnostics, start)
         return QPSolution(u=u, multipliers=lam, status=status, reason=reason,

@@ -16,16 +16,17 @@ from scipy import sparse
 from scipy.sparse.linalg import LinearOperator, onenormest, splu
 
 from formulations.base import STATUS_FAILED, STATUS_OK, ContactQP, SolverDiagnostics
+from formulations.solvers.backends import factorise
 from formulations.solvers.lcp import SINGULAR
 
 VIOLATION_TOLERANCE = 1e-12  # relative to the displacement scale: round-off, not penetration
 
 
-def initial_active_set(qp: ContactQP) -> np.ndarray:
+def initial_active_set(qp: ContactQP, backend: str = "splu") -> np.ndarray:
     """{i : (B u0 - G)_i > 0} for the unconstrained u0 = K^-1 F (u0 = 0 when F = 0)."""
     if not np.any(qp.F):
         return -qp.G > 0
-    return qp.B @ splu(sparse.csc_matrix(qp.K)).solve(qp.F) - qp.G > 0
+    return qp.B @ factorise(qp.K, backend, qp.near_null)(qp.F) - qp.G > 0
 
 
 def condition_estimate(system: sparse.csc_matrix, lu) -> float:
@@ -45,7 +46,7 @@ def condition_estimate(system: sparse.csc_matrix, lu) -> float:
     return float(abs(system).sum(axis=0).max() * norm)
 
 
-def solve_augmented(qp: ContactQP, active: np.ndarray, max_iter: int):
+def solve_augmented(qp: ContactQP, active: np.ndarray, max_iter: int, backend: str = "splu"):
     """Returns (u, lambda, iterations, status, reason, diagnostics): the diagnostics hold the
     active-set changes of every iteration, whether a set repeated (``cycled``) and the
     condition estimate of the last (scaled) saddle-point matrix factorised."""

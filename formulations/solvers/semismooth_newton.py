@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy import linalg, sparse
@@ -42,6 +42,7 @@ from formulations.solvers.backends import (
     condenses,
     factorise,
     factorise_condensed,
+    iterative,
 )
 from formulations.solvers.registry import FAST_SOLVER, register_system_solver
 
@@ -80,6 +81,7 @@ class Linearised:
     argument: Callable[[np.ndarray], np.ndarray]
     step: Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, float]]
     scale: Callable[[np.ndarray], float]
+    krylov: list[int] = field(default_factory=list)  # iterations per step (iterative back-end)
 
 
 def dense_step(J: np.ndarray, rhs: np.ndarray) -> tuple[np.ndarray, float]:
@@ -161,18 +163,25 @@ def condensed_problem(G: np.ndarray, P0: np.ndarray) -> Linearised:
 
 def sparse_problem(system: SemismoothSystem, backend: str | None = None) -> Linearised:
     """Newton on u with the full sparse Jacobian K + T' D_A T, factorised once a step: by the
-    back-end ``backend`` (an SPD Jacobian: a system without S), else by SuperLU."""
+    back-end ``backend`` (an SPD Jacobian: a system without S; or an iterative back-end,
+    which takes any Jacobian), else by SuperLU. An iterative back-end's Krylov iterations of
+    every step are appended to ``krylov``."""
     T = system.T
+    krylov: list[int] = []
 
     def step(active, u):
         J = system_matrix(system, active)
         rhs = -(J @ u + T.T @ system.phi_affine(active)[1] - system.F)
         if backend is not None:
-            return factorise(J, backend)(rhs), float("nan")
+            solve = factorise(J, backend, system.near_null)
+            dx = solve(rhs)
+            krylov.extend(getattr(solve, "iterations", ()))
+            return dx, float("nan")
         return splu(J.tocsc()).solve(rhs), float("nan")
 
     return Linearised(system.residual, lambda u: system.pressure_argument(T @ u), step,
-                      lambda u: np.linalg.norm(system.F) + np.linalg.norm(system.K @ u))
+                      lambda u: np.linalg.norm(system.F) + np.linalg.norm(system.K @ u),
+                      krylov)
 
 
 def newton(problem: Linearised, x: np.ndarray, active: np.ndarray,
@@ -247,7 +256,8 @@ def solve_semismooth(system: SemismoothSystem, warm_start: np.ndarray | None = N
         problem, x = condensed_problem(reduced.G, P0), np.zeros(system.nq)
     else:  # SPD steps (no S) on the back-end itself, else SuperLU
         phases, x = [], np.zeros(system.n)
-        problem = sparse_problem(system, None if system.ns else backend)
+        problem = sparse_problem(system, None if system.ns and not iterative(backend)
+                                 else backend)
     active = (np.asarray(warm_start) > 0) if warm_start is not None else \
         problem.argument(x) < 0
     clock = time.perf_counter()
@@ -262,7 +272,8 @@ def solve_semismooth(system: SemismoothSystem, warm_start: np.ndarray | None = N
         phases.append(("back-substitute", time.perf_counter() - clock))
     diagnostics = SolverDiagnostics(active_set_changes=result.changes, cycled=result.cycled,
                                     safeguard=result.safeguard,
-                                    condition_estimate=result.condition, phases=tuple(phases))
+                                    condition_estimate=result.condition, phases=tuple(phases),
+                                    krylov_iterations=tuple(problem.krylov))
     return QPSolution(u=u if ok else None, multipliers=system.pressure(u) if ok else None,
                       status=result.status, reason=result.reason, iterations=result.iterations,
                       solve_time=time.perf_counter() - start, solver=FAST_SOLVER,

@@ -13,7 +13,11 @@ so B K^-1 B' = B_C S_C^-1 B_C' is a small dense matrix. A back-end is one module
 * ``cholmod`` (``cholmod.py``; optional scikit-sparse, needs SuiteSparse's headers): S_C as the
   trailing block of the Cholesky factor with C ordered last;
 * ``splu`` (``splu.py``; scipy's SuperLU, always there): no cheap S_C, so the active-set solver
-  factorises the augmented saddle-point system once per iteration (``augmented``).
+  factorises the augmented saddle-point system once per iteration (``augmented``);
+* ``amg`` (``amg.py``; PyAMG): no factorisation at all, Krylov iterations preconditioned by
+  smoothed-aggregation multigrid; the active-set solver runs its projected iteration
+  (``projected``). Never the default: chosen by name, or by the route choice when a level
+  does not fit a direct factorisation (``bench.sequence.memory``).
 
 The measured comparison that fixed this order is in docs/solvers.md.
 """
@@ -25,7 +29,7 @@ import os
 import numpy as np
 from scipy import sparse
 
-from formulations.solvers.backends import cholmod, pardiso, splu  # noqa: F401  (registers)
+from formulations.solvers.backends import amg, cholmod, pardiso, splu  # noqa: F401 (registers)
 from formulations.solvers.backends.base import (
     REGISTRY,
     Backend,
@@ -39,7 +43,7 @@ from formulations.solvers.backends.base import (
 
 __all__ = ["BACKENDS", "Backend", "BackendError", "CondensedFactor", "FactorisationError",
            "available_backends", "backend_names", "check_backend", "condenses",
-           "default_backend", "factorise", "factorise_condensed", "register_backend",
+           "default_backend", "factorise", "factorise_condensed", "iterative", "register_backend",
            "unregister_backend"]
 
 
@@ -78,10 +82,20 @@ def condenses(backend: str | None) -> bool:
     return REGISTRY.get(check_backend(backend)).condense is not None
 
 
-def factorise(K: sparse.spmatrix, backend: str | None = None) -> Solve:
+def iterative(backend: str | None) -> bool:
+    """Whether ``backend`` solves by iterations (``amg``) instead of a factorisation."""
+    return REGISTRY.get(check_backend(backend)).iterative
+
+
+def factorise(K: sparse.spmatrix, backend: str | None = None,
+              near_null: np.ndarray | None = None) -> Solve:
     """A plain factorisation of K: the linear-solve floor every contact solve is measured
-    against (same back-end, same ordering options as ``factorise_condensed``)."""
-    return REGISTRY.get(check_backend(backend)).factorise(sparse.csc_matrix(K))
+    against (same back-end, same ordering options as ``factorise_condensed``). An iterative
+    back-end builds its preconditioner instead, with the rigid-body modes ``near_null``."""
+    chosen = REGISTRY.get(check_backend(backend))
+    if chosen.iterative:
+        return chosen.factorise(sparse.csr_matrix(K), near_null)
+    return chosen.factorise(sparse.csc_matrix(K))
 
 
 def check_dense_block(size: int) -> None:

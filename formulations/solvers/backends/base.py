@@ -45,7 +45,9 @@ class Backend:
     when the back-end has no cheap Schur complement; ``rank``: the default is the available
     back-end of lowest rank; ``missing``: why it cannot be used here ('' when it can);
     ``memory_gib``: the measured peak memory of a whole P1 level on this route, (base GiB, GiB
-    per DOF) (bench.sequence.memory; None: not measured, the steepest measured line is used)."""
+    per DOF) (bench.sequence.memory; None: not measured, the steepest measured line is used);
+    ``iterative``: ``factorise(K, near_null)`` returns an iterative solve (no factorisation;
+    ``near_null``: K's rigid-body modes, or None)."""
 
     name: str
     rank: int
@@ -54,6 +56,7 @@ class Backend:
     missing: str = ""
     description: str = ""
     memory_gib: tuple[float, float] | None = None
+    iterative: bool = False
 
 
 REGISTRY = Registry("back-end")

@@ -1,0 +1,94 @@
+"""``amg``: Krylov iterations preconditioned by smoothed-aggregation algebraic multigrid
+(PyAMG), with the rigid-body modes as near-null space (docs/theory.md, section 14).
+
+No factorisation and no dense block: the memory is O(N) and a solve costs a bounded number of
+V-cycles on a mesh-independent hierarchy. ``factorise(K, near_null)`` builds the hierarchy once
+and returns a solve that runs conjugate gradients (symmetric K) or GMRES (a nonsymmetric
+Jacobian: Nitsche with theta != 1) to the relative residual ``RTOL``, from the last solution
+when asked (``IterativeSolve.start``). A solve that does not reach RTOL raises
+``FactorisationError`` with the residual reached: never an inaccurate answer passed on.
+
+There is no cheap Schur complement, so the active-set solver runs its projected iteration
+(``formulations.solvers.projected``) and the semismooth Newton its sparse steps on this
+back-end. Rigid-body modes come with the problem (``near_null``); without them the
+translations of each component are lost and PyAMG falls back to constants (slower, not wrong).
+"""
+
+from __future__ import annotations
+
+import importlib.util
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy import sparse
+from scipy.sparse.linalg import cg, gmres
+
+from formulations.solvers.backends.base import Backend, FactorisationError, register_backend
+
+# relative residual |b - K x| / |b| of every solve: the energy-norm difference to a direct
+# solve is then below 1e-9 relative on the suite's 2D and 3D P1-P3 problems (measured in
+# tests/formulations/test_amg.py, cond(K) to 1e7)
+RTOL = 1e-12
+MAX_ITERATIONS = 2000
+SYMMETRIC = 1e-12  # max |K - K'| / max |K| below which K is treated as symmetric (round-off)
+
+
+@dataclass(eq=False)
+class IterativeSolve:
+    """K^-1 b by preconditioned Krylov iterations; ``iterations`` counts each solve's."""
+
+    K: sparse.csr_matrix
+    preconditioner: object
+    symmetric: bool
+    iterations: list[int] = field(default_factory=list)
+
+    def __call__(self, b: np.ndarray, start: np.ndarray | None = None) -> np.ndarray:
+        b = np.asarray(b, dtype=float)
+        if b.ndim == 2:
+            return np.column_stack([self(column) for column in b.T])
+        norm = np.linalg.norm(b)
+        if norm == 0.0:
+            return np.zeros_like(b)
+        count = [0]
+
+        def tick(_):
+            count[0] += 1
+
+        method = cg if self.symmetric else gmres
+        extra = {} if self.symmetric else {"restart": 60, "callback_type": "pr_norm"}
+        x, info = method(self.K, b, x0=start, rtol=RTOL, atol=0.0, maxiter=MAX_ITERATIONS,
+                         M=self.preconditioner, callback=tick, **extra)
+        self.iterations.append(count[0])
+        residual = np.linalg.norm(b - self.K @ x) / norm
+        if info != 0 and residual > 10 * RTOL:
+            raise FactorisationError(f"amg: {'CG' if self.symmetric else 'GMRES'} reached "
+                                     f"a relative residual of {residual:.1e}, not {RTOL:.0e}, "
+                                     f"in {count[0]} iterations")
+        return x
+
+
+def is_symmetric(K: sparse.spmatrix) -> bool:
+    scale = abs(K).max()
+    return bool(scale == 0.0 or abs(K - K.T).max() <= SYMMETRIC * scale)
+
+
+def factorise(K: sparse.spmatrix, near_null: np.ndarray | None = None) -> IterativeSolve:
+    """The smoothed-aggregation hierarchy of K (``near_null``: its rigid-body modes, n x 3 in
+    2D or n x 6 in 3D) and the solve that uses it as preconditioner."""
+    import pyamg
+
+    K = sparse.csr_matrix(K)
+    symmetric = is_symmetric(K)
+    modes = None if near_null is None else np.ascontiguousarray(near_null, dtype=float)
+    hierarchy = pyamg.smoothed_aggregation_solver(
+        K, B=modes, symmetry="symmetric" if symmetric else "nonsymmetric",
+        strength=("symmetric", {"theta": 0.0}), max_coarse=500)
+    return IterativeSolve(K, hierarchy.aspreconditioner(cycle="V"), symmetric)
+
+
+register_backend(Backend(
+    "amg", rank=3, factorise=factorise, condense=None,
+    missing="" if importlib.util.find_spec("pyamg") else "pyamg is not installed",
+    description="conjugate gradients with smoothed-aggregation AMG (PyAMG), rigid-body "
+                "near-null space; no factorisation (the projected active-set iteration)",
+    iterative=True))

@@ -1,0 +1,108 @@
+"""The primal-dual active set iteration for an iterative back-end (``amg``): each active set's
+equality-constrained problem is solved by projected preconditioned conjugate gradients, with
+no factorisation of K and no dense block (docs/theory.md, section 14).
+
+For the active rows B_A the constrained minimiser of 1/2 u'Ku - F'u subject to B_A u = G_A is
+u = u_p + w with u_p = B_A' (B_A B_A')^-1 G_A and w in ker B_A. The orthogonal projection
+Pi = I - B_A' (B_A B_A')^-1 B_A onto ker B_A needs only the small sparse Gram matrix B_A B_A'
+(diagonal for the vi's nodal rows; banded for the mixed method's), factorised once per set.
+Conjugate gradients on ker B_A with the preconditioner Pi M^-1 Pi (M: the multigrid cycle of
+K) converge like the unconstrained CG (Gould, Hribar and Nocedal 2001). The multipliers are
+lambda_A = (B_A B_A')^-1 B_A (F - K u), the least-squares solution of K u + B_A' lambda_A = F.
+
+The active-set update is the augmented iteration's (``augmented``): keep the active rows with
+lambda_i > 0, add the inactive rows the new u violates; each set's CG starts from the last u.
+The iterative solve leaves multipliers exact to about the solve's relative residual, so a row
+whose multiplier is zero to that accuracy keeps its place (no flip-flop on weakly active rows).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy import sparse
+from scipy.sparse.linalg import splu
+
+from formulations.base import STATUS_FAILED, STATUS_OK, ContactQP, SolverDiagnostics
+from formulations.solvers.augmented import VIOLATION_TOLERANCE
+from formulations.solvers.backends import FactorisationError, factorise
+from formulations.solvers.backends.amg import MAX_ITERATIONS, RTOL
+from formulations.solvers.lcp import SINGULAR
+
+WEAKLY_ACTIVE = 1e-8  # |lambda_i| / max |lambda| below which a multiplier is zero (solve accuracy)
+
+
+def projection(B_A: sparse.csr_matrix):
+    """(Pi, particular) for the rows B_A: x -> Pi x, and G_A -> B_A' (B_A B_A')^-1 G_A."""
+    if B_A.shape[0] == 0:
+        return (lambda x: x), (lambda g: np.zeros(B_A.shape[1])), (lambda r: np.zeros(0))
+    gram = splu(sparse.csc_matrix(B_A @ B_A.T))
+
+    def project(x):
+        return x - B_A.T @ gram.solve(B_A @ x)
+
+    return project, (lambda g: B_A.T @ gram.solve(g)), (lambda r: gram.solve(B_A @ r))
+
+
+def projected_cg(K, precondition, project, F: np.ndarray, u: np.ndarray,
+                 counts: list[int]) -> np.ndarray:
+    """min 1/2 u'Ku - F'u on the affine set of ``u`` (u + ker B_A) by preconditioned CG."""
+    r = project(F - K @ u)
+    # |F| + |K u|: the scale of the balance, also when the load is the obstacle's (F = 0)
+    norm = np.linalg.norm(F) + np.linalg.norm(K @ u)
+    z = project(precondition(r))
+    p, rz = z.copy(), r @ z
+    for iteration in range(1, MAX_ITERATIONS + 1):
+        if np.linalg.norm(r) <= RTOL * norm:
+            counts.append(iteration - 1)
+            return u
+        Kp = K @ p
+        alpha = rz / (p @ Kp)
+        u = u + alpha * p
+        r = r - alpha * project(Kp)
+        z = project(precondition(r))
+        rz, rz_old = r @ z, rz
+        p = z + (rz / rz_old) * p
+    residual = np.linalg.norm(project(F - K @ u)) / norm
+    raise FactorisationError(f"amg: projected CG reached a relative residual of "
+                             f"{residual:.1e}, not {RTOL:.0e}, in {MAX_ITERATIONS} iterations")
+
+
+def solve_projected(qp: ContactQP, active: np.ndarray, max_iter: int, backend: str):
+    """(u, lambda, iterations, status, reason, diagnostics) as ``solve_augmented`` returns
+    them; the diagnostics hold the CG iterations of every active set."""
+    solve = factorise(qp.K, backend, qp.near_null)
+    K = sparse.csr_matrix(qp.K)
+    seen, changes, counts = set(), [], []
+    u, lam = np.zeros(qp.n), np.zeros(qp.m)
+    scale = max(qp.gap_scale, np.finfo(float).tiny)
+
+    def diagnostics(cycled):
+        return SolverDiagnostics(active_set_changes=tuple(changes), cycled=cycled,
+                                 krylov_iterations=tuple(counts))
+
+    for iteration in range(1, max_iter + 1):
+        if active.tobytes() in seen:
+            return (u, lam, iteration - 1, STATUS_FAILED, "active set cycles (a set repeated)",
+                    diagnostics(True))
+        seen.add(active.tobytes())
+        rows = np.flatnonzero(active)
+        B_A = qp.B[rows]
+        try:
+            project, particular, multipliers = projection(B_A)
+        except RuntimeError:  # dependent active rows: B_A B_A' singular
+            return u, lam, iteration, STATUS_FAILED, SINGULAR, diagnostics(False)
+        u = project(u) + particular(qp.G[rows])  # the last u, moved onto the new set
+        u = projected_cg(K, solve.preconditioner.matvec, project, qp.F, u, counts)
+        lam = np.zeros(qp.m)
+        lam[rows] = multipliers(qp.F - K @ u)
+        slack = qp.G - qp.B @ u
+        scale = max(np.abs(u).max(initial=0.0), qp.gap_scale, np.finfo(float).tiny)
+        zero = WEAKLY_ACTIVE * np.abs(lam).max(initial=0.0)
+        new_active = np.where(active, lam > -zero, slack < -VIOLATION_TOLERANCE * scale)
+        changes.append(int((new_active != active).sum()))
+        if changes[-1] == 0:
+            lam[rows] = np.maximum(lam[rows], 0.0)  # the zero-to-accuracy ones: exactly zero
+            return u, lam, iteration, STATUS_OK, "", diagnostics(False)
+        active = new_active
+    return (u, lam, max_iter, STATUS_FAILED,
+            f"active set still changing after {max_iter} iterations", diagnostics(False))
