@@ -110,7 +110,7 @@ def time_linear_and_fast(disc, backend: str, row: dict):
     from formulations.solvers.backends import factorise
 
     start = time.perf_counter()
-    factorise(disc.qp.K, backend)(linear_rhs(disc.qp))
+    factorise(disc.qp.K, backend, disc.qp.near_null)(linear_rhs(disc.qp))
     row["t_linear_solve"] = time.perf_counter() - start
     fast = solve(disc, FAST_SOLVER, backend=backend)
     row.update(t_fast_solve=fast.solve_time, fast_iterations=fast.iterations,

@@ -59,7 +59,7 @@ def measure_sequence(strategy: str, max_dofs: int, backend: str | None = None,
     frame = pd.DataFrame([vars(row) for row in rows])
     K = last.solution.elasticity.K_free
     clock = time.perf_counter()
-    factorise(K, backend)(np.ones(K.shape[0]))
+    factorise(K, backend, last.solution.elasticity.rigid_modes)(np.ones(K.shape[0]))
     t_linear = time.perf_counter() - clock
     out = {"strategy": strategy, "cell": cell, "max_dofs": max_dofs, "backend": backend,
            "levels": len(rows), "final_ndofs": int(frame["ndofs"].iloc[-1]),

@@ -17,7 +17,7 @@ from bench.sequence.columns import (
     solver_columns,
 )
 from bench.sequence.marking import MARKINGS, check_marking, grade_contact_trace, mark
-from bench.sequence.memory import available_gib, predict_peak_gib, route
+from bench.sequence.memory import MemoryRoute, available_gib, memory_route
 from bench.sequence.options import option
 from bench.sequence.rows import ResultRow, identity_columns
 from estimators.base import estimator_on
@@ -163,17 +163,20 @@ def target_reason(config: LoopConfig, est) -> str | None:
     return f"target reached: guaranteed eta={est.eta:.4g} <= {config.target_error:g}"
 
 
+def level_memory(level: int, ndofs: int, solver: str, config: LoopConfig,
+                 dim: int = 2) -> MemoryRoute:
+    """The memory route of a level (``bench.sequence.memory.memory_route``) within
+    ``config.max_memory_gib``, or the memory available now."""
+    backend = check_backend(config.options().get("backend"))
+    limit = config.max_memory_gib if config.max_memory_gib is not None else available_gib()
+    return memory_route(level, ndofs, solver, backend, limit, config.order, dim)
+
+
 def memory_refusal(level: int, ndofs: int, solver: str, config: LoopConfig,
                    dim: int = 2) -> str | None:
     """Why a level of ``ndofs`` unknowns must not be built (its predicted peak memory does not
-    fit), or None."""
-    backend = check_backend(config.options().get("backend"))
-    need = predict_peak_gib(ndofs, solver, backend, config.order, dim)
-    limit = config.max_memory_gib if config.max_memory_gib is not None else available_gib()
-    if need <= limit:
-        return None
-    return (f"memory: level {level} needs ~{need:.2f} GiB ({ndofs} DOFs, "
-            f"{route(solver, backend)}), {limit:.2f} available")
+    fit on any back-end), or None."""
+    return level_memory(level, ndofs, solver, config, dim).refusal
 
 
 def level_refusal(level: int, ndofs: int, solver: str, config: LoopConfig,
@@ -222,6 +225,9 @@ def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
         disc = discretise(scene, mesh)
         t_assemble = time.perf_counter() - start
         options = config.options()
+        rerouted = level_memory(level, ndofs, solver, config, scene.dim)
+        if rerouted.backend is not None:
+            options["backend"] = rerouted.backend
         if config.nested and previous is not None and previous.ok:
             options["warm_start"] = disc.warm_start(previous, solver)  # nested iteration
         sol = previous = solve(disc, solver, **options)
@@ -234,7 +240,7 @@ def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
                        **(solver_columns(sol.diagnostics) if failed else {}))
         if not failed:
             numbers.update(diagnostic_columns(disc, sol, config.diagnostics,
-                                              config.options().get("backend")))
+                                              options.get("backend")))
             numbers.update(eta=est.eta, eta_0=est.eta_0, eta_geometric=est.eta_geometric,
                            eta_complementarity=est.eta_complementarity,
                            **(est.bound.columns() if est.bound is not None else {}))
@@ -243,8 +249,8 @@ def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
             if solver != REFERENCE_SOLVER and disc.ndofs <= crosscheck_dofs:
                 numbers.update(crosscheck_columns(disc, sol))
         reached = None if failed else target_reason(config, est)
-        if reached:
-            numbers["reason"] = "; ".join(filter(None, (numbers["reason"], reached)))
+        numbers["reason"] = "; ".join(filter(None, (numbers["reason"], rerouted.note,
+                                                    reached)))
         yield LevelResult(ResultRow(**ident, **numbers), sol, est)
         if failed:
             return "failed"

@@ -12,6 +12,10 @@ meshes) on the 2-core reference machine. ``reference`` (Clarabel), running after
 route in the same process, never raised the peak at 1e5 or 1e6, so the cholmod line
 (REFERENCE_BOUND) bounds it. A back-end without a line gets the steepest measured one.
 
+Iterative back-ends (``amg``) factorise nothing: their memory is linear in N in 3D as in 2D,
+and a level whose direct factorisation would not fit is solved by the first iterative back-end
+that does (``iterative_route``; the row's reason says so) instead of refused.
+
 Formulations differ by a few slack unknowns per contact point, which the model ignores.
 
 Higher order: a P_p DOF couples to more DOFs (stiffness nonzeros per row 12 / 22 / 33 for
@@ -70,12 +74,62 @@ def predict_peak_gib(ndofs: int, solver: str, backend: str, order: int = 1,
                      dim: int = 2) -> float:
     """The predicted peak memory of a level with ``ndofs`` unknowns of order ``order`` (GiB);
     a back-end without a measured line gets the steepest one (a bound, not a fit). In 3D the
-    per-DOF slope grows like N^(1/3) (a 3D factor's fill), from DIM3_FACTOR at DIM3_AT DOFs."""
-    line = memory_line(route(solver, backend))
+    per-DOF slope grows like N^(1/3) (a 3D factor's fill), from DIM3_FACTOR at DIM3_AT DOFs;
+    a back-end with a measured 3D line (``Backend.memory_gib_3d``: no factor, no fill) uses
+    that line instead."""
+    name = route(solver, backend)
+    if dim == 3 and name in BACKENDS.names() and BACKENDS.get(name).memory_gib_3d:
+        base, per_dof = BACKENDS.get(name).memory_gib_3d
+        return base + ORDER_FACTOR[order] * per_dof * ndofs
+    line = memory_line(name)
     per_dof = ORDER_FACTOR[order] * line.per_dof_gib
     if dim == 3:
         per_dof *= DIM3_FACTOR * max(ndofs / DIM3_AT, 1.0) ** (1 / 3)
     return line.base_gib + per_dof * ndofs
+
+
+@dataclass(frozen=True)
+class MemoryRoute:
+    """How a level's predicted peak memory is met: ``backend``, an iterative back-end that
+    replaces the configured one (None: no change), with ``note`` for the row's reason; or
+    ``refusal``, why the level must not be built (None: it fits)."""
+
+    backend: str | None = None
+    note: str = ""
+    refusal: str | None = None
+
+
+def memory_route(level: int, ndofs: int, solver: str, backend: str, limit_gib: float,
+                 order: int = 1, dim: int = 2) -> MemoryRoute:
+    """The route of a level of ``ndofs`` unknowns: as configured if it fits in ``limit_gib``,
+    else on an iterative back-end that fits, else refused."""
+    need = predict_peak_gib(ndofs, solver, backend, order, dim)
+    if need <= limit_gib:
+        return MemoryRoute()
+    why = (f"level {level} needs ~{need:.2f} GiB ({ndofs} DOFs, {route(solver, backend)}), "
+           f"{limit_gib:.2f} available")
+    instead = iterative_route(ndofs, solver, backend, limit_gib, order, dim)
+    if instead is not None:
+        return MemoryRoute(instead, f"memory: {why}; solved by {instead} instead")
+    return MemoryRoute(refusal=f"memory: {why}")
+
+
+def iterative_route(ndofs: int, solver: str, backend: str, limit_gib: float, order: int = 1,
+                    dim: int = 2) -> str | None:
+    """The iterative back-end (``Backend.iterative``) of lowest rank that fits in
+    ``limit_gib`` where ``backend`` does not, for the fast solver (the reference uses no
+    back-end); None if ``backend`` fits or none does."""
+    if solver == REFERENCE_SOLVER:
+        return None
+    if predict_peak_gib(ndofs, solver, backend, order, dim) <= limit_gib:
+        return None
+    candidates = sorted((BACKENDS.get(name) for name in BACKENDS.names()),
+                        key=lambda b: b.rank)
+    for candidate in candidates:
+        if candidate.iterative and not candidate.missing and candidate.name != backend and \
+                predict_peak_gib(ndofs, solver, candidate.name, order, dim) <= limit_gib:
+            return candidate.name
+    return None
 
 
 def available_gib(meminfo: str | Path = "/proc/meminfo") -> float:

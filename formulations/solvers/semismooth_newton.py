@@ -55,6 +55,8 @@ REFINED = 1e-11
 # steps each): condensed 0.77 / 2.88 / 6.92 / 22.9 s against sparse 1.14 / 1.99 / 3.73 /
 # 8.29 s at nq = 1068 / 1810 / 2556 / 4262 (86k to 504k DOFs)
 SPARSE_NEWTON_FROM = 1500
+# an iterative back-end's relative residual while the active set changes (``projected``)
+SEARCH_RTOL = 1e-4
 MERIT_TOLERANCE = 1e-13  # |R| relative to |z0| + |M phi| at which the damped phase stops
 ARMIJO = 1e-4
 
@@ -82,6 +84,8 @@ class Linearised:
     step: Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, float]]
     scale: Callable[[np.ndarray], float]
     krylov: list[int] = field(default_factory=list)  # iterations per step (iterative back-end)
+    # switch inexact steps to exact ones; True if they were inexact (the iteration goes on)
+    tighten: Callable[[], bool] = lambda: False
 
 
 def dense_step(J: np.ndarray, rhs: np.ndarray) -> tuple[np.ndarray, float]:
@@ -168,20 +172,28 @@ def sparse_problem(system: SemismoothSystem, backend: str | None = None) -> Line
     every step are appended to ``krylov``."""
     T = system.T
     krylov: list[int] = []
+    rtol = [SEARCH_RTOL if iterative(backend) else 0.0]  # an iterative back-end's, per step
+
+    def tighten() -> bool:
+        """Solve to the back-end's own tolerance from now on; True if it was looser."""
+        looser, rtol[0] = rtol[0] == SEARCH_RTOL, None
+        return looser
 
     def step(active, u):
         J = system_matrix(system, active)
         rhs = -(J @ u + T.T @ system.phi_affine(active)[1] - system.F)
-        if backend is not None:
+        if backend is not None and iterative(backend):
             solve = factorise(J, backend, system.near_null)
-            dx = solve(rhs)
-            krylov.extend(getattr(solve, "iterations", ()))
+            dx = solve(rhs, rtol=rtol[0])
+            krylov.extend(solve.iterations)
             return dx, float("nan")
+        if backend is not None:
+            return factorise(J, backend)(rhs), float("nan")
         return splu(J.tocsc()).solve(rhs), float("nan")
 
     return Linearised(system.residual, lambda u: system.pressure_argument(T @ u), step,
                       lambda u: np.linalg.norm(system.F) + np.linalg.norm(system.K @ u),
-                      krylov)
+                      krylov, tighten)
 
 
 def newton(problem: Linearised, x: np.ndarray, active: np.ndarray,
@@ -197,6 +209,9 @@ def newton(problem: Linearised, x: np.ndarray, active: np.ndarray,
         x = x + dx
         new = problem.argument(x) < 0
         changes.append(int((new != active).sum()))
+        if changes[-1] == 0 and problem.tighten():  # settled inexactly: now solve exactly
+            seen = {active.tobytes()}
+            continue
         if changes[-1] == 0:
             return NewtonResult(x, STATUS_OK, "", iteration, tuple(changes), False, "",
                                 condition)

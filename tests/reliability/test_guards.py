@@ -12,6 +12,7 @@ import pandas as pd
 import pytest
 
 import bench.sequence.loop as loop_module
+import bench.sequence.memory as memory_module
 from bench.cli import main
 from bench.matrix.artifacts import file_stem
 from bench.matrix.store import partition_table
@@ -53,6 +54,7 @@ def test_no_level_over_the_dof_budget_is_assembled(monkeypatch, strategy):
 
 def test_a_level_that_would_not_fit_in_memory_is_refused_before_it_is_built(monkeypatch):
     sizes = assembled_sizes(monkeypatch)
+    monkeypatch.setattr(memory_module, "iterative_route", lambda *args: None)  # none fits
     limit = predict_peak_gib(2112, "active-set", backends.check_backend(None)) * 1.01
     rows = [r.row for r in run_sequence(
         get_scene("paper"), "mixed", "active-set", "residual",
@@ -61,6 +63,25 @@ def test_a_level_that_would_not_fit_in_memory_is_refused_before_it_is_built(monk
     assert [r.status for r in rows[:-1]] == ["ok"] * 4 and rows[-2].ndofs == 2112
     assert last.status == "failed" and last.ndofs == 8320 and 8320 not in sizes
     assert last.reason.startswith("memory: level 4 needs ~") and "available" in last.reason
+
+
+@pytest.mark.skipif("amg" not in backends.available_backends(), reason="pyamg missing")
+def test_a_level_too_large_for_a_factorisation_is_solved_by_the_iterative_back_end(
+        monkeypatch):
+    direct = backends.check_backend(None)
+
+    def predicted(ndofs, solver, backend, order=1, dim=2):  # only level 4 is too large
+        return 100.0 if ndofs > 2112 and not backends.iterative(backend) else 0.1
+    monkeypatch.setattr(memory_module, "predict_peak_gib", predicted)
+    rows = [r.row for r in run_sequence(
+        get_scene("paper"), "mixed", "active-set", "residual",
+        LoopConfig(strategy="uniform", max_dofs=8400, max_memory_gib=1.0))]
+    assert [r.status for r in rows] == ["ok"] * 5 and rows[-1].ndofs == 8320
+    assert [r.backend for r in rows] == [direct] * 4 + ["amg"]
+    assert rows[-1].reason == (f"memory: level 4 needs ~100.00 GiB (8320 DOFs, {direct}), "
+                               "1.00 available; solved by amg instead")
+    # the reference uses no back-end: it is refused, not rerouted
+    assert memory_module.memory_route(4, 8320, "reference", direct, 1.0).refusal
 
 
 def test_memory_model_matches_the_scaling_table_within_1_5():

@@ -47,7 +47,8 @@ class Backend:
     ``memory_gib``: the measured peak memory of a whole P1 level on this route, (base GiB, GiB
     per DOF) (bench.sequence.memory; None: not measured, the steepest measured line is used);
     ``iterative``: ``factorise(K, near_null)`` returns an iterative solve (no factorisation;
-    ``near_null``: K's rigid-body modes, or None)."""
+    ``near_null``: K's rigid-body modes, or None); ``memory_gib_3d``: the measured 3D line of a
+    back-end whose memory stays linear in N (no fill), else None."""
 
     name: str
     rank: int
@@ -57,6 +58,7 @@ class Backend:
     description: str = ""
     memory_gib: tuple[float, float] | None = None
     iterative: bool = False
+    memory_gib_3d: tuple[float, float] | None = None  # a measured 3D line (bench.sequence.memory)
 
 
 REGISTRY = Registry("back-end")
