@@ -65,7 +65,8 @@ class LoopSettings:
     # available minus a margin (bench.sequence.memory)
     max_memory_gib: float | None = option(
         None, "refuse (status failed) a level whose predicted peak memory exceeds this many "
-        "GiB, before building it", flag="max-memory", kind="gib", section="where",
+        "GiB, before building it; a level only a factorisation would not fit is solved by "
+        "an iterative back-end (amg) instead", flag="max-memory", kind="gib", section="where",
         metavar="GIB", default_text="the memory the machine has available, minus 10 % and "
         "at least 1 GiB")
 
