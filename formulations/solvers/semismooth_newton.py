@@ -21,29 +21,33 @@ When it revisits an active set or reaches ``max_iter``, it continues from the it
 smallest |R| as a damped Newton method with Armijo backtracking on the merit |R|^2 (the
 ``safeguard`` diagnostic says so); if that fails too, the status is ``failed`` with the reason.
 Back-ends without a Schur complement (splu) run the same iteration on u with the full sparse
-Jacobian K + T' D_A T, factorised once per iteration.
+Jacobian K + T' D_A T, factorised once per iteration; so does every back-end beyond
+SPARSE_NEWTON_FROM points when that Jacobian is SPD (a penalty; theta = 1), where the dense
+nq x nq block would cost O(nq^3) (``newton_route``); an iterative back-end (amg) always does.
 """
 
 from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 from scipy import linalg, sparse
 from scipy.linalg.lapack import dgecon
 from scipy.sparse.linalg import splu
 
-from formulations.base import STATUS_FAILED, STATUS_OK, QPSolution, SolverDiagnostics
+from formulations.base import STATUS_OK, QPSolution, SolverDiagnostics
 from formulations.semismooth import SemismoothSystem
 from formulations.solvers.backends import (
+    FactorisationError,
     check_backend,
     condenses,
     factorise,
     factorise_condensed,
     iterative,
 )
+from formulations.solvers.newton import Linearised, newton
 from formulations.solvers.registry import FAST_SOLVER, register_system_solver
 
 # relative nonlinear residual at which iterative refinement stops (one step reaches 1e-13 ..
@@ -57,35 +61,7 @@ REFINED = 1e-11
 SPARSE_NEWTON_FROM = 1500
 # an iterative back-end's relative residual while the active set changes (``projected``)
 SEARCH_RTOL = 1e-4
-MERIT_TOLERANCE = 1e-13  # |R| relative to |z0| + |M phi| at which the damped phase stops
-ARMIJO = 1e-4
 
-
-@dataclass(frozen=True)
-class NewtonResult:
-    x: np.ndarray
-    status: str
-    reason: str
-    iterations: int
-    changes: tuple[int, ...]
-    cycled: bool
-    safeguard: str
-    condition: float
-
-
-@dataclass(frozen=True, eq=False)
-class Linearised:
-    """The problem in the unknown x (z condensed, or u): R(x), P(x), and ``step(A, x)``: the
-    Newton step -J_A^-1 R_A(x) of the affine equation R_A for the active set A (phi with A
-    fixed; R_A = R where A is x's own active set), with the 1-norm condition estimate of J_A."""
-
-    residual: Callable[[np.ndarray], np.ndarray]
-    argument: Callable[[np.ndarray], np.ndarray]
-    step: Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, float]]
-    scale: Callable[[np.ndarray], float]
-    krylov: list[int] = field(default_factory=list)  # iterations per step (iterative back-end)
-    # switch inexact steps to exact ones; True if they were inexact (the iteration goes on)
-    tighten: Callable[[], bool] = lambda: False
 
 
 def dense_step(J: np.ndarray, rhs: np.ndarray) -> tuple[np.ndarray, float]:
@@ -196,60 +172,6 @@ def sparse_problem(system: SemismoothSystem, backend: str | None = None) -> Line
                       krylov, tighten)
 
 
-def newton(problem: Linearised, x: np.ndarray, active: np.ndarray,
-           max_iter: int) -> NewtonResult:
-    """The plain iteration from ``x`` with the first step's active set ``active``, then the
-    damped safeguard (module docstring)."""
-    changes, seen, condition = [], {active.tobytes()}, float("nan")
-    best = (np.inf, x)
-    for iteration in range(1, max_iter + 1):
-        r = problem.residual(x)
-        best = min(best, (np.linalg.norm(r), x), key=lambda b: b[0])
-        dx, condition = problem.step(active, x)
-        x = x + dx
-        new = problem.argument(x) < 0
-        changes.append(int((new != active).sum()))
-        if changes[-1] == 0 and problem.tighten():  # settled inexactly: now solve exactly
-            seen = {active.tobytes()}
-            continue
-        if changes[-1] == 0:
-            return NewtonResult(x, STATUS_OK, "", iteration, tuple(changes), False, "",
-                                condition)
-        if new.tobytes() in seen:
-            return damped(problem, best[1], iteration, tuple(changes), True,
-                          "plain semismooth Newton revisited an active set")
-        seen.add(new.tobytes())
-        active = new
-    return damped(problem, best[1], max_iter, tuple(changes), False,
-                  f"plain semismooth Newton did not settle in {max_iter} iterations")
-
-
-def damped(problem: Linearised, x: np.ndarray, done: int, changes: tuple[int, ...],
-           cycled: bool, why: str, max_iter: int = 200) -> NewtonResult:
-    """Newton with Armijo backtracking on |R|^2 from ``x``."""
-    r = problem.residual(x)
-    condition = float("nan")
-    for iteration in range(1, max_iter + 1):
-        if np.linalg.norm(r) <= MERIT_TOLERANCE * problem.scale(x):
-            return NewtonResult(x, STATUS_OK, f"{why}; answered by damped Newton (safeguard)",
-                                done + iteration, changes, cycled, "damped Newton", condition)
-        active = problem.argument(x) < 0
-        dx, condition = problem.step(active, x)
-        t, norm = 1.0, np.linalg.norm(r)
-        while True:
-            trial = problem.residual(x + t * dx)
-            if np.linalg.norm(trial) <= (1.0 - ARMIJO * t) * norm or t < 1e-12:
-                break
-            t *= 0.5
-        if t < 1e-12:
-            break
-        x, r = x + t * dx, trial
-        changes += (int(((problem.argument(x) < 0) != active).sum()),)
-    return NewtonResult(x, STATUS_FAILED, f"{why}; damped Newton stalled at |R| = "
-                        f"{np.linalg.norm(r):.2e}", done + max_iter, changes, cycled,
-                        "damped Newton", condition)
-
-
 @register_system_solver(FAST_SOLVER, "semismooth Newton (primal-dual active set) on the "
                                       "contact values, condensed from one factorisation")
 def solve_semismooth(system: SemismoothSystem, warm_start: np.ndarray | None = None,
@@ -259,8 +181,45 @@ def solve_semismooth(system: SemismoothSystem, warm_start: np.ndarray | None = N
     backend = check_backend(backend)
     if warm_start is not None and np.shape(warm_start) != (system.nq,):
         raise ValueError(f"warm_start has shape {np.shape(warm_start)}, not ({system.nq},)")
+    condensed, steps_on = newton_route(system, backend)
+    try:
+        u, result, phases, krylov = run_newton(system, warm_start, max_iter, backend,
+                                               condensed, steps_on)
+    except FactorisationError:  # a Jacobian with S that is not positive definite
+        if condensed or not system.ns or iterative(backend) or not condenses(backend):
+            raise
+        u, result, phases, krylov = run_newton(system, warm_start, max_iter, backend, True,
+                                               None)
+    ok = result.status == STATUS_OK
+    diagnostics = SolverDiagnostics(active_set_changes=result.changes, cycled=result.cycled,
+                                    safeguard=result.safeguard,
+                                    condition_estimate=result.condition, phases=tuple(phases),
+                                    krylov_iterations=tuple(krylov))
+    return QPSolution(u=u if ok else None, multipliers=system.pressure(u) if ok else None,
+                      status=result.status, reason=result.reason, iterations=result.iterations,
+                      solve_time=time.perf_counter() - start, solver=FAST_SOLVER,
+                      backend=backend, diagnostics=diagnostics)
+
+
+def newton_route(system: SemismoothSystem, backend: str) -> tuple[bool, str | None]:
+    """(condensed, the back-end of the sparse steps; None: SuperLU). Condensed while the dense
+    nq x nq block is cheap (nq <= SPARSE_NEWTON_FROM); beyond, sparse steps on the back-end when
+    the Jacobian is SPD: no S (a penalty), or theta = 1 (symmetric, positive definite for a
+    stable gamma_0; if the factorisation finds it is not, the condensed route answers). An
+    iterative back-end always takes sparse steps; splu takes them with SuperLU."""
+    if iterative(backend):
+        return False, backend
+    if not condenses(backend):
+        return False, None if system.ns else backend
+    if system.nq <= SPARSE_NEWTON_FROM or (system.ns and system.theta != 1.0):
+        return True, None
+    return False, backend
+
+
+def run_newton(system: SemismoothSystem, warm_start, max_iter: int, backend: str,
+               condensed: bool, steps_on: str | None):
+    """(u, NewtonResult, phases, Krylov iterations) on the route ``newton_route`` chose."""
     T = system.T
-    condensed = condenses(backend) and (system.ns or system.nq <= SPARSE_NEWTON_FROM)
     if condensed:
         factor = factorise_condensed(system.K, np.unique(T.indices), backend)
         clock = time.perf_counter()
@@ -269,30 +228,21 @@ def solve_semismooth(system: SemismoothSystem, warm_start: np.ndarray | None = N
         P0, s_free = reduced.free(T @ u0, system.gap)
         phases = [*factor.phases, ("condense", time.perf_counter() - clock)]
         problem, x = condensed_problem(reduced.G, P0), np.zeros(system.nq)
-    else:  # SPD steps (no S) on the back-end itself, else SuperLU
+    else:
         phases, x = [], np.zeros(system.n)
-        problem = sparse_problem(system, None if system.ns and not iterative(backend)
-                                 else backend)
+        problem = sparse_problem(system, steps_on)
     active = (np.asarray(warm_start) > 0) if warm_start is not None else \
         problem.argument(x) < 0
     clock = time.perf_counter()
     result = newton(problem, x, active, max_iter)
     phases.append(("iterate", time.perf_counter() - clock))
     u = result.x
-    ok = result.status == STATUS_OK
-    if ok and condensed:
+    if result.status == STATUS_OK and condensed:
         clock = time.perf_counter()
         u = refine(system, factor.solve, reduced,
                    u0 - factor.solve(T.T @ reduced.phi(s_free, result.x)))
         phases.append(("back-substitute", time.perf_counter() - clock))
-    diagnostics = SolverDiagnostics(active_set_changes=result.changes, cycled=result.cycled,
-                                    safeguard=result.safeguard,
-                                    condition_estimate=result.condition, phases=tuple(phases),
-                                    krylov_iterations=tuple(problem.krylov))
-    return QPSolution(u=u if ok else None, multipliers=system.pressure(u) if ok else None,
-                      status=result.status, reason=result.reason, iterations=result.iterations,
-                      solve_time=time.perf_counter() - start, solver=FAST_SOLVER,
-                      backend=backend, diagnostics=diagnostics)
+    return u, result, phases, problem.krylov
 
 
 def refine(system: SemismoothSystem, solve: Callable, reduced: ReducedPressure, u: np.ndarray,

@@ -97,7 +97,6 @@ register_backend(Backend(
                 "near-null space; no factorisation (the projected active-set iteration)",
     iterative=True,
     # bench scaling --backend amg: peak of a whole level (assembly, solve, estimator) 0.46 /
-    # 2.73 GiB at 100 800 / 992 640 DOFs (2D, mixed) and 1.30 / 6.10 GiB at 104 544 / 545 832
-    # DOFs (3D, vi), the lines through them; in 3D the solver's share is small: pardiso's
-    # level peaks at 1.31 GiB at 104 544 DOFs too
-    memory_gib=(0.2034, 2.545e-6), memory_gib_3d=(0.1629, 1.0877e-5)))
+    # 2.73 GiB at 100 800 / 992 640 DOFs (2D, mixed) and 0.93 / 3.88 GiB at 104 544 / 545 832
+    # DOFs (3D, vi; reports/amg/scaling-3d.md), the lines through them
+    memory_gib=(0.2034, 2.545e-6), memory_gib_3d=(0.2313, 6.685e-6)))
