@@ -28,7 +28,8 @@ def energy_difference(discretisation, a, b) -> float:
 
 @pytest.mark.parametrize("scene,refine,order,formulation", [
     ("paper", 3, 1, "vi"), ("paper", 3, 1, "mixed"), ("paper", 3, 1, "penalty"),
-    ("paper", 3, 1, "nitsche"), ("paper", 2, 2, "vi"), ("hertz", 2, 3, "nitsche"),
+    ("paper", 3, 1, "nitsche"), ("paper", 2, 2, "vi"),
+    pytest.param("hertz", 2, 3, "nitsche", marks=pytest.mark.slow),
     ("paper-3d", 0, 1, "vi"), ("paper-3d", 0, 1, "nitsche"), ("paper-3d", 1, 1, "mixed")])
 def test_the_contact_solve_agrees_with_the_direct_one(scene, refine, order, formulation):
     scene = get_scene(scene)
@@ -74,3 +75,18 @@ def test_a_solve_that_does_not_converge_raises_with_the_residual(monkeypatch):
     with pytest.raises(FactorisationError, match=r"amg: CG reached a relative residual of "
                                                  r"\S+, not 1e-10, in 2 iterations"):
         solve_k(qp.K @ np.ones(qp.n))
+
+
+@pytest.mark.slow
+def test_cg_iterations_barely_grow_with_the_mesh():
+    """Rigid-body modes make the V-cycle mesh-independent: measured 14 / 20 / 25 / 30 CG
+    iterations to 1e-10 at 1 944 / 13 872 / 104 544 / 811 200 P1 DOFs on paper-3d; without
+    them 107 at 13 872 already. 1.5 x over one refinement allows for that slow growth."""
+    scene = get_scene("paper-3d")
+    counts = []
+    for refine in (2, 3):
+        qp = get_formulation("vi")(scene, scene.mesh.refined(refine)).qp
+        solve_k = backends.factorise(qp.K, "amg", qp.near_null)
+        solve_k(qp.K @ np.random.default_rng(0).standard_normal(qp.n))
+        counts += solve_k.iterations
+    assert counts[1] <= 1.5 * counts[0], counts
