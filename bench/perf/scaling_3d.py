@@ -85,6 +85,7 @@ def markdown_table_3d(frame: pd.DataFrame) -> str:
         "fast contact solve [s]": frame["t_fast_solve"].map("{:.2f}".format),
         "fast / linear": frame["fast_over_linear"].map("{:.2f}".format),
         "iterations": frame["fast_iterations"],
+        "Krylov iterations (linear / contact)": krylov_column(frame),
         "estimator [s]": frame["t_estimate"].map("{:.2f}".format),
         "peak memory [GiB]": frame["peak_gib"].map("{:.2f}".format),
         "memory model [GiB]": pd.Series(expected_peak_gib(frame)).map("{:.2f}".format),
@@ -92,6 +93,17 @@ def markdown_table_3d(frame: pd.DataFrame) -> str:
     backend = ", ".join(sorted(set(frame["backend"])))
     return (f"paper-3d, vi, uniform tetrahedral meshes. Back-end: {backend}. Machine: "
             f"{machine_line()}.\n\n" + table.to_markdown(index=False))
+
+
+def krylov_column(frame: pd.DataFrame) -> pd.Series:
+    """'linear / contact' Krylov iterations on an iterative back-end; '' for a factorisation
+    (and for tables measured before the columns existed)."""
+    if "fast_krylov_iterations" not in frame:
+        return pd.Series([""] * len(frame), index=frame.index)
+    pairs = zip(frame["linear_krylov_iterations"], frame["fast_krylov_iterations"],
+                strict=True)
+    return pd.Series([f"{int(a)} / {int(b)}" if b else "" for a, b in pairs],
+                     index=frame.index)
 
 
 def write_scaling_3d(frame: pd.DataFrame, out: str | Path, readme: str | Path | None = None):

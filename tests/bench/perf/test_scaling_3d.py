@@ -6,6 +6,7 @@ import pytest
 
 from bench.perf.scaling_3d import SIZES_3D, measure_3d, paper_3d_problem, write_scaling_3d
 from formulations.elasticity import count_free_dofs
+from formulations.solvers.backends import available_backends
 
 
 def test_sizes_give_the_dof_counts_they_name():
@@ -31,3 +32,14 @@ def test_one_3d_size_is_measured_and_written(tmp_path):
     text = write_scaling_3d(frame, tmp_path, readme).read_text()
     assert "paper-3d, vi" in text and "memory model [GiB]" in text
     assert "old" not in readme.read_text() and str(row["ndofs"]) in readme.read_text()
+
+
+@pytest.mark.skipif("amg" not in available_backends(), reason="pyamg is not installed")
+def test_an_iterative_back_end_reports_its_krylov_iterations(tmp_path):
+    row = measure_3d("1e4", backend="amg")
+    assert row["fast_status"] == "ok" and row["backend"] == "amg"
+    assert row["linear_krylov_iterations"] > 0 and row["fast_krylov_iterations"] > 0
+    frame = pd.DataFrame([row])
+    frame["fast_over_linear"] = frame["t_fast_solve"] / frame["t_linear_solve"]
+    text = write_scaling_3d(frame, tmp_path).read_text()
+    assert f"{row['linear_krylov_iterations']} / {row['fast_krylov_iterations']}" in text
