@@ -34,6 +34,7 @@ def test_one_3d_size_is_measured_and_written(tmp_path):
     assert "old" not in readme.read_text() and str(row["ndofs"]) in readme.read_text()
 
 
+@pytest.mark.slow
 @pytest.mark.skipif("amg" not in available_backends(), reason="pyamg is not installed")
 def test_an_iterative_back_end_reports_its_krylov_iterations(tmp_path):
     row = measure_3d("1e4", backend="amg")
