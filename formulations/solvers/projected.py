@@ -110,8 +110,11 @@ def solve_projected(qp: ContactQP, active: np.ndarray, max_iter: int, backend: s
             project, particular, multipliers = projection(qp.B[rows])
         except RuntimeError:  # dependent active rows: B_A B_A' singular
             return u, lam, iteration, STATUS_FAILED, SINGULAR, diagnostics(False)
-        u = project(u) + particular(qp.G[rows])  # the last u, moved onto the new set
-        u = projected_cg(K, precondition, project, qp.F, u, rtol, counts)
+        u_p = particular(qp.G[rows])
+        if not np.any(qp.F) and not np.any(u_p):  # no load, no gap to close: u = 0 exactly
+            u, counts = np.zeros(qp.n), counts + [0]
+        else:  # the last u, moved onto the new set
+            u = projected_cg(K, precondition, project, qp.F, project(u) + u_p, rtol, counts)
         lam, new_active = next_active_set(qp, active, u, K, multipliers)
         changes.append(int((new_active != active).sum()))
         if changes[-1] == 0 and rtol == RTOL:
