@@ -117,11 +117,9 @@ def memory_route(level: int, ndofs: int, solver: str, backend: str, limit_gib: f
 def iterative_route(ndofs: int, solver: str, backend: str, limit_gib: float, order: int = 1,
                     dim: int = 2) -> str | None:
     """The iterative back-end (``Backend.iterative``) of lowest rank that fits in
-    ``limit_gib`` where ``backend`` does not, for the fast solver (the reference uses no
-    back-end); None if ``backend`` fits or none does."""
+    ``limit_gib`` (``memory_route`` asks where ``backend`` does not), for the fast solver (the
+    reference uses no back-end); None if none does."""
     if solver == REFERENCE_SOLVER:
-        return None
-    if predict_peak_gib(ndofs, solver, backend, order, dim) <= limit_gib:
         return None
     candidates = sorted((BACKENDS.get(name) for name in BACKENDS.names()),
                         key=lambda b: b.rank)

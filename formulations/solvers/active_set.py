@@ -83,8 +83,9 @@ def solve_active_set(qp: ContactQP, warm_start: np.ndarray | None = None,
     if not condenses(backend):
         active = (np.asarray(warm_start) > 0) if warm_start is not None else \
             initial_active_set(qp, backend)
-        route = solve_projected if iterative(backend) else solve_augmented
-        u, lam, iterations, status, reason, diagnostics = route(qp, active, max_iter, backend)
+        u, lam, iterations, status, reason, diagnostics = (
+            solve_projected(qp, active, max_iter, backend) if iterative(backend)
+            else solve_augmented(qp, active, max_iter))
         if status != STATUS_OK:
             return _fallback(qp, f"plain active set failed ({reason})", diagnostics, start)
         return QPSolution(u=u, multipliers=lam, status=status, reason=reason,

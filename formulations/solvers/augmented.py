@@ -46,7 +46,7 @@ def condition_estimate(system: sparse.csc_matrix, lu) -> float:
     return float(abs(system).sum(axis=0).max() * norm)
 
 
-def solve_augmented(qp: ContactQP, active: np.ndarray, max_iter: int, backend: str = "splu"):
+def solve_augmented(qp: ContactQP, active: np.ndarray, max_iter: int):
     """Returns (u, lambda, iterations, status, reason, diagnostics): the diagnostics hold the
     active-set changes of every iteration, whether a set repeated (``cycled``) and the
     condition estimate of the last (scaled) saddle-point matrix factorised."""

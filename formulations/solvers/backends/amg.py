@@ -4,9 +4,9 @@
 No factorisation and no dense block: the memory is O(N) and a solve costs a bounded number of
 V-cycles on a mesh-independent hierarchy. ``factorise(K, near_null)`` builds the hierarchy once
 and returns a solve that runs conjugate gradients (symmetric K) or GMRES (a nonsymmetric
-Jacobian: Nitsche with theta != 1) to the relative residual ``RTOL``, from the last solution
-when asked (``IterativeSolve.start``). A solve that does not reach RTOL raises
-``FactorisationError`` with the residual reached: never an inaccurate answer passed on.
+Jacobian: Nitsche with theta != 1) to the relative residual ``RTOL``. A solve that does not
+reach RTOL raises ``FactorisationError`` with the residual reached: never an inaccurate answer
+passed on.
 
 There is no cheap Schur complement, so the active-set solver runs its projected iteration
 (``formulations.solvers.projected``) and the semismooth Newton its sparse steps on this
@@ -43,9 +43,8 @@ class IterativeSolve:
     symmetric: bool
     iterations: list[int] = field(default_factory=list)
 
-    def __call__(self, b: np.ndarray, start: np.ndarray | None = None,
-                 rtol: float | None = None) -> np.ndarray:
-        """K^-1 b to the relative residual ``rtol`` (None: RTOL), from ``start``."""
+    def __call__(self, b: np.ndarray, rtol: float | None = None) -> np.ndarray:
+        """K^-1 b to the relative residual ``rtol`` (None: RTOL)."""
         rtol = RTOL if rtol is None else rtol
         b = np.asarray(b, dtype=float)
         if b.ndim == 2:
@@ -60,7 +59,7 @@ class IterativeSolve:
 
         method = cg if self.symmetric else gmres
         extra = {} if self.symmetric else {"restart": 60, "callback_type": "pr_norm"}
-        x, info = method(self.K, b, x0=start, rtol=rtol, atol=0.0, maxiter=MAX_ITERATIONS,
+        x, info = method(self.K, b, rtol=rtol, atol=0.0, maxiter=MAX_ITERATIONS,
                          M=self.preconditioner, callback=tick, **extra)
         self.iterations.append(count[0])
         residual = np.linalg.norm(b - self.K @ x) / norm
