@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from formulations import get_formulation, solve
-from formulations.solvers.backends import available_backends
+from formulations.solvers.backends import available_backends, iterative
 from formulations.solvers.lcp import pdas
 from scenes import get_scene
 
@@ -49,8 +49,13 @@ def test_active_set_agrees_with_reference(label, mesh, backend):
     assert fast.status == "ok", fast.reason
     assert fast.backend == backend
     assert reference.status == "ok", reference.reason
-    # the fast solver is exact: KKT residuals at round-off
-    assert max(vars(fast.residuals).values()) < 1e-12
+    # a direct back-end is exact: KKT residuals at round-off. An iterative one stops its Krylov
+    # solve at a relative residual of 1e-10 (backends/amg.py RTOL), so stationarity is only
+    # bounded by that; the other residuals stay at round-off either way
+    stationarity_bound = 1e-10 if iterative(backend) else 1e-12
+    residuals = fast.residuals
+    assert residuals.stationarity < stationarity_bound, residuals
+    assert max(residuals.violation, residuals.dual_violation, residuals.complementarity) < 1e-12
     free, K = disc.elasticity.free, disc.qp.K
     du = fast.u[free] - reference.u[free]
     energy_diff = np.sqrt(du @ K @ du) / np.sqrt(reference.u[free] @ K @ reference.u[free])
