@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from formulations.registry import frictionless_only
 from scenes.registry import Registry
 
 
@@ -76,14 +77,16 @@ SIMPLICES = ("tri", "tet")  # the cell families (formulations.cells) most estima
 
 
 def register_estimator(name: str, description: str, applies=None, guaranteed: bool = False,
-                       families: tuple[str, ...] = SIMPLICES):
+                       families: tuple[str, ...] = SIMPLICES, friction: bool = False):
     """Register ``estimate(scene, solution) -> Estimate`` under ``name``; ``guaranteed``: its
     eta is an upper bound of the energy error with every constant computed (what
     ``--target-error`` needs); ``families``: the cell families it runs on (others can add
-    their own ``register_cell_variant``)."""
-    return ESTIMATORS.register(name, description, applies,
+    their own ``register_cell_variant``); ``friction``: whether it has the friction terms
+    (else a scene with friction is refused with that reason)."""
+    check = applies if friction else frictionless_only("estimator", name, applies)
+    return ESTIMATORS.register(name, description, check,
                                meta={"guaranteed": bool(guaranteed),
-                                     "families": tuple(families)})
+                                     "families": tuple(families), "friction": bool(friction)})
 
 
 def register_cell_variant(name: str, family: str):

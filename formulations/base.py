@@ -25,6 +25,37 @@ STATUS_SKIPPED = "skipped"
 
 
 @dataclass(frozen=True, eq=False)
+class FrictionRows:
+    """Friction on the constraint nodes of a ``ContactQP`` (docs/theory.md, 17.2): the objective
+    gains sum_i b_i |T_i u| with T_i the ``block`` (d - 1) tangential rows of node i (row i of B
+    is its normal row) and b_i its slip bound, a force: the given ``bound`` (Tresca), or
+    ``coefficient`` times the node's normal reaction (Coulomb: a fixed point on the bound)."""
+
+    T: sparse.csr_matrix
+    bound: np.ndarray
+    coefficient: float = 0.0
+    block: int = 1
+
+    @property
+    def coulomb(self) -> bool:
+        return self.coefficient > 0
+
+    def bounds(self, normal_reactions: np.ndarray | None) -> np.ndarray:
+        """b_i: the Tresca bound, or mu (lambda_n,i)^+ for Coulomb."""
+        if not self.coulomb:
+            return self.bound
+        return self.coefficient * np.maximum(np.asarray(normal_reactions, dtype=float), 0.0)
+
+    def with_bound(self, bound: np.ndarray) -> FrictionRows:
+        """The Tresca problem with slip bound ``bound`` (a Coulomb fixed point's step)."""
+        return FrictionRows(T=self.T, bound=np.asarray(bound, dtype=float), block=self.block)
+
+    def node_norms(self, values: np.ndarray) -> np.ndarray:
+        """|v_i| per node of a tangential vector (block entries per node, node-major)."""
+        return np.linalg.norm(np.reshape(values, (-1, self.block)), axis=1)
+
+
+@dataclass(frozen=True, eq=False)
 class ContactQP:
     """min 1/2 u'Ku - F'u  s.t.  B u <= G, over the free DOFs.
 
@@ -42,6 +73,8 @@ class ContactQP:
     # K's rigid-body modes (``Elasticity.rigid_modes``): the near-null space of the ``amg``
     # back-end (None: none known; the back-end is then slower, not wrong)
     near_null: np.ndarray | None = None
+    # Tresca or Coulomb friction on the nodes of B (None: frictionless)
+    friction: FrictionRows | None = None
 
     @property
     def n(self) -> int:
@@ -90,6 +123,9 @@ class SolverDiagnostics:
     condensed: np.ndarray | None = None  # B K^-1 B' when the solver formed it (pardiso, cholmod)
     phases: tuple[tuple[str, float], ...] = ()  # (phase, seconds) of the solve, in order
     krylov_iterations: tuple[int, ...] = ()  # per linear solve, on an iterative back-end
+    # the final sets of a box-constrained solve (solvers.box: -1 at the lower bound, 0 free, 1
+    # at the upper; normal rows, then tangential), the next Coulomb step's start
+    sets: np.ndarray | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -105,6 +141,8 @@ class QPSolution:
     solver: str
     backend: str = ""
     diagnostics: SolverDiagnostics = field(default_factory=SolverDiagnostics)
+    # the tangential reactions lambda_t of a frictional QP (FrictionRows), one per row of T
+    tangential: np.ndarray | None = None
 
 
 @dataclass(frozen=True)

@@ -136,6 +136,7 @@ def solve(discretisation: Discretisation, solver: str, **options) -> DiscreteSol
         status, reason = final_status(answer, None)
     else:
         residuals = (system.residuals(answer.u) if system is not None else
-                     qp_residuals(discretisation.qp, answer.u, answer.multipliers))
+                     qp_residuals(discretisation.qp, answer.u, answer.multipliers,
+                                  answer.tangential))
         status, reason = final_status(answer, residuals)
     return discretisation.recover(answer, residuals, status, reason)

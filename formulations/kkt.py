@@ -39,21 +39,46 @@ def _scale(*values: float) -> float:
     return s if s > 0 and np.isfinite(s) else 1.0
 
 
-def qp_residuals(qp: ContactQP, u: np.ndarray, multipliers: np.ndarray) -> Residuals:
+def qp_residuals(qp: ContactQP, u: np.ndarray, multipliers: np.ndarray,
+                 tangential: np.ndarray | None = None) -> Residuals:
+    """The four residuals of the module docstring; with friction (``qp.friction``) they also
+    judge the tangential reactions ``tangential`` (``friction_terms``)."""
     Ku = qp.K @ u
     gap = qp.B @ u - qp.G
     lam = np.maximum(multipliers, 0.0)
     BTl = qp.B.T @ lam
     u_scale = _scale(np.abs(u).max(initial=0.0), qp.gap_scale)
+    energy_scale = _scale(u @ Ku, qp.objective_scale * u_scale**2)
+    bound_excess, slip_gap = 0.0, 0.0
+    if qp.friction is not None:
+        tangential = np.zeros(qp.friction.T.shape[0]) if tangential is None else tangential
+        BTl = BTl + qp.friction.T.T @ tangential
+        bound_excess, slip_gap = friction_terms(qp, u, lam, tangential)
     return Residuals(
         violation=float(np.maximum(gap / qp.row_scale, 0.0).max(initial=0.0) / u_scale),
-        dual_violation=float(np.maximum(-multipliers, 0.0).max(initial=0.0)
-                             / _scale(np.abs(multipliers).max(initial=0.0))),
-        complementarity=float(abs(lam @ gap) / _scale(u @ Ku, qp.objective_scale * u_scale**2)),
+        dual_violation=max(float(np.maximum(-multipliers, 0.0).max(initial=0.0)
+                                 / _scale(np.abs(multipliers).max(initial=0.0))), bound_excess),
+        complementarity=float((abs(lam @ gap) + slip_gap) / energy_scale),
         stationarity=float(np.linalg.norm(Ku - qp.F + BTl)
                            / _scale(np.linalg.norm(Ku), np.linalg.norm(qp.F), np.linalg.norm(BTl),
                                     np.abs(qp.K.diagonal()).max(initial=0.0) * u_scale)),
     )
+
+
+def friction_terms(qp: ContactQP, u: np.ndarray, lam: np.ndarray,
+                   tangential: np.ndarray) -> tuple[float, float]:
+    """The friction law's residuals (docs/theory.md, 17.2): max_i (|lambda_t,i| - b_i)^+
+    relative to max(max b, max |lambda_t|) (a dual violation), and
+    |sum_i b_i |T_i u| - lambda_t,i . T_i u| (a complementarity gap: zero exactly when each
+    node sticks, T_i u = 0, or slips with lambda_t,i = b_i T_i u / |T_i u|; an energy)."""
+    friction = qp.friction
+    bound = friction.bounds(lam)
+    size = friction.node_norms(tangential)
+    excess = np.maximum(size - bound, 0.0).max(initial=0.0)
+    excess /= _scale(bound.max(initial=0.0), size.max(initial=0.0))
+    slip = friction.T @ u
+    gap = abs(bound @ friction.node_norms(slip) - tangential @ slip)
+    return float(excess), float(gap)
 
 
 def final_status(solution: QPSolution, residuals: Residuals | None) -> tuple[str, str]:

@@ -32,6 +32,7 @@ from formulations.discretisation import Discretisation, discrete_solution
 from formulations.elasticity import assemble_elasticity, check_order
 from formulations.evaluation import evaluate_on_trace
 from formulations.kkt import count_active
+from formulations.nodal_friction import NodalFriction, friction_rows, nodal_friction, tangents
 from formulations.registry import register_formulation
 from formulations.surface_nodes import (
     nodal_pressures,
@@ -50,6 +51,7 @@ class NodalDetails:
     reactions: np.ndarray
     nodal_pressure: np.ndarray
     contact_nodes: np.ndarray
+    friction: NodalFriction | None = None  # with a friction law (formulations.nodal_friction)
 
 
 def newton_cotes(order: int) -> np.ndarray:
@@ -79,27 +81,38 @@ def trace_nodes(mesh: MeshTri, trace, order: int) -> TraceNodes:
                       vertices=vertices)
 
 
-def constraint_rows(elasticity, trace, nodes: TraceNodes) -> sparse.csr_matrix:
+def constraint_rows(elasticity, trace, nodes: TraceNodes,
+                    directions: np.ndarray | None = None) -> sparse.csr_matrix:
     """B_i = n_i' u_h(x_i): the vertex DOFs directly, the nodes inside facets by evaluating the
-    basis there (other basis functions vanish at a Lagrange node up to round-off, dropped)."""
+    basis there (other basis functions vanish at a Lagrange node up to round-off, dropped).
+    ``directions`` (2, m) replaces the normals n_i (the tangential rows of friction)."""
     nv = nodes.vertices.size
+    directions = nodes.normal if directions is None else directions
     dofs = elasticity.basis.nodal_dofs[:, nodes.vertices]  # (2, nv)
-    vertex_rows = sparse.csr_matrix((nodes.normal[:, :nv].ravel(),
+    vertex_rows = sparse.csr_matrix((directions[:, :nv].ravel(),
                                      (np.tile(np.arange(nv), 2), dofs.ravel())),
                                     shape=(nv, elasticity.basis.N))
     inner = elasticity.order - 1
     if inner == 0:
         return vertex_rows
     t_inside = lagrange_nodes(elasticity.order)[1:-1]
-    inside = evaluate_on_trace(elasticity.basis, trace, t_inside).matrix(nodes.normal[:, nv:])
+    inside = evaluate_on_trace(elasticity.basis, trace, t_inside).matrix(directions[:, nv:])
     inside.data[np.abs(inside.data) < 1e-12] = 0.0
     inside.eliminate_zeros()
     return sparse.vstack([vertex_rows, inside], format="csr")
 
 
+def planar_friction(scene=None, **_) -> str | None:
+    if scene is not None and scene.friction.active and scene.dim == 3:
+        return ("vi models friction in 2D only (in 3D each node's bound is a disc: a "
+                "second-order cone, not built)")
+    return None
+
+
 @register_formulation("vi", "primal variational inequality: nodal constraints "
                             "u_h(x_i).n_i <= g(x_i) at every Lagrange node of Gamma_C, "
-                            "lambda_h from the nodal reactions")
+                            "lambda_h from the nodal reactions; Tresca or Coulomb friction "
+                            "on the same nodes (2D)", planar_friction, friction=True)
 def discretise(scene: Scene, mesh: MeshTri, order: int = 1) -> Discretisation:
     elasticity = assemble_elasticity(scene, mesh, check_order(order))
     trace = contact_trace(scene, mesh)
@@ -112,12 +125,20 @@ def discretise(scene: Scene, mesh: MeshTri, order: int = 1) -> Discretisation:
     m = nodes.weight.size
     G = np.asarray(scene.gap(nodes.points), dtype=float)
     # rows of B are dimensionless (a normal), so the multipliers are forces; row_scale 1
+    friction = (friction_rows(scene, nodes, elasticity.restrict(
+        constraint_rows(elasticity, trace, nodes, tangents(nodes.normal))))
+        if scene.friction.active and trace.dim == 2 else None)
     qp = ContactQP(K=elasticity.K_free, F=elasticity.F_free,
                    B=elasticity.restrict(B), G=G, row_scale=np.ones(m),
                    objective_scale=float(scene.material.young_modulus),
-                   near_null=elasticity.rigid_modes)
+                   near_null=elasticity.rigid_modes, friction=friction)
     coordinate = np.asarray(scene.contact_coordinate(nodes.points), dtype=float)
     pieces = elasticity.order  # lambda_h is linear between consecutive nodes of a facet
+
+    def tangential_of(answer: QPSolution) -> np.ndarray:  # NaN where a solve failed
+        if answer.tangential is not None:
+            return answer.tangential
+        return np.full(friction.T.shape[0], np.nan)
 
     def recover(answer: QPSolution, residuals: Residuals, status: str,
                 reason: str) -> DiscreteSolution:
@@ -139,7 +160,10 @@ def discretise(scene: Scene, mesh: MeshTri, order: int = 1) -> Discretisation:
             multiplier_breaks=np.sort(coordinate) if trace.dim == 2 else np.zeros(0),
             active_constraints=count_active(qp, answer.u, reaction),
             details=NodalDetails(reactions=reaction, nodal_pressure=lam,
-                                 contact_nodes=nodes.vertices))
+                                 contact_nodes=nodes.vertices,
+                                 friction=None if friction is None else nodal_friction(
+                                     friction, answer.u, reaction, tangential_of(answer),
+                                     nodes.weight)))
 
     return Discretisation(formulation="vi", elasticity=elasticity, trace=trace, qp=qp,
                           recover=recover, row_coordinate=coordinate)

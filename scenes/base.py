@@ -7,16 +7,14 @@ construction so that a bad problem is refused before any solve.
 
 from __future__ import annotations
 
-import numbers
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
 from skfem import Mesh, MeshTri
 
-PointFunction = Callable[[np.ndarray], np.ndarray]
-"""A function of points ``x`` with shape (d, ...) (d = 2 or 3) returning values of shape (...)
-or (d, ...)."""
+from scenes.checks import PointFunction, SceneError, is_integer, is_number  # noqa: F401
+from scenes.friction import NO_FRICTION, FrictionLaw
 
 # the corners of the reference triangle and its centroid, as (2, 4) local coordinates: where a
 # 3D scene's gap is checked on every contact facet
@@ -41,20 +39,6 @@ def simplex_measures(corners: np.ndarray) -> np.ndarray:
         return np.linalg.norm(corners[:, 1] - corners[:, 0], axis=0)
     return 0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0],
                                          corners[:, 2] - corners[:, 0], axis=0), axis=0)
-
-
-class SceneError(ValueError):
-    """A scene parameter is out of its allowed range."""
-
-
-def is_number(value) -> bool:
-    """A real number as users write them: Python or numpy ints and floats, never a bool."""
-    return isinstance(value, numbers.Real) and not isinstance(value, bool | np.bool_)
-
-
-def is_integer(value) -> bool:
-    """An integer (Python or numpy), never a bool."""
-    return isinstance(value, numbers.Integral) and not isinstance(value, bool | np.bool_)
 
 
 def _check(condition: bool, parameter: str, value, allowed: str) -> None:
@@ -150,6 +134,8 @@ class Scene:
     predict_contact: Callable[[float], ContactPrediction] | None = None
     # the corners where the solution may be singular (scenes.corners), for rate predictions
     corners: tuple = ()
+    # the friction law on Gamma_C (scenes.friction; frictionless unless a scene says otherwise)
+    friction: FrictionLaw = NO_FRICTION
 
     def __post_init__(self):
         _check(isinstance(self.material, Material), "material", self.material,

@@ -63,6 +63,9 @@ class CellFamily:
     centroid_rule: tuple[np.ndarray, np.ndarray] = (np.zeros((2, 1)), np.ones(1))
     adaptive: bool = True  # meshes refine where marked (else uniform only)
     tensor_product: bool = False  # Q_p on mapped squares or cubes (else P_p on simplices)
+    # the registered formulations run on these cells and answer for friction themselves (else
+    # a scene with friction is refused here: the family's own formulations do not model it)
+    friction: bool = False
 
     # --- elements ---------------------------------------------------------------------------
     def why_no_element(self, order: int) -> str | None:
@@ -75,6 +78,9 @@ class CellFamily:
         """Why this family cannot run ``scene`` with ``strategy``, or None."""
         if strategy == "adaptive" and not self.adaptive:
             return f"adaptive refinement of {self.shape} is not built (uniform only)"
+        if scene.friction.active and not self.friction:
+            return (f"friction on {self.shape} is not built (the scene's law is "
+                    f"{scene.friction.label})")
         return self.why_no_mesh(scene) or self.why_no_contact()
 
     def why_no_mesh(self, scene) -> str | None:

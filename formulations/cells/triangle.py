@@ -24,6 +24,7 @@ class Triangles(CellFamily):
     mesh_type = MeshTri1
     elements = {1: ElementTriP1, 2: ElementTriP2, 3: ElementTriP3}
     centroid_rule = (np.full((2, 1), 1.0 / 3.0), np.array([0.5]))  # weight = the area
+    friction = True  # the registered formulations say for themselves
 
     def refinement(self, mesh, marked=None) -> Plan:
         return Plan(self, mesh, marked, refinement_plan(mesh, marked))

@@ -49,6 +49,7 @@ from formulations.solvers.backends import (
     factorise_condensed,
     iterative,
 )
+from formulations.solvers.friction import solve_frictional
 from formulations.solvers.lcp import CYCLING_EXAMPLE, condition_1, least_index_pivoting, pdas
 from formulations.solvers.projected import solve_projected
 from formulations.solvers.reference import solve_reference
@@ -80,6 +81,11 @@ def solve_active_set(qp: ContactQP, warm_start: np.ndarray | None = None,
     backend = check_backend(backend)
     if warm_start is not None and np.shape(warm_start) != (qp.m,):
         raise ValueError(f"warm_start has shape {np.shape(warm_start)}, not ({qp.m},)")
+    if qp.friction is not None:
+        answer = solve_frictional(qp, warm_start, max_iter, backend)
+        if answer.status == STATUS_OK or qp.friction.coulomb:
+            return answer
+        return _fallback(qp, answer.reason, answer.diagnostics, start)
     if not condenses(backend):
         active = (np.asarray(warm_start) > 0) if warm_start is not None else \
             initial_active_set(qp, backend)

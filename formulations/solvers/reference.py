@@ -12,12 +12,14 @@ from __future__ import annotations
 
 import time
 import warnings
+from dataclasses import replace
 
 import cvxpy as cp
 import numpy as np
 from scipy import sparse
 
 from formulations.base import STATUS_FAILED, STATUS_INACCURATE, STATUS_OK, ContactQP, QPSolution
+from formulations.solvers.coulomb import coulomb_fixed_point, joined
 from formulations.solvers.registry import REFERENCE_SOLVER, register_solver
 
 # Clarabel's defaults are 1e-8. Measured on the paper scene (2e3..3e4 DOFs) against the exact
@@ -28,12 +30,34 @@ CLARABEL_TOLERANCES = {"tol_gap_abs": 1e-10, "tol_gap_rel": 1e-10, "tol_feas": 1
                        "tol_ktratio": 1e-8}
 
 
+# With friction the gap also carries the slip term b |T u|, and 1e-10 left ~2e-7 (energy norm)
+# against the exact active-set answer on paper P2 (2e3 DOFs); 1e-12 leaves ~2e-9 and ~2e-8 in
+# lambda_t (1e-14 stops short: optimal_inaccurate)
+FRICTION_TOLERANCES = {"tol_gap_abs": 1e-12, "tol_gap_rel": 1e-12, "tol_feas": 1e-12}
+
+# Coulomb's fixed point on reference steps stops at this relative change of the bound: the
+# steps' own multipliers carry ~1e-8 relative noise at the tolerances above
+COULOMB_RTOL = 1e-8
+
+
 @register_solver(REFERENCE_SOLVER, "CVXPY + Clarabel interior point (the judge of correctness)")
 def solve_reference(qp: ContactQP, warm_start=None, backend=None,
                     **clarabel_options) -> QPSolution:
     """Solve ``qp`` with Clarabel; ``warm_start`` and ``backend`` are accepted for the common
     solver interface and ignored (an interior-point method gains little from a warm start, and
-    Clarabel brings its own sparse LDL')."""
+    Clarabel brings its own sparse LDL'). Coulomb friction: a fixed point of such solves
+    (``coulomb``)."""
+    if qp.friction is not None and qp.friction.coulomb:
+        return coulomb_fixed_point(qp, lambda step, _: solve_reference(step, **clarabel_options),
+                                   COULOMB_RTOL)
+    if qp.friction is not None and not clarabel_options:
+        answer = solve_reference(qp, **FRICTION_TOLERANCES)
+        if answer.status != STATUS_INACCURATE:
+            return answer
+        retry = solve_reference(qp, **CLARABEL_TOLERANCES)  # the tighter tolerances stalled
+        return replace(retry, reason=joined(retry.reason, "stalled at the friction "
+                                             "tolerances 1e-12, answered at 1e-10"),
+                       solve_time=answer.solve_time + retry.solve_time)
     settings = {**CLARABEL_TOLERANCES, **clarabel_options}
     d = qp.gap_scale if 0 < qp.gap_scale < np.inf else 1.0
     K = (qp.K / qp.objective_scale).tocsc()
@@ -42,9 +66,12 @@ def solve_reference(qp: ContactQP, warm_start=None, backend=None,
     B, G = (row @ qp.B).tocsr(), qp.G / (qp.row_scale * d)
 
     u = cp.Variable(qp.n)
-    objective = cp.Minimize(0.5 * cp.quad_form(u, cp.psd_wrap(K)) - F @ u)
-    constraint = B @ u <= G
-    problem = cp.Problem(objective, [constraint] if qp.m else [])
+    objective = 0.5 * cp.quad_form(u, cp.psd_wrap(K)) - F @ u
+    constraints = [B @ u <= G] if qp.m else []
+    if qp.friction is not None:  # b |T u| = max over |lambda_t| <= b of lambda_t T u
+        objective, slips = friction_term(qp, u, objective, d)
+        constraints += slips
+    problem = cp.Problem(cp.Minimize(objective), constraints)
     start = time.perf_counter()
     try:
         with warnings.catch_warnings():  # an inaccurate answer is reported in the status
@@ -59,7 +86,11 @@ def solve_reference(qp: ContactQP, warm_start=None, backend=None,
     if problem.status not in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE) or u.value is None:
         return QPSolution(None, None, STATUS_FAILED, f"Clarabel status {problem.status!r}",
                           iterations, elapsed, REFERENCE_SOLVER, "clarabel")
-    mu = np.asarray(constraint.dual_value if qp.m else np.zeros(0), dtype=float).ravel()
+    mu = np.asarray(constraints[0].dual_value if qp.m else np.zeros(0), dtype=float).ravel()
+    tangential = None
+    if qp.friction is not None:  # the two one-sided rows' multipliers, in force units
+        plus, minus = (np.asarray(c.dual_value, dtype=float) for c in constraints[-2:])
+        tangential = qp.objective_scale * d * (plus - minus)
     status, reason = STATUS_OK, ""
     if problem.status == cp.OPTIMAL_INACCURATE:
         status, reason = STATUS_INACCURATE, "Clarabel stopped short of its tolerances " \
@@ -67,4 +98,18 @@ def solve_reference(qp: ContactQP, warm_start=None, backend=None,
     return QPSolution(u=d * np.asarray(u.value, dtype=float),
                       multipliers=qp.objective_scale * d * mu / qp.row_scale,
                       status=status, reason=reason, iterations=iterations, solve_time=elapsed,
-                      solver=REFERENCE_SOLVER, backend="clarabel")
+                      solver=REFERENCE_SOLVER, backend="clarabel", tangential=tangential)
+
+
+def friction_term(qp: ContactQP, u: cp.Variable, objective, d: float):
+    """The Tresca term sum_i b_i |T_i u| in the scaled units (u = d v, objective / (E d^2)):
+    a slip variable z >= |T v| per row, costed (b / (E d)) z; the rows' multipliers are the
+    tangential reactions."""
+    friction = qp.friction
+    if friction.block != 1:
+        raise ValueError(f"friction with {friction.block} tangential directions per node "
+                         "needs a second-order cone; the reference has only the 2D form")
+    z = cp.Variable(friction.T.shape[0])
+    weight = friction.bound / (qp.objective_scale * d)
+    T = friction.T.tocsr()
+    return objective + weight @ z, [T @ u - z <= 0, -T @ u - z <= 0]

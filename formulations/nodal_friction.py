@@ -1,0 +1,67 @@
+"""Friction on the nodes of Gamma_C for the nodal VI (docs/theory.md, 17.2).
+
+At every constraint node x_i (normal n_i, lumped weight w_i) the tangential row is
+T_i u = t_i . u_h(x_i) with t_i = (-n_2, n_1) (n_i turned by +90 degrees), and the friction
+functional is j_h(u) = sum_i w_i s(x_i) |T_i u| (Tresca: the lumped quadrature of
+int_{Gamma_C} s |u_t| ds), or the same with w_i s(x_i) replaced by mu times the normal reaction
+(Coulomb). The tangential reaction lambda_t,i is a force; the shear traction at the node is
+sigma_t = -lambda_t,i / w_i (friction opposes the slip).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from formulations.base import FrictionRows
+
+# a node is in contact where its normal reaction exceeds this fraction of the largest one, and
+# slips where |lambda_t| is within it (times the largest bound) of its bound: the exact solver
+# leaves round-off, the interior-point reference ~1e-9 relative
+STATE_FRACTION = 1e-6
+STATES = ("separated", "stick", "slip")
+
+
+@dataclass(frozen=True, eq=False)
+class NodalFriction:
+    """The friction arrays of a nodal solution: tangential reactions (forces), the shear
+    traction sigma_t at the nodes, the tangential displacement t_i . u_h(x_i), each node's
+    bound (a force) and its state (``STATES``)."""
+
+    tangential_reactions: np.ndarray
+    shear: np.ndarray
+    slip: np.ndarray
+    bound: np.ndarray
+    state: np.ndarray
+
+
+def tangents(normal: np.ndarray) -> np.ndarray:
+    """t_i = (-n_2, n_1): the unit normals turned by +90 degrees (2D)."""
+    return np.array([-normal[1], normal[0]])
+
+
+def friction_rows(scene, nodes, T) -> FrictionRows | None:
+    """The ``FrictionRows`` of ``scene``'s law on ``nodes`` with tangential rows ``T`` (free
+    DOFs), or None without friction."""
+    law = scene.friction
+    if not law.active:
+        return None
+    bound = (nodes.weight * np.asarray(law.slip_bound(nodes.points), dtype=float)
+             if law.kind == "tresca" else np.zeros(nodes.weight.size))
+    if np.any(bound < 0) or not np.all(np.isfinite(bound)):
+        raise ValueError("slip_bound is negative or not finite at a contact node (it must be "
+                         "a finite function >= 0 on Gamma_C)")
+    return FrictionRows(T=T, bound=bound, coefficient=law.coefficient)
+
+
+def nodal_friction(friction: FrictionRows, u_free: np.ndarray, reactions: np.ndarray,
+                   tangential: np.ndarray, weight: np.ndarray) -> NodalFriction:
+    """The node states and tractions from the returned arrays (never from a solver's sets)."""
+    bound = friction.bounds(reactions)
+    size = np.abs(tangential)
+    contact = reactions > STATE_FRACTION * max(reactions.max(initial=0.0), 0.0)
+    slipping = size >= bound - STATE_FRACTION * bound.max(initial=0.0)
+    state = np.where(~contact, "separated", np.where(slipping & (bound > 0), "slip", "stick"))
+    return NodalFriction(tangential_reactions=tangential, shear=-tangential / weight,
+                         slip=friction.T @ u_free, bound=bound, state=state)

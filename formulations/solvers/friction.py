@@ -1,0 +1,125 @@
+"""The fast frictional solve: condensed primal-dual active sets on stick, slip and separation
+(docs/theory.md, 17.3).
+
+With C = [B; T] (normal rows, then the tangential rows of the same nodes), u = K^-1 (F - C'lam)
+and the Tresca problem's dual is the box QP
+
+    min 1/2 lam'S lam - r'lam,  S = C K^-1 C',  r = C K^-1 F - [G; 0],
+    lam_n >= 0,  -b <= lam_t <= b,
+
+solved exactly by ``box.box_pdas`` (the slack r - S lam is [Bu - G; Tu]: a free normal entry is
+a node in contact, a free tangential one a node that sticks, one at a bound a node that slips).
+K is factorised once and S comes from the same factorisation, as in the frictionless
+``active_set``; Coulomb's fixed point (``coulomb``) reuses both for every step, so a Coulomb
+level costs one factorisation too. Two tangential directions per node (3D) make the bound a
+disc, not a box: that is not solved here (``FrictionError``).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import replace
+
+import numpy as np
+from scipy import sparse
+
+from formulations.base import STATUS_OK, ContactQP, QPSolution, SolverDiagnostics
+from formulations.solvers.backends import (
+    check_backend,
+    condenses,
+    factorise,
+    factorise_condensed,
+    iterative,
+)
+from formulations.solvers.box import AT_LOWER, FREE, box_pdas, initial_state
+from formulations.solvers.coulomb import coulomb_fixed_point
+from formulations.solvers.registry import FAST_SOLVER
+
+# the exact active-set steps leave round-off; the fixed point stops when the bound has settled
+COULOMB_RTOL = 1e-11
+
+
+class FrictionError(ValueError):
+    """A frictional problem this solver does not handle."""
+
+
+def condensed_system(qp: ContactQP, backend: str):
+    """(solve, S, r, phases): a factorisation of K, the condensed C K^-1 C' and its right-hand
+    side, on any back-end (an iterative one solves for each row of C in turn)."""
+    C = sparse.vstack([qp.B, qp.friction.T], format="csr")
+    clock = time.perf_counter()
+    if condenses(backend):
+        factor = factorise_condensed(qp.K, np.unique(C.indices), backend)
+        solve, S, phases = factor.solve, factor.condensed(C), list(factor.phases)
+    else:
+        solve = factorise(qp.K, backend, qp.near_null)
+        columns = C.T.toarray()
+        X = (np.column_stack([solve(column) for column in columns.T]) if iterative(backend)
+             else solve(columns))
+        S, phases = np.asarray(C @ X), []
+    u0 = solve(qp.F)
+    r = C @ u0 - np.concatenate([qp.G, np.zeros(qp.friction.T.shape[0])])
+    phases.append(("condense", time.perf_counter() - clock))
+    return solve, C, S, r, phases
+
+
+def tresca_step(S: np.ndarray, r: np.ndarray, qp: ContactQP, previous: QPSolution | None,
+                warm_start: np.ndarray | None, max_iter: int):
+    """One Tresca box solve (``box.BoxResult``). Starts, in turn until one converges: the
+    previous step's sets (a node pinned there by a zero bound sticks instead), the warm
+    start's contact zone with every node sticking, the unconstrained solution's sets. The
+    iteration is not globally convergent (it can cycle from a poor start, as the frictionless
+    one can), and the next start is then tried."""
+    m, bound = qp.m, qp.friction.bound  # a Tresca step: Coulomb's steps have their bound
+    lower = np.concatenate([np.zeros(m), -bound])
+    upper = np.concatenate([np.full(m, np.inf), bound])
+    starts = []
+    if previous is not None and previous.diagnostics.sets is not None:
+        sets = previous.diagnostics.sets.copy()
+        sets[m:] = np.where(sets[m:] == AT_LOWER, FREE, sets[m:])
+        starts.append(sets)
+    if warm_start is not None:
+        starts.append(np.concatenate([np.where(np.asarray(warm_start) > 0, FREE, AT_LOWER),
+                                      np.full(bound.size, FREE)]))
+    starts.append(initial_state(r, lower, upper))
+    changes: tuple[int, ...] = ()
+    for state in starts:
+        result = box_pdas(S, r, lower, upper, state, max_iter)
+        changes += result.changes
+        if result.status == STATUS_OK:
+            break
+    return replace(result, changes=changes)
+
+
+def solve_frictional(qp: ContactQP, warm_start: np.ndarray | None = None, max_iter: int = 100,
+                     backend: str | None = None) -> QPSolution:
+    """Tresca or Coulomb (a fixed point on the bound, ``coulomb``) on one factorisation."""
+    if qp.friction.block != 1:
+        raise FrictionError(f"friction with {qp.friction.block} tangential directions per "
+                            "node (3D) needs a second-order-cone solve; the active-set solver "
+                            "has only the 2D box")
+    start = time.perf_counter()
+    backend = check_backend(backend)
+    solve, C, S, r, phases = condensed_system(qp, backend)
+
+    def tresca(step_qp: ContactQP, previous: QPSolution | None) -> QPSolution:
+        clock = time.perf_counter()
+        result = tresca_step(S, r, step_qp, previous, warm_start, max_iter)
+        diagnostics = SolverDiagnostics(active_set_changes=result.changes,
+                                        cycled=result.cycled, sets=result.state)
+        if result.status != STATUS_OK:
+            return QPSolution(None, None, result.status, f"frictional active set failed "
+                              f"({result.reason})", result.iterations,
+                              time.perf_counter() - clock, FAST_SOLVER, backend, diagnostics)
+        u = solve(qp.F - C.T @ result.lam)
+        return QPSolution(u=u, multipliers=result.lam[:qp.m], status=STATUS_OK, reason="",
+                          iterations=result.iterations, solve_time=time.perf_counter() - clock,
+                          solver=FAST_SOLVER, backend=backend, diagnostics=diagnostics,
+                          tangential=result.lam[qp.m:])
+
+    answer = (coulomb_fixed_point(qp, tresca, COULOMB_RTOL) if qp.friction.coulomb
+              else tresca(qp, None))
+    phases.append(("iterate", answer.solve_time))
+    return replace(answer, solve_time=time.perf_counter() - start,
+                   diagnostics=replace(answer.diagnostics, phases=tuple(phases)))
+
