@@ -55,6 +55,31 @@ class FrictionRows:
         return np.linalg.norm(np.reshape(values, (-1, self.block)), axis=1)
 
 
+FRICTION_STATES = ("separated", "stick", "slip")
+
+
+@dataclass(frozen=True, eq=False)
+class FrictionState:
+    """The friction law's answer at the points where a formulation poses it (the nodes of
+    Gamma_C for vi; docs/theory.md, 17.2): their contact coordinate, tangential reaction (a
+    force), shear traction sigma_t, tangential displacement (the slip), bound (a force) and
+    state (``FRICTION_STATES``), all computed from the returned arrays."""
+
+    coordinate: np.ndarray
+    tangential_reactions: np.ndarray
+    shear: np.ndarray
+    slip: np.ndarray
+    bound: np.ndarray
+    state: np.ndarray
+
+    def zone(self, state: str) -> tuple[float, float]:
+        """The end points of the points in ``state`` (NaN, NaN if there are none)."""
+        where = self.coordinate[self.state == state]
+        if where.size == 0:
+            return float("nan"), float("nan")
+        return float(where.min()), float(where.max())
+
+
 @dataclass(frozen=True, eq=False)
 class ContactQP:
     """min 1/2 u'Ku - F'u  s.t.  B u <= G, over the free DOFs.
@@ -187,6 +212,7 @@ class DiscreteSolution:
     # formulation can check it (penalty); 0 where lambda_h is the multiplier itself
     pressure_mismatch: float = 0.0
     diagnostics: SolverDiagnostics = field(default_factory=SolverDiagnostics)
+    friction: FrictionState | None = None  # with a friction law
 
     @property
     def ok(self) -> bool:

@@ -10,30 +10,14 @@ sigma_t = -lambda_t,i / w_i (friction opposes the slip).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
-from formulations.base import FrictionRows
+from formulations.base import FrictionRows, FrictionState
 
 # a node is in contact where its normal reaction exceeds this fraction of the largest one, and
 # slips where |lambda_t| is within it (times the largest bound) of its bound: the exact solver
 # leaves round-off, the interior-point reference ~1e-9 relative
 STATE_FRACTION = 1e-6
-STATES = ("separated", "stick", "slip")
-
-
-@dataclass(frozen=True, eq=False)
-class NodalFriction:
-    """The friction arrays of a nodal solution: tangential reactions (forces), the shear
-    traction sigma_t at the nodes, the tangential displacement t_i . u_h(x_i), each node's
-    bound (a force) and its state (``STATES``)."""
-
-    tangential_reactions: np.ndarray
-    shear: np.ndarray
-    slip: np.ndarray
-    bound: np.ndarray
-    state: np.ndarray
 
 
 def tangents(normal: np.ndarray) -> np.ndarray:
@@ -56,12 +40,15 @@ def friction_rows(scene, nodes, T) -> FrictionRows | None:
 
 
 def nodal_friction(friction: FrictionRows, u_free: np.ndarray, reactions: np.ndarray,
-                   tangential: np.ndarray, weight: np.ndarray) -> NodalFriction:
-    """The node states and tractions from the returned arrays (never from a solver's sets)."""
+                   tangential: np.ndarray, weight: np.ndarray,
+                   coordinate: np.ndarray) -> FrictionState:
+    """The node states and tractions from the returned arrays (never from a solver's sets); a
+    node in contact with a zero bound slides freely: it slips."""
     bound = friction.bounds(reactions)
     size = np.abs(tangential)
     contact = reactions > STATE_FRACTION * max(reactions.max(initial=0.0), 0.0)
     slipping = size >= bound - STATE_FRACTION * bound.max(initial=0.0)
-    state = np.where(~contact, "separated", np.where(slipping & (bound > 0), "slip", "stick"))
-    return NodalFriction(tangential_reactions=tangential, shear=-tangential / weight,
-                         slip=friction.T @ u_free, bound=bound, state=state)
+    state = np.where(~contact, "separated", np.where(slipping, "slip", "stick"))
+    return FrictionState(coordinate=coordinate, tangential_reactions=tangential,
+                         shear=-tangential / weight, slip=friction.T @ u_free, bound=bound,
+                         state=state)

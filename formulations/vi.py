@@ -32,7 +32,7 @@ from formulations.discretisation import Discretisation, discrete_solution
 from formulations.elasticity import assemble_elasticity, check_order
 from formulations.evaluation import evaluate_on_trace
 from formulations.kkt import count_active
-from formulations.nodal_friction import NodalFriction, friction_rows, nodal_friction, tangents
+from formulations.nodal_friction import friction_rows, nodal_friction, tangents
 from formulations.registry import register_formulation
 from formulations.surface_nodes import (
     nodal_pressures,
@@ -51,7 +51,6 @@ class NodalDetails:
     reactions: np.ndarray
     nodal_pressure: np.ndarray
     contact_nodes: np.ndarray
-    friction: NodalFriction | None = None  # with a friction law (formulations.nodal_friction)
 
 
 def newton_cotes(order: int) -> np.ndarray:
@@ -160,10 +159,9 @@ def discretise(scene: Scene, mesh: MeshTri, order: int = 1) -> Discretisation:
             multiplier_breaks=np.sort(coordinate) if trace.dim == 2 else np.zeros(0),
             active_constraints=count_active(qp, answer.u, reaction),
             details=NodalDetails(reactions=reaction, nodal_pressure=lam,
-                                 contact_nodes=nodes.vertices,
-                                 friction=None if friction is None else nodal_friction(
-                                     friction, answer.u, reaction, tangential_of(answer),
-                                     nodes.weight)))
+                                 contact_nodes=nodes.vertices),
+            friction=None if friction is None else nodal_friction(
+                friction, answer.u, reaction, tangential_of(answer), nodes.weight, coordinate))
 
     return Discretisation(formulation="vi", elasticity=elasticity, trace=trace, qp=qp,
                           recover=recover, row_coordinate=coordinate)

@@ -13,6 +13,7 @@ from scenes import (  # noqa: F401  (register themselves)
     hertz_3d,
     paper,
     paper_3d,
+    stick_slip,
 )
 from scenes.base import ContactPrediction, ExactSolution, Material, Scene, SceneError
 from scenes.registry import get_scene, register_scene, scene_descriptions, scene_names

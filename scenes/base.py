@@ -81,13 +81,18 @@ class Material:
 class ExactSolution:
     """A scene's known solution: u (``displacement(x)``, shape (2, ...)), its gradient
     (``gradient(x)``, shape (2, 2, ...), grad[i, j] = du_i/dx_j), the contact pressure as a function
-    of the contact coordinate, and the contact-zone end points (contact coordinates)."""
+    of the contact coordinate, and the contact-zone end points (contact coordinates); with
+    friction also the shear traction and the stick zone."""
 
     displacement: PointFunction
     gradient: PointFunction
     pressure: Callable[[np.ndarray], np.ndarray]
     contact_zone: tuple[float, float]
     source: str = ""
+    # with friction: the shear traction sigma_t along Gamma_C (a function of the contact
+    # coordinate, t = n turned by +90 degrees) and the stick zone's end points
+    shear: Callable[[np.ndarray], np.ndarray] | None = None
+    stick_zone: tuple[float, float] | None = None
 
 
 @dataclass(frozen=True)
