@@ -3,7 +3,8 @@
 w := (g - u_hn)_- on Gamma_C (minus the penetration).
 * geometric term ||w||_{1/2,Gamma_C}^2, computed through the interpolation bound of the paper's
   Remark 2: ||w||_{1/2}^2 ~ ||w||_{0,Gamma_C} ||w||_{1,Gamma_C};
-* complementarity term |(lambda_h, w)_{0,Gamma_C}|.
+* complementarity term |(lambda_h, w)_{0,Gamma_C}|, with friction plus the friction
+  complementarity of ``friction_complementarity``.
 
 Per-element shares (for marking) are the facet-wise products ||w||_{0,e} ||w||_{1,e} rescaled to
 sum to the global geometric term, and the facet-wise |(lambda_h, w)_e| (which sum exactly to the
@@ -63,6 +64,19 @@ def tangential_derivatives(scene, trace, t: np.ndarray, gradient: np.ndarray) ->
             for dg_k, tau in zip(dg, tangents, strict=True)]
 
 
+def friction_complementarity(scene, solution: DiscreteSolution, at_points, t: np.ndarray,
+                             w: np.ndarray) -> np.ndarray:
+    """|int_e (s |u_th| + sigma_t,h u_th) ds| per contact facet (2D; docs/theory.md, 17.5):
+    zero where the friction law holds pointwise (stick: u_th = 0; slip: sigma_t,h = -s u_th /
+    |u_th|), with s the Tresca bound or mu lambda_h (Coulomb)."""
+    trace, law = solution.trace, scene.friction
+    tangent = np.repeat(np.array([-trace.normal[1], trace.normal[0]]), t.size, axis=1)
+    u_t = np.einsum("in,in->n", at_points.value(solution.u), tangent).reshape(trace.size, -1)
+    bound = (law.slip_bound(trace.points(t)) if law.kind == "tresca"
+             else law.coefficient * solution.pressure(t))
+    return np.abs(trace.integrate(bound * np.abs(u_t) + solution.friction.traction(t) * u_t, w))
+
+
 def contact_terms(scene, solution: DiscreteSolution) -> ContactTerms:
     trace = solution.trace
     t, w = (gauss_legendre(QUADRATURE_POINTS) if trace.dim == 2
@@ -87,6 +101,8 @@ def contact_terms(scene, solution: DiscreteSolution) -> ContactTerms:
     if local_geo.sum() > 0:
         local_geo *= geometric / local_geo.sum()
     local_comp = np.abs(trace.integrate(solution.pressure(t) * wval, w))
+    if solution.friction is not None:
+        local_comp += friction_complementarity(scene, solution, at_points, t, w)
     n_elements = solution.elasticity.mesh.t.shape[1]
     per_element = np.bincount(trace.element, weights=local_geo + local_comp, minlength=n_elements)
     return ContactTerms(geometric=geometric, complementarity=float(local_comp.sum()),

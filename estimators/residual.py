@@ -4,7 +4,8 @@ tetrahedra: ``estimators.residual_3d``).
 eta_0^2 = sum_T ( (h_T/p)^2 R_{0,T}^2 + sum_{e in E_T} (h_e/p) R_{0,e}^2 ),
 R_{0,T} = ||f + div sigma(u_h)||_{0,T},
 R_{0,e} = 1/2 ||[sigma_n(u_h)]||_e (interior), ||sigma_n(u_h) - q||_e (Gamma_N),
-          ||sigma_nn(u_h) + lambda_h||_e + ||sigma_nt(u_h)||_e (Gamma_C), 0 on Gamma_D.
+          ||sigma_nn(u_h) + lambda_h||_e + ||sigma_nt(u_h) - sigma_t,h||_e (Gamma_C), 0 on
+          Gamma_D, with sigma_t,h the discrete shear traction with friction (0 without).
 For P1, sigma(u_h) is constant per element, so div sigma(u_h) = 0 and the jumps are constant
 along each edge. h_T is the element diameter, h_e the edge length, p the polynomial order (the
 hp weights of Melenk and Wohlmuth; docs/theory.md, section 9).
@@ -20,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 from skfem import Basis, ElementTetP0, ElementTriP0
 
-from estimators.base import Estimate, combine, register_estimator
+from estimators.base import Estimate, combine, planar_friction, register_estimator
 from estimators.contact_terms import contact_terms
 from estimators.residual_3d import face_residuals_3d, stress_divergence_3d
 from formulations import DiscreteSolution
@@ -130,15 +131,20 @@ def edge_residuals(scene, solution: DiscreteSolution) -> np.ndarray:
     sigma = stress_at(solution, trace.points(t).reshape(2, -1), np.repeat(trace.element, nq))
     sn = np.einsum("ijn,jn->in", sigma, normal)
     snn = np.einsum("in,in->n", sn, normal)
-    snt2 = ((sn - snn * normal) ** 2).sum(axis=0).reshape(-1, nq)
+    # sigma_nt(u_h) - sigma_t,h along t = n turned by +90 degrees (sigma_t,h = 0 frictionless)
+    snt = np.einsum("in,in->n", sn, np.array([-normal[1], normal[0]])).reshape(-1, nq)
+    if solution.friction is not None:
+        snt = snt - solution.friction.traction(t)
     normal_part = np.sqrt(trace.integrate((snn.reshape(-1, nq) + solution.pressure(t)) ** 2, w))
-    r_e = normal_part + np.sqrt(trace.integrate(snt2, w))
+    r_e = normal_part + np.sqrt(trace.integrate(snt**2, w))
     out += np.bincount(trace.element, trace.length / order * r_e**2, n_elements)
     return out
 
 
 @register_estimator("residual", "residual eta_0 (seed paper, section 5) plus the geometric and "
-                                "complementarity contact terms of eq. (8)")
+                                "complementarity contact terms of eq. (8); with friction the "
+                                "shear residual and the friction complementarity (2D)",
+                    applies=planar_friction, friction=True)
 def estimate(scene, solution: DiscreteSolution) -> Estimate:
     return combine("residual", volume_terms(scene, solution), contact_terms(scene, solution))
 

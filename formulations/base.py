@@ -63,7 +63,9 @@ class FrictionState:
     """The friction law's answer at the points where a formulation poses it (the nodes of
     Gamma_C for vi; docs/theory.md, 17.2): their contact coordinate, tangential reaction (a
     force), shear traction sigma_t, tangential displacement (the slip), bound (a force) and
-    state (``FRICTION_STATES``), all computed from the returned arrays."""
+    state (``FRICTION_STATES``), all computed from the returned arrays; ``traction(t)``: the
+    discrete shear traction sigma_t,h at local coordinates t of every contact facet, as
+    ``DiscreteSolution.pressure`` gives lambda_h (t = n turned by +90 degrees)."""
 
     coordinate: np.ndarray
     tangential_reactions: np.ndarray
@@ -71,6 +73,7 @@ class FrictionState:
     slip: np.ndarray
     bound: np.ndarray
     state: np.ndarray
+    traction: Callable[[np.ndarray], np.ndarray]
 
     def zone(self, state: str) -> tuple[float, float]:
         """The end points of the points in ``state`` (NaN, NaN if there are none)."""

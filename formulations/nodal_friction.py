@@ -39,9 +39,17 @@ def friction_rows(scene, nodes, T) -> FrictionRows | None:
     return FrictionRows(T=T, bound=bound, coefficient=law.coefficient)
 
 
+def facet_interpolant(values: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """The piecewise linear interpolant along each 2D facet of its p + 1 nodal ``values``
+    (n_facets, p + 1) at local coordinates t: (n_facets, len(t))."""
+    pieces = values.shape[1] - 1
+    x = np.clip(np.asarray(t, dtype=float), 0.0, 1.0) * pieces
+    k = np.minimum(np.floor(x).astype(int), pieces - 1)
+    return values[:, k] + (values[:, k + 1] - values[:, k]) * (x - k)[None, :]
+
+
 def nodal_friction(friction: FrictionRows, u_free: np.ndarray, reactions: np.ndarray,
-                   tangential: np.ndarray, weight: np.ndarray,
-                   coordinate: np.ndarray) -> FrictionState:
+                   tangential: np.ndarray, nodes, coordinate: np.ndarray) -> FrictionState:
     """The node states and tractions from the returned arrays (never from a solver's sets); a
     node in contact with a zero bound slides freely: it slips."""
     bound = friction.bounds(reactions)
@@ -49,6 +57,7 @@ def nodal_friction(friction: FrictionRows, u_free: np.ndarray, reactions: np.nda
     contact = reactions > STATE_FRACTION * max(reactions.max(initial=0.0), 0.0)
     slipping = size >= bound - STATE_FRACTION * bound.max(initial=0.0)
     state = np.where(~contact, "separated", np.where(slipping, "slip", "stick"))
-    return FrictionState(coordinate=coordinate, tangential_reactions=tangential,
-                         shear=-tangential / weight, slip=friction.T @ u_free, bound=bound,
-                         state=state)
+    shear = -tangential / nodes.weight
+    return FrictionState(coordinate=coordinate, tangential_reactions=tangential, shear=shear,
+                         slip=friction.T @ u_free, bound=bound, state=state,
+                         traction=lambda t: facet_interpolant(shear[nodes.facet_rows], t))

@@ -32,7 +32,12 @@ from formulations.discretisation import Discretisation, discrete_solution
 from formulations.elasticity import assemble_elasticity, check_order
 from formulations.evaluation import evaluate_on_trace
 from formulations.kkt import count_active
-from formulations.nodal_friction import friction_rows, nodal_friction, tangents
+from formulations.nodal_friction import (
+    facet_interpolant,
+    friction_rows,
+    nodal_friction,
+    tangents,
+)
 from formulations.registry import register_formulation
 from formulations.surface_nodes import (
     nodal_pressures,
@@ -132,7 +137,6 @@ def discretise(scene: Scene, mesh: MeshTri, order: int = 1) -> Discretisation:
                    objective_scale=float(scene.material.young_modulus),
                    near_null=elasticity.rigid_modes, friction=friction)
     coordinate = np.asarray(scene.contact_coordinate(nodes.points), dtype=float)
-    pieces = elasticity.order  # lambda_h is linear between consecutive nodes of a facet
 
     def tangential_of(answer: QPSolution) -> np.ndarray:  # NaN where a solve failed
         if answer.tangential is not None:
@@ -149,9 +153,7 @@ def discretise(scene: Scene, mesh: MeshTri, order: int = 1) -> Discretisation:
         def pressure(t):
             if trace.dim == 3:
                 return surface_pressure(values, t)
-            x = np.clip(np.asarray(t, dtype=float), 0.0, 1.0) * pieces
-            k = np.minimum(np.floor(x).astype(int), pieces - 1)
-            return values[:, k] + (values[:, k + 1] - values[:, k]) * (x - k)[None, :]
+            return facet_interpolant(values, t)
 
         return discrete_solution(
             "vi", elasticity, trace, answer, residuals, status, reason, u_free=answer.u,
@@ -161,7 +163,7 @@ def discretise(scene: Scene, mesh: MeshTri, order: int = 1) -> Discretisation:
             details=NodalDetails(reactions=reaction, nodal_pressure=lam,
                                  contact_nodes=nodes.vertices),
             friction=None if friction is None else nodal_friction(
-                friction, answer.u, reaction, tangential_of(answer), nodes.weight, coordinate))
+                friction, answer.u, reaction, tangential_of(answer), nodes, coordinate))
 
     return Discretisation(formulation="vi", elasticity=elasticity, trace=trace, qp=qp,
                           recover=recover, row_coordinate=coordinate)

@@ -57,6 +57,15 @@ def pressure_error(solution: DiscreteSolution, true_pressure, trace=None) -> flo
     return float(np.sqrt(trace.integrate(diff**2, w).sum()))
 
 
+def shear_error(solution: DiscreteSolution, true_shear) -> float:
+    """||sigma_t - sigma_t,h||_{0,Gamma_C} on u_h's contact facets (2D), with
+    ``true_shear(s)`` a function of the contact coordinate."""
+    trace = solution.trace
+    t, w = gauss_legendre(PRESSURE_POINTS)
+    diff = true_shear(trace.coordinates_at(t)) - solution.friction.traction(t)
+    return float(np.sqrt(trace.integrate(diff**2, w).sum()))
+
+
 def errors_from(energy_error: float, solution: DiscreteSolution, true_pressure,
                 true_zone) -> Errors:
     """The pressure and zone errors of ``solution`` beside a measured energy-norm error."""

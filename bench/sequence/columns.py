@@ -6,7 +6,9 @@ from __future__ import annotations
 
 import time
 
+from bench.measure.contact import zone_error
 from bench.measure.difference import solution_difference
+from bench.measure.discretisation_error import shear_error
 from formulations import STATUS_FAILED, STATUS_SKIPPED, SolverDiagnostics, solve
 from formulations.diagnostics import inf_sup_constant, pressure_oscillation
 from formulations.discretisation import why_unsolvable
@@ -26,6 +28,25 @@ def error_columns(truth, solution, estimate) -> dict:
                    effectivity_complementarity=estimate.eta_complementarity
                    / errors.energy_error)
     out["t_error"] = time.perf_counter() - start
+    return out
+
+
+def friction_columns(scene, solution) -> dict:
+    """The friction law and its answer (docs/columns.md): points that stick and slip, the
+    stick zone and, against an exact solution that has them, its error and the shear
+    traction's."""
+    out = {"friction": scene.friction.label}
+    state = solution.friction
+    if state is None:
+        return out
+    zone = state.zone("stick")
+    out.update(stick_points=int((state.state == "stick").sum()),
+               slip_points=int((state.state == "slip").sum()),
+               stick_zone_start=zone[0], stick_zone_end=zone[1])
+    exact = scene.exact
+    if exact is not None and exact.stick_zone is not None:
+        out.update(stick_zone_error=zone_error(zone, exact.stick_zone),
+                   shear_error=shear_error(solution, exact.shear))
     return out
 
 

@@ -14,6 +14,7 @@ from bench.sequence.columns import (
     crosscheck_columns,
     diagnostic_columns,
     error_columns,
+    friction_columns,
     solver_columns,
 )
 from bench.sequence.marking import MARKINGS, check_marking, grade_contact_trace, mark
@@ -242,6 +243,7 @@ def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
         if not failed:
             numbers.update(diagnostic_columns(disc, sol, config.diagnostics,
                                               options.get("backend")))
+            numbers.update(friction_columns(scene, sol))
             numbers.update(eta=est.eta, eta_0=est.eta_0, eta_geometric=est.eta_geometric,
                            eta_complementarity=est.eta_complementarity,
                            **(est.bound.columns() if est.bound is not None else {}))

@@ -58,6 +58,13 @@ class ResultRow:
     zone_error: float = math.nan
     contact_zone_start: float = math.nan
     contact_zone_end: float = math.nan
+    friction: str = ""  # the scene's friction law (scenes.friction): none, tresca, coulomb(mu=..)
+    stick_points: int = 0
+    slip_points: int = 0
+    stick_zone_start: float = math.nan
+    stick_zone_end: float = math.nan
+    stick_zone_error: float = math.nan
+    shear_error: float = math.nan
     effectivity_index: float = math.nan
     effectivity_0: float = math.nan
     effectivity_geometric: float = math.nan
