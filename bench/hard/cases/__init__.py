@@ -4,6 +4,7 @@ case is one new module here and one import line below."""
 
 from bench.hard.cases import (  # noqa: F401
     cycling,
+    friction,
     invalid,
     mixed_patches_3d,
     mixed_ratio,

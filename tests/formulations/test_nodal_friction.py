@@ -1,0 +1,124 @@
+"""Friction in the nodal VI: the box iteration, the fast solve against the reference, the
+Coulomb fixed point and its verdict, and the refusals of the formulations without it."""
+
+import numpy as np
+import pytest
+
+from bench.measure.difference import solution_difference
+from formulations import get_formulation, solve
+from formulations.kkt import RESIDUAL_TOLERANCE, qp_residuals
+from formulations.registry import FORMULATIONS
+from formulations.solvers.backends import available_backends, iterative
+from formulations.solvers.box import AT_LOWER, AT_UPPER, FREE, box_pdas, initial_state
+from scenes import get_scene
+
+
+def test_box_pdas_solves_a_diagonal_box_qp_exactly():
+    # S = diag(d): lam_i = clip(r_i / d_i, lower_i, upper_i) is the unique minimiser
+    d = np.array([1.0, 2.0, 4.0, 0.5, 1.0])
+    r = np.array([3.0, -3.0, 2.0, -0.1, 0.2])
+    lower = np.array([0.0, -1.0, -0.25, -1.0, 0.0])
+    upper = np.array([np.inf, 1.0, 0.25, 1.0, 0.0])  # the last is pinned at 0
+    result = box_pdas(np.diag(d), r, lower, upper, initial_state(r, lower, upper))
+    assert result.status == "ok"
+    # the free entries come from an LU solve of a diagonal block: exact up to one rounding
+    assert result.lam == pytest.approx(np.clip(r / d, lower, upper), rel=1e-15, abs=0)
+    assert list(result.state) == [FREE, AT_LOWER, AT_UPPER, FREE, AT_LOWER]
+
+
+def test_box_pdas_reports_a_cycle_instead_of_looping():
+    S = np.array([[2.0, -1.9], [-1.9, 2.0]])
+    r = np.array([1.0, -1.0])
+    result = box_pdas(S, r, np.full(2, -0.1), np.full(2, 0.1),
+                      np.array([AT_UPPER, AT_UPPER]), max_iter=1)
+    assert result.status == "failed" and "still changing" in result.reason
+
+
+CASES = [("paper", dict(friction="tresca", slip_bound=300.0), 1),
+         ("paper", dict(friction="coulomb", mu=0.3), 1),
+         ("paper", dict(friction="coulomb", mu=1.0), 2),
+         ("stick-slip", dict(), 3),
+         ("stick-slip", dict(friction="coulomb"), 2)]
+
+
+@pytest.mark.parametrize("name, parameters, order", CASES)
+def test_the_fast_solve_is_exact_and_agrees_with_the_reference(name, parameters, order):
+    scene = get_scene(name, **parameters)
+    disc = get_formulation("vi")(scene, scene.mesh.refined(2), order=order)
+    fast, reference = solve(disc, "active-set"), solve(disc, "reference")
+    assert fast.status == "ok" and reference.status == "ok", (fast.reason, reference.reason)
+    # exact box sets: every residual at round-off (the Coulomb fixed point stops at 1e-11)
+    assert max(vars(fast.residuals).values()) < 1e-10, fast.residuals
+    energy, pressure = solution_difference(disc, fast, reference)
+    shear = (np.abs(fast.friction.shear - reference.friction.shear).max()
+             / np.abs(reference.friction.shear).max())
+    # Clarabel at 1e-12 (1e-10 where it stalls) leaves ~2e-9 in u and ~2e-8 in the tractions
+    # on these meshes; a wrong stick/slip set differs by 1e-3 or more
+    assert energy < 1e-7 and pressure < 1e-5 and shear < 1e-5, (energy, pressure, shear)
+    assert list(fast.friction.state) == list(reference.friction.state)
+
+
+@pytest.mark.parametrize("backend", available_backends())
+def test_every_backend_gives_the_same_tresca_answer(backend):
+    scene = get_scene("stick-slip")
+    disc = get_formulation("vi")(scene, scene.mesh.refined(2))
+    answer, direct = solve(disc, "active-set", backend=backend), solve(disc, "active-set",
+                                                                       backend="splu")
+    assert answer.status == "ok" and answer.backend == backend
+    energy, _ = solution_difference(disc, answer, direct)
+    # a direct back-end: round-off; amg: its Krylov stopping rule, 1e-10 relative
+    assert energy < (1e-8 if iterative(backend) else 1e-12)
+
+
+def test_the_fixed_point_is_relaxed_where_it_cycles_and_fails_where_it_is_too_slow():
+    mesh = get_scene("paper").mesh.refined(3)
+    # mu = 10: the plain fixed point repeats a change of 3.5e-2; halving the step converges
+    scene = get_scene("paper", friction="coulomb", mu=10.0)
+    answer = solve(get_formulation("vi")(scene, mesh), "active-set")
+    assert answer.status == "ok" and max(vars(answer.residuals).values()) < 1e-10
+    scene = get_scene("paper", friction="coulomb", mu=30.0)
+    answer = solve(get_formulation("vi")(scene, mesh), "active-set")
+    assert answer.status == "failed"
+    assert "Coulomb fixed point not converged after 100 Tresca steps" in answer.reason
+    assert "mu=30 too large" in answer.reason
+
+
+def test_the_friction_residuals_catch_a_wrong_tangential_reaction():
+    scene = get_scene("stick-slip")
+    disc = get_formulation("vi")(scene, scene.mesh.refined(2))
+    fast = solve(disc, "active-set")
+    qp, u, lam_n = disc.qp, fast.u[disc.elasticity.free], fast.multipliers
+    lam_t = fast.friction.tangential_reactions
+    assert max(vars(qp_residuals(qp, u, lam_n, lam_t)).values()) < 1e-10
+    beyond = qp_residuals(qp, u, lam_n, 2 * lam_t)  # over the bound, out of equilibrium
+    # a slipping node's 2 |lambda_t| exceeds its bound b by b: half of the scale max |2 lambda_t|
+    assert beyond.dual_violation == pytest.approx(0.5, rel=1e-12)
+    assert beyond.stationarity > 1e-3
+    reversed_slip = qp_residuals(qp, u, lam_n, -lam_t)  # pushes along the slip
+    # 2 sum b |T u| relative to the energy: small slips, but far above what an answer called
+    # ok may leave (RESIDUAL_TOLERANCE)
+    assert reversed_slip.complementarity > 10 * RESIDUAL_TOLERANCE
+
+
+def test_the_nodes_stick_slip_and_separate_where_the_exact_solution_does():
+    scene = get_scene("stick-slip")
+    disc = get_formulation("vi")(scene, scene.mesh.refined(4))
+    state = solve(disc, "active-set").friction
+    s = state.coordinate
+    # one mesh size (1/32) away from the exact ends b = 0.2, a = 0.4 (the traction reaches its
+    # bound quadratically at b, so the discrete end lies within a few h of it)
+    assert set(state.state[np.abs(s) < 0.2 - 0.1]) == {"stick"}
+    assert set(state.state[(np.abs(s) > 0.2 + 0.07) & (np.abs(s) < 0.4 - 0.04)]) == {"slip"}
+    assert set(state.state[np.abs(s) > 0.4 + 0.04]) == {"separated"}
+
+
+@pytest.mark.parametrize("formulation", FORMULATIONS.names())
+def test_a_formulation_without_friction_refuses_the_scene(formulation):
+    scene = get_scene("stick-slip")
+    why = FORMULATIONS.why_not(formulation, scene=scene)
+    if FORMULATIONS.meta(formulation, "friction", False):
+        assert why is None
+        assert FORMULATIONS.why_not(formulation, scene=get_scene("paper")) is None
+    else:
+        assert why == (f"formulation {formulation!r} does not model friction (the scene's "
+                       "law is tresca)")
