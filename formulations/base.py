@@ -27,14 +27,20 @@ STATUS_SKIPPED = "skipped"
 @dataclass(frozen=True, eq=False)
 class FrictionRows:
     """Friction on the constraint nodes of a ``ContactQP`` (docs/theory.md, 17.2): the objective
-    gains sum_i b_i |T_i u| with T_i the ``block`` (d - 1) tangential rows of node i (row i of B
-    is its normal row) and b_i its slip bound, a force: the given ``bound`` (Tresca), or
-    ``coefficient`` times the node's normal reaction (Coulomb: a fixed point on the bound)."""
+    gains sum_i b_i |T_i u - w_i| with T_i the ``block`` (d - 1) tangential rows of node i (row
+    i of B is its normal row), w_i the obstacle's tangential displacement (``shift``, 0 if
+    None) and b_i the slip bound, a force: the given ``bound`` (Tresca), or ``coefficient``
+    times the node's normal reaction (Coulomb: a fixed point on the bound)."""
 
     T: sparse.csr_matrix
     bound: np.ndarray
     coefficient: float = 0.0
     block: int = 1
+    shift: np.ndarray | None = None  # the obstacle's tangential displacement per row of T
+
+    def slip(self, u: np.ndarray) -> np.ndarray:
+        """T u minus the obstacle's own tangential displacement: the slip per row of T."""
+        return self.T @ u if self.shift is None else self.T @ u - self.shift
 
     @property
     def coulomb(self) -> bool:
@@ -48,7 +54,8 @@ class FrictionRows:
 
     def with_bound(self, bound: np.ndarray) -> FrictionRows:
         """The Tresca problem with slip bound ``bound`` (a Coulomb fixed point's step)."""
-        return FrictionRows(T=self.T, bound=np.asarray(bound, dtype=float), block=self.block)
+        return FrictionRows(T=self.T, bound=np.asarray(bound, dtype=float), block=self.block,
+                            shift=self.shift)
 
     def node_norms(self, values: np.ndarray) -> np.ndarray:
         """|v_i| per node of a tangential vector (block entries per node, node-major)."""
@@ -74,6 +81,7 @@ class FrictionState:
     bound: np.ndarray
     state: np.ndarray
     traction: Callable[[np.ndarray], np.ndarray]
+    bound_traction: np.ndarray  # the bound as a stress (s(x_i), or mu lambda_h(x_i))
 
     def zone(self, state: str) -> tuple[float, float]:
         """The end points of the points in ``state`` (NaN, NaN if there are none)."""

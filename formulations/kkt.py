@@ -76,7 +76,7 @@ def friction_terms(qp: ContactQP, u: np.ndarray, lam: np.ndarray,
     size = friction.node_norms(tangential)
     excess = np.maximum(size - bound, 0.0).max(initial=0.0)
     excess /= _scale(bound.max(initial=0.0), size.max(initial=0.0))
-    slip = friction.T @ u
+    slip = friction.slip(u)
     gap = abs(bound @ friction.node_norms(slip) - tangential @ slip)
     return float(excess), float(gap)
 

@@ -36,7 +36,8 @@ def friction_rows(scene, nodes, T) -> FrictionRows | None:
     if np.any(bound < 0) or not np.all(np.isfinite(bound)):
         raise ValueError("slip_bound is negative or not finite at a contact node (it must be "
                          "a finite function >= 0 on Gamma_C)")
-    return FrictionRows(T=T, bound=bound, coefficient=law.coefficient)
+    shift = np.full(nodes.weight.size, law.slide) if law.slide else None
+    return FrictionRows(T=T, bound=bound, coefficient=law.coefficient, shift=shift)
 
 
 def facet_interpolant(values: np.ndarray, t: np.ndarray) -> np.ndarray:
@@ -59,5 +60,6 @@ def nodal_friction(friction: FrictionRows, u_free: np.ndarray, reactions: np.nda
     state = np.where(~contact, "separated", np.where(slipping, "slip", "stick"))
     shear = -tangential / nodes.weight
     return FrictionState(coordinate=coordinate, tangential_reactions=tangential, shear=shear,
-                         slip=friction.T @ u_free, bound=bound, state=state,
+                         slip=friction.slip(u_free), bound=bound, state=state,
+                         bound_traction=bound / nodes.weight,
                          traction=lambda t: facet_interpolant(shear[nodes.facet_rows], t))

@@ -110,6 +110,30 @@ class ContactPrediction:
         return self.peak_pressure * np.sqrt(np.clip(1.0 - r**2, 0.0, None))
 
 
+@dataclass(frozen=True)
+class StickPrediction:
+    """A closed-form partial-slip answer (Cattaneo-Mindlin's) at given normal and tangential
+    forces: the stick zone's half-width, and the shear traction q(s) of the slip and stick zones
+    (Hertz's half-width and peak pressure beside them)."""
+
+    stick_half_width: float
+    half_width: float
+    peak_pressure: float
+    coefficient: float
+    direction: float = 1.0  # the sign of the shear traction (along t)
+    centre: float = 0.0
+    label: str = ""
+
+    def shear(self, s: np.ndarray) -> np.ndarray:
+        """mu p0 (sqrt(1 - x^2/b^2)_+ - (c/b) sqrt(1 - x^2/c^2)_+), x = s - centre (Johnson,
+        Contact Mechanics, 7.1)."""
+        x = np.asarray(s, dtype=float) - self.centre
+        b, c = self.half_width, self.stick_half_width
+        outer = np.sqrt(np.clip(1.0 - (x / b) ** 2, 0.0, None))
+        inner = (c / b) * np.sqrt(np.clip(1.0 - (x / c) ** 2, 0.0, None)) if c > 0 else 0.0
+        return self.direction * self.coefficient * self.peak_pressure * (outer - inner)
+
+
 @dataclass(frozen=True, eq=False)
 class Scene:
     """A Signorini problem on a 2D or 3D body (docs/theory.md, sections 2 and 14).
@@ -137,6 +161,9 @@ class Scene:
     exact: ExactSolution | None = None
     # a closed-form contact pressure for the computed contact force, where theory has one
     predict_contact: Callable[[float], ContactPrediction] | None = None
+    # a closed-form stick zone and shear traction for the computed normal and tangential
+    # forces (P, Q), where theory has one (Cattaneo-Mindlin on hertz with a sliding obstacle)
+    predict_stick: Callable[[float, float], StickPrediction] | None = None
     # the corners where the solution may be singular (scenes.corners), for rate predictions
     corners: tuple = ()
     # the friction law on Gamma_C (scenes.friction; frictionless unless a scene says otherwise)

@@ -8,8 +8,10 @@ Where |sigma_t| < bound the point sticks (u_t = 0); where it slips, sigma_t = -b
 (friction opposes the slip).
 
 Scenes take the law from three parameters, so that options and sweeps work as for every other
-parameter (``paper:friction=coulomb,mu=0.1|0.3``): ``friction`` (the law's name), ``mu`` (the
-Coulomb coefficient) and ``slip_bound`` (a constant Tresca bound s, a stress).
+parameter (``paper:friction=coulomb:mu=0.1|0.3``): ``friction`` (the law's name), ``mu`` (the
+Coulomb coefficient) and ``slip_bound`` (a constant Tresca bound s, a stress). A scene may also
+let the obstacle slide along t by a constant ``slide`` (a length; Cattaneo-Mindlin's tangential
+loading): the slip is then u_t - slide.
 """
 
 from __future__ import annotations
@@ -31,6 +33,8 @@ class FrictionLaw:
     kind: str = "none"
     coefficient: float = 0.0
     slip_bound: PointFunction | None = None
+    # the obstacle's own displacement along t (a length): the slip is u_t - slide
+    slide: float = 0.0
 
     def __post_init__(self):
         if self.kind not in LAWS:
@@ -54,7 +58,7 @@ NO_FRICTION = FrictionLaw()
 
 
 def friction_law(friction: str = "none", mu: float = 0.0, slip_bound: float = 0.0,
-                 tresca_bound: PointFunction | None = None) -> FrictionLaw:
+                 tresca_bound: PointFunction | None = None, slide: float = 0.0) -> FrictionLaw:
     """The law from a scene's parameters: ``tresca`` takes the constant ``slip_bound`` (a
     stress, > 0) unless the scene gives its own bound function ``tresca_bound``; ``coulomb``
     takes ``mu`` (> 0). A parameter that the law does not use must keep its default, so that a
@@ -69,15 +73,20 @@ def friction_law(friction: str = "none", mu: float = 0.0, slip_bound: float = 0.
     if friction != "tresca" and slip_bound != 0:
         raise SceneError(f"slip_bound={slip_bound!r} needs friction='tresca' "
                          f"(friction={friction!r})")
+    if not (is_number(slide) and np.isfinite(slide)):
+        raise SceneError(f"slide={slide!r} is not a finite number")
+    if friction == "none" and slide != 0:
+        raise SceneError(f"slide={slide!r} needs a friction law (friction='none': a "
+                         "frictionless obstacle slides without effect)")
     if friction == "coulomb":
         if mu <= 0:
             raise SceneError(f"mu={mu!r} is not > 0 (friction='coulomb')")
-        return FrictionLaw("coulomb", coefficient=float(mu))
+        return FrictionLaw("coulomb", coefficient=float(mu), slide=float(slide))
     if friction == "tresca":
         if tresca_bound is None:
             if slip_bound <= 0:
                 raise SceneError(f"slip_bound={slip_bound!r} is not > 0 (friction='tresca')")
             s = float(slip_bound)
             tresca_bound = lambda x: np.full(np.shape(x)[1:], s)  # noqa: E731
-        return FrictionLaw("tresca", slip_bound=tresca_bound)
+        return FrictionLaw("tresca", slip_bound=tresca_bound, slide=float(slide))
     return NO_FRICTION

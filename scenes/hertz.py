@@ -12,15 +12,33 @@ and E* = E / (1 - nu^2) (a rigid flat), Hertz gives the contact half-width and p
 valid while b << D and b << W (the half-space assumption); the defaults give b ~ 0.1 against
 D = W = 2. The approach delta itself has no closed form in 2D (it depends on the body's size),
 which is why the comparison is made at the computed force P.
+
+With Coulomb friction (``friction="coulomb"``, ``mu``) and an obstacle that slides along x by
+``slide`` after pressing (Cattaneo and Mindlin's loading: normal first, then tangential), the
+tangential force Q < mu P leaves a stick zone |x| < c = b sqrt(1 - Q / (mu P)) and the shear
+traction q(x) = mu p0 (sqrt(1 - x^2/b^2) - (c/b) sqrt(1 - x^2/c^2)) (Johnson, section 7.1),
+compared at the computed P and Q. That theory neglects the coupling of normal and tangential
+tractions, exact for an incompressible body on a rigid base (nu -> 1/2) and an approximation
+otherwise.
 """
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
-from scenes.base import ContactPrediction, Material, Scene, SceneError, is_integer
+from scenes.base import (
+    ContactPrediction,
+    Material,
+    Scene,
+    SceneError,
+    StickPrediction,
+    is_integer,
+)
 from scenes.budget import tensor_mesh
 from scenes.corners import Corner
+from scenes.friction import friction_law
 from scenes.registry import register_scene
 
 _TOL = 1e-10
@@ -43,32 +61,55 @@ def hertz_contact(young_modulus: float, poisson_ratio: float, radius: float,
     return ContactPrediction(b, p0, label=f"Hertz, b = {b:.4g}, p0 = {p0:.4g}")
 
 
+def cattaneo_mindlin(mu: float, slide: float):
+    """(P, Q) -> Cattaneo-Mindlin's partial slip under Hertz's pressure: the stick zone
+    c = b sqrt(1 - |Q| / (mu P)), the shear traction along the obstacle's slide."""
+    def predict(scene_material: Material, radius: float, P: float, Q: float) -> StickPrediction:
+        hertz = hertz_contact(scene_material.young_modulus, scene_material.poisson_ratio,
+                              radius, P)
+        ratio = float(np.clip(1.0 - abs(Q) / (mu * P), 0.0, 1.0))
+        c = hertz.half_width * np.sqrt(ratio)
+        return StickPrediction(c, hertz.half_width, hertz.peak_pressure, mu,
+                               direction=float(np.sign(slide)),
+                               label=f"Cattaneo-Mindlin, c = {c:.4g}, b = {hertz.half_width:.4g}")
+    return predict
+
+
 @register_scene("hertz", "Hertz line contact: a block pressed by a rigid parabola of radius R "
                          "(half-space model), plane strain; closed-form width and peak pressure",
                 tags=("exact", "hertz"), dim=2)
 def hertz(young_modulus: float = 1000.0, poisson_ratio: float = 0.3, radius: float = 1.0,
-          approach: float = 0.005, half_size: float = 2.0, initial_divisions: int = 16) -> Scene:
+          approach: float = 0.005, half_size: float = 2.0, initial_divisions: int = 16,
+          friction: str = "none", mu: float = 0.0, slip_bound: float = 0.0,
+          slide: float = 0.0) -> Scene:
     if not (is_integer(initial_divisions) and initial_divisions >= 2
             and initial_divisions % 2 == 0):
         raise SceneError(f"initial_divisions={initial_divisions!r} is not an even integer >= 2")
     initial_divisions = int(initial_divisions)
     W = D = float(half_size)
+    material = Material(young_modulus, poisson_ratio, "strain")
+    law = friction_law(friction, mu, slip_bound, slide=slide)
+    # the frictionless scene keeps its parameters (and its cached references' keys)
+    with_friction = ({"friction": friction, "mu": float(mu), "slip_bound": float(slip_bound),
+                      "slide": float(slide)} if law.active else {})
     xs = np.linspace(-W, W, initial_divisions + 1)
     ys = np.linspace(-D, 0.0, initial_divisions // 2 + 1)
     return Scene(
         name="hertz",
         description="block (-W,W)x(-D,0) pressed up by the parabola y = x^2/(2R) - delta - D",
-        mesh=tensor_mesh(xs, ys), material=Material(young_modulus, poisson_ratio,
-                                                            "strain"),
+        mesh=tensor_mesh(xs, ys), material=material,
         is_dirichlet=lambda x: np.abs(x[1]) < _TOL,
         is_contact=lambda x: np.abs(x[1] + D) < _TOL,
         gap=lambda x: x[0] ** 2 / (2 * radius) - approach,
         contact_coordinate=lambda x: x[0],
         parameters={"young_modulus": young_modulus, "poisson_ratio": poisson_ratio,
                     "radius": radius, "approach": approach, "half_size": half_size,
-                    "initial_divisions": initial_divisions},
+                    "initial_divisions": initial_divisions, **with_friction},
         tags=("exact", "hertz"),
         predict_contact=lambda force: hertz_contact(young_modulus, poisson_ratio, radius, force),
         corners=(Corner((-W, 0.0), np.pi / 2, ("clamped", "free")),
                  Corner((W, 0.0), np.pi / 2, ("clamped", "free"))),
+        friction=law,
+        predict_stick=(functools.partial(cattaneo_mindlin(mu, law.slide), material, radius)
+                       if law.kind == "coulomb" and law.slide else None),
     )

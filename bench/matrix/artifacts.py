@@ -16,6 +16,7 @@ import numpy as np
 from bench.measure.contact import contact_zone
 from bench.measure.discretisation_error import element_energy_errors
 from bench.sequence.rows import name_parts
+from formulations.base import FRICTION_STATES
 from formulations.contact_surface import TRIANGLE_VERTICES
 from formulations.elasticity import von_mises
 
@@ -71,9 +72,23 @@ def save_artifact(path: Path, result, scene=None) -> Path | None:
         trace_coordinate=sol.trace.coordinate,
         pressure=sol.pressure(PRESSURE_SAMPLES) if dim == 2 else ends,
         zone=np.array(contact_zone(sol)), contact_force=sol.contact_force(),
-        ndofs=sol.elasticity.ndofs, level=result.row.level)
+        ndofs=sol.elasticity.ndofs, level=result.row.level, **friction_fields(sol))
     os.replace(tmp, path)
     return path
+
+
+def friction_fields(sol) -> dict:
+    """With friction, per friction point: its contact coordinate, the shear traction, the
+    bound as a stress and the state (0 separated, 1 stick, 2 slip: FRICTION_STATES); and the
+    normal and tangential forces on the body (sums of the reactions)."""
+    state = sol.friction
+    if state is None:
+        return {}
+    code = (state.state[:, None] == np.array(FRICTION_STATES)[None, :]).argmax(axis=1)
+    return dict(friction_coordinate=state.coordinate, friction_shear=state.shear,
+                friction_bound=state.bound_traction, friction_state=code,
+                friction_forces=np.array([sol.multipliers.sum(),
+                                          -state.tangential_reactions.sum()]))
 
 
 def publish_last_level(out: str | Path, row) -> Path | None:

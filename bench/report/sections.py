@@ -10,7 +10,7 @@ import numpy as np
 import pandas as pd
 
 from bench.matrix.artifacts import artifact_path, file_stem, load_artifact
-from bench.report import figures, figures_3d, panels
+from bench.report import figures, figures_3d, friction_figures, panels
 from bench.sequence.rows import KEYS
 from scenes import get_scene
 
@@ -72,6 +72,24 @@ def _pressure_curve(scene, artifacts: dict):
     return s, predicted.pressure(s), predicted.label
 
 
+def _shear_curve(scene, artifacts: dict):
+    """The true shear traction: the exact one, or the scene's partial-slip prediction at the
+    forces of the first adaptive artifact with friction."""
+    if scene is None or scene.dim != 2:
+        return None
+    if scene.exact is not None and scene.exact.shear is not None:
+        s = np.linspace(*np.sort(scene.contact_coordinate(scene.mesh.p))[[0, -1]], 801)
+        return s, scene.exact.shear(s), "exact shear traction"
+    data = next(iter(v for k, v in sorted(artifacts.items())
+                     if k[2] == "adaptive" and "friction_forces" in v), None)
+    if scene.predict_stick is None or data is None:
+        return None
+    predicted = scene.predict_stick(*map(float, data["friction_forces"]))
+    b = predicted.half_width
+    s = np.linspace(predicted.centre - 1.5 * b, predicted.centre + 1.5 * b, 601)
+    return s, predicted.shear(s), predicted.label
+
+
 def _first_adaptive(artifacts: dict):
     return next(iter(v for k, v in sorted(artifacts.items()) if k[2] == "adaptive"), None)
 
@@ -88,7 +106,11 @@ def field_figures(scene, name: str, artifacts: dict, preferred) -> tuple:
          "the clamped corners (the paper's Figure 1a)."),
         (figures.pressures(artifacts, _pressure_curve(scene, artifacts)), "pressure",
          "Contact pressure lambda_h along Gamma_C (adaptive, last level) per formulation; "
-         "dotted lines are the contact-zone end points."))
+         "dotted lines are the contact-zone end points."),
+        (friction_figures.shear_traction(artifacts, _shear_curve(scene, artifacts)), "shear",
+         "Shear traction sigma_t,h along Gamma_C (adaptive, last level) per formulation, "
+         "dotted: the friction bound; below, where each friction point sticks, slips or is "
+         "separated."))
 
 
 def field_figures_3d(artifacts: dict) -> tuple:

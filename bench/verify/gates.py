@@ -20,6 +20,7 @@ from bench.matrix.rates import rates_table
 from bench.sequence.rows import KEYS
 from bench.verify.closed_form import closed_form_table
 from bench.verify.expected import EXPECTED, load_expected
+from bench.verify.partial_slip import partial_slip_table
 from bench.verify.truth_checks import error_bar_table, truth_table
 
 
@@ -103,12 +104,13 @@ def verify(out: str | Path = "results-verify", expected_path: str | Path = EXPEC
     rows = run_gate_matrices(expected, out, on_level, workers)
     rates = rates_table(rows)
     closed_form = closed_form_table(expected["closed_form"])
+    partial_slip = partial_slip_table(expected["partial_slip"])
     truth = truth_table(expected["truth"], quick)
     bars = error_bar_table(expected["truth"], quick)
-    for name, table in (("rates", rates), ("closed-form", closed_form), ("truth", truth),
-                        ("error-bar", bars)):
+    for name, table in (("rates", rates), ("closed-form", closed_form),
+                        ("partial-slip", partial_slip), ("truth", truth), ("error-bar", bars)):
         table.to_csv(Path(out) / f"{name}.csv", index=False)
-    verdicts = check_gates(expected, [rates, closed_form, truth, bars], quick)
+    verdicts = check_gates(expected, [rates, closed_form, partial_slip, truth, bars], quick)
     if hard:
         table = run_hard()
         write_hard(table, out)

@@ -4,10 +4,11 @@
 With C = [B; T] (normal rows, then the tangential rows of the same nodes), u = K^-1 (F - C'lam)
 and the Tresca problem's dual is the box QP
 
-    min 1/2 lam'S lam - r'lam,  S = C K^-1 C',  r = C K^-1 F - [G; 0],
+    min 1/2 lam'S lam - r'lam,  S = C K^-1 C',  r = C K^-1 F - [G; w],
     lam_n >= 0,  -b <= lam_t <= b,
 
-solved exactly by ``box.box_pdas`` (the slack r - S lam is [Bu - G; Tu]: a free normal entry is
+with w the obstacle's tangential displacement (0 unless it slides), solved exactly by
+``box.box_pdas`` (the slack r - S lam is [Bu - G; Tu - w]: a free normal entry is
 a node in contact, a free tangential one a node that sticks, one at a bound a node that slips).
 K is factorised once and S comes from the same factorisation, as in the frictionless
 ``active_set``; Coulomb's fixed point (``coulomb``) reuses both for every step, so a Coulomb
@@ -58,7 +59,9 @@ def condensed_system(qp: ContactQP, backend: str):
              else solve(columns))
         S, phases = np.asarray(C @ X), []
     u0 = solve(qp.F)
-    r = C @ u0 - np.concatenate([qp.G, np.zeros(qp.friction.T.shape[0])])
+    shift = qp.friction.shift
+    r = C @ u0 - np.concatenate([qp.G, np.zeros(qp.friction.T.shape[0]) if shift is None
+                                 else shift])
     phases.append(("condense", time.perf_counter() - clock))
     return solve, C, S, r, phases
 

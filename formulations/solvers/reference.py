@@ -113,4 +113,5 @@ def friction_term(qp: ContactQP, u: cp.Variable, objective, d: float):
     z = cp.Variable(friction.T.shape[0])
     weight = friction.bound / (qp.objective_scale * d)
     T = friction.T.tocsr()
-    return objective + weight @ z, [T @ u - z <= 0, -T @ u - z <= 0]
+    shift = np.zeros(T.shape[0]) if friction.shift is None else friction.shift / d
+    return objective + weight @ z, [T @ u - shift - z <= 0, -(T @ u - shift) - z <= 0]
