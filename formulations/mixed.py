@@ -46,7 +46,12 @@ from formulations.discretisation import Discretisation, discrete_solution
 from formulations.elasticity import assemble_elasticity, check_order
 from formulations.evaluation import drop_roundoff, normal_trace_matrix
 from formulations.kkt import count_active
-from formulations.registry import register_formulation
+from formulations.mixed_friction import (
+    mixed_friction_rows,
+    mixed_friction_state,
+    tangential_rows,
+)
+from formulations.registry import planar_friction, register_formulation
 from scenes import Scene
 from scenes.base import is_integer, is_number
 
@@ -132,7 +137,9 @@ def segment_weights(trace, segment: np.ndarray, breaks: np.ndarray, degree: int,
 @register_formulation("mixed", "Haslinger's mixed method: multiplier of degree p - 1 "
                                "(piecewise constant for P1) on a coarser contact mesh, "
                                "h/H <= 1/2 (seed paper, eq. (3)); in 3D piecewise constant "
-                               "on vertex-star patches of contact triangles")
+                               "on vertex-star patches of contact triangles; Tresca or "
+                               "Coulomb friction with a tangential multiplier in the same "
+                               "space (2D)", planar_friction, friction=True)
 def discretise(scene: Scene, mesh: MeshTri, h_over_H: float = 0.5, order: int = 1,
                multiplier_degree: int | None = None) -> Discretisation:
     """``h_over_H``: the largest allowed ratio of a facet to its multiplier segment. The
@@ -165,13 +172,17 @@ def discretise(scene: Scene, mesh: MeshTri, h_over_H: float = 0.5, order: int = 
     t, w = gauss_legendre(order + 1)
     B = segment_weights(trace, segment, breaks, degree, t, w) @ normal_trace_matrix(
         elasticity.basis, trace, t)
+    friction = (tangential_rows(elasticity, trace, segment_weights(
+        trace, segment, breaks, degree, t, w), t) if scene.friction.active else None)
     t, w = gauss_legendre(GAP_QUADRATURE_POINTS)
-    G = segment_weights(trace, segment, breaks, degree, t, w) @ np.ravel(
-        scene.gap(trace.points(t)))
+    fine = segment_weights(trace, segment, breaks, degree, t, w)
+    G = fine @ np.ravel(scene.gap(trace.points(t)))
+    if friction is not None:
+        friction = mixed_friction_rows(scene, friction, trace, fine, t)
     qp = ContactQP(K=elasticity.K_free, F=elasticity.F_free,
                    B=elasticity.restrict(B), G=G, row_scale=np.repeat(H, degree + 1),
                    objective_scale=float(scene.material.young_modulus),
-                   near_null=elasticity.rigid_modes)
+                   near_null=elasticity.rigid_modes, friction=friction)
     # each coefficient sits at its Greville point k / q of the segment (the middle for q = 0)
     greville = np.array([0.5]) if degree == 0 else np.linspace(0.0, 1.0, degree + 1)
     row_coordinate = (breaks[:-1, None] + np.diff(breaks)[:, None] * greville).ravel()
@@ -185,7 +196,10 @@ def discretise(scene: Scene, mesh: MeshTri, h_over_H: float = 0.5, order: int = 
                                           segment_basis(trace, segment, breaks, degree, tt),
                                           lam.reshape(-1, degree + 1)[segment]),
             multiplier_breaks=breaks, active_constraints=count_active(qp, answer.u, lam),
-            max_h_over_H=h_over_H, details=MixedDetails(segment_of_facet=segment))
+            max_h_over_H=h_over_H, details=MixedDetails(segment_of_facet=segment),
+            friction=None if friction is None else mixed_friction_state(
+                friction, answer.u, lam, answer.tangential, row_coordinate,
+                lambda tt: segment_basis(trace, segment, breaks, degree, tt), segment))
 
     # Gram matrix of sum_S H_S ||mu||_{0,S}^2: H_S^2 times the Bernstein mass matrix per segment
     gram = sparse.kron(sparse.diags(H**2), bernstein_gram(degree)).toarray() if degree else H**2

@@ -13,11 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from formulations.base import FrictionRows, FrictionState
-
-# a node is in contact where its normal reaction exceeds this fraction of the largest one, and
-# slips where |lambda_t| is within it (times the largest bound) of its bound: the exact solver
-# leaves round-off, the interior-point reference ~1e-9 relative
-STATE_FRACTION = 1e-6
+from formulations.friction_state import friction_state
 
 
 def tangents(normal: np.ndarray) -> np.ndarray:
@@ -51,15 +47,7 @@ def facet_interpolant(values: np.ndarray, t: np.ndarray) -> np.ndarray:
 
 def nodal_friction(friction: FrictionRows, u_free: np.ndarray, reactions: np.ndarray,
                    tangential: np.ndarray, nodes, coordinate: np.ndarray) -> FrictionState:
-    """The node states and tractions from the returned arrays (never from a solver's sets); a
-    node in contact with a zero bound slides freely: it slips."""
-    bound = friction.bounds(reactions)
-    size = np.abs(tangential)
-    contact = reactions > STATE_FRACTION * max(reactions.max(initial=0.0), 0.0)
-    slipping = size >= bound - STATE_FRACTION * bound.max(initial=0.0)
-    state = np.where(~contact, "separated", np.where(slipping, "slip", "stick"))
+    """The node states and tractions from the returned arrays (``friction_state``)."""
     shear = -tangential / nodes.weight
-    return FrictionState(coordinate=coordinate, tangential_reactions=tangential, shear=shear,
-                         slip=friction.slip(u_free), bound=bound, state=state,
-                         bound_traction=bound / nodes.weight,
-                         traction=lambda t: facet_interpolant(shear[nodes.facet_rows], t))
+    return friction_state(friction, u_free, reactions, tangential, 1.0 / nodes.weight,
+                          coordinate, lambda t: facet_interpolant(shear[nodes.facet_rows], t))

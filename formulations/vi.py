@@ -38,7 +38,7 @@ from formulations.nodal_friction import (
     nodal_friction,
     tangents,
 )
-from formulations.registry import register_formulation
+from formulations.registry import planar_friction, register_formulation
 from formulations.surface_nodes import (
     nodal_pressures,
     surface_nodes,
@@ -104,13 +104,6 @@ def constraint_rows(elasticity, trace, nodes: TraceNodes,
     inside.data[np.abs(inside.data) < 1e-12] = 0.0
     inside.eliminate_zeros()
     return sparse.vstack([vertex_rows, inside], format="csr")
-
-
-def planar_friction(scene=None, **_) -> str | None:
-    if scene is not None and scene.friction.active and scene.dim == 3:
-        return ("vi models friction in 2D only (in 3D each node's bound is a disc: a "
-                "second-order cone, not built)")
-    return None
 
 
 @register_formulation("vi", "primal variational inequality: nodal constraints "

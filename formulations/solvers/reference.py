@@ -91,7 +91,7 @@ def solve_reference(qp: ContactQP, warm_start=None, backend=None,
     tangential = None
     if qp.friction is not None:  # the two one-sided rows' multipliers, in force units
         plus, minus = (np.asarray(c.dual_value, dtype=float) for c in constraints[-2:])
-        tangential = qp.objective_scale * d * (plus - minus)
+        tangential = qp.objective_scale * d * (plus - minus) / qp.row_scale
     status, reason = STATUS_OK, ""
     if problem.status == cp.OPTIMAL_INACCURATE:
         status, reason = STATUS_INACCURATE, "Clarabel stopped short of its tolerances " \
@@ -103,15 +103,17 @@ def solve_reference(qp: ContactQP, warm_start=None, backend=None,
 
 
 def friction_term(qp: ContactQP, u: cp.Variable, objective, d: float):
-    """The Tresca term sum_i b_i |T_i u| in the scaled units (u = d v, objective / (E d^2)):
-    a slip variable z >= |T v| per row, costed (b / (E d)) z; the rows' multipliers are the
-    tangential reactions."""
+    """The Tresca term sum_i b_i |T_i u - w_i| in the scaled units (u = d v, objective / (E d^2),
+    each row of T divided by its B row's ``row_scale``, r): a slip variable
+    z >= |T v / r - w / (r d)| per row, costed (b r / (E d)) z; the rows' multipliers are the
+    tangential reactions (times r / (E d))."""
     friction = qp.friction
     if friction.block != 1:
         raise ValueError(f"friction with {friction.block} tangential directions per node "
                          "needs a second-order cone; the reference has only the 2D form")
     z = cp.Variable(friction.T.shape[0])
-    weight = friction.bound / (qp.objective_scale * d)
-    T = friction.T.tocsr()
-    shift = np.zeros(T.shape[0]) if friction.shift is None else friction.shift / d
+    weight = friction.bound * qp.row_scale / (qp.objective_scale * d)
+    T = (sparse.diags(1.0 / qp.row_scale) @ friction.T).tocsr()
+    shift = (np.zeros(T.shape[0]) if friction.shift is None
+             else friction.shift / (qp.row_scale * d))
     return objective + weight @ z, [T @ u - shift - z <= 0, -(T @ u - shift) - z <= 0]

@@ -1,6 +1,8 @@
 """Friction in the nodal VI: the box iteration, the fast solve against the reference, the
 Coulomb fixed point and its verdict, and the refusals of the formulations without it."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -11,6 +13,7 @@ from formulations.registry import FORMULATIONS
 from formulations.solvers.backends import available_backends, iterative
 from formulations.solvers.box import AT_LOWER, AT_UPPER, FREE, box_pdas, initial_state
 from scenes import get_scene
+from scenes.friction import friction_law
 
 
 def test_box_pdas_solves_a_diagonal_box_qp_exactly():
@@ -105,8 +108,8 @@ def test_the_nodes_stick_slip_and_separate_where_the_exact_solution_does():
     disc = get_formulation("vi")(scene, scene.mesh.refined(4))
     state = solve(disc, "active-set").friction
     s = state.coordinate
-    # one mesh size (1/32) away from the exact ends b = 0.2, a = 0.4 (the traction reaches its
-    # bound quadratically at b, so the discrete end lies within a few h of it)
+    # away from the exact ends b = 0.2, a = 0.4 by 3.2, 2.2 and 1.3 mesh sizes h = 1/32 (the
+    # traction reaches its bound quadratically at b, so the discrete end lies within a few h)
     assert set(state.state[np.abs(s) < 0.2 - 0.1]) == {"stick"}
     assert set(state.state[(np.abs(s) > 0.2 + 0.07) & (np.abs(s) < 0.4 - 0.04)]) == {"slip"}
     assert set(state.state[np.abs(s) > 0.4 + 0.04]) == {"separated"}
@@ -122,3 +125,7 @@ def test_a_formulation_without_friction_refuses_the_scene(formulation):
     else:
         assert why == (f"formulation {formulation!r} does not model friction (the scene's "
                        "law is tresca)")
+    # in 3D the bound is a disc per point: refused by every formulation, with the reason
+    solid = replace(get_scene("free-boundary-3d"), friction=friction_law("tresca",
+                                                                         slip_bound=1.0))
+    assert "friction" in FORMULATIONS.why_not(formulation, scene=solid)

@@ -37,7 +37,7 @@ def _finding(row: dict, solution) -> str:
     if state is None:
         return "frictionless"
     counts = {name: int((state.state == name).sum()) for name in ("stick", "slip")}
-    return f"{counts['stick']} nodes stick, {counts['slip']} slip; {row['iterations']} " \
+    return f"{counts['stick']} points stick, {counts['slip']} slip; {row['iterations']} " \
            "Tresca iterations in all"
 
 
