@@ -47,10 +47,12 @@ class FrictionRows:
         return self.coefficient > 0
 
     def bounds(self, normal_reactions: np.ndarray | None) -> np.ndarray:
-        """b_i: the Tresca bound, or mu (lambda_n,i)^+ for Coulomb."""
+        """b_i: the Tresca bound, or mu (lambda_n,i)^+ for Coulomb (the first rows of B are
+        the friction points' normal rows; a slack QP's further rows are not)."""
         if not self.coulomb:
             return self.bound
-        return self.coefficient * np.maximum(np.asarray(normal_reactions, dtype=float), 0.0)
+        normal = np.asarray(normal_reactions, dtype=float)[:self.bound.size]  # the points' rows
+        return self.coefficient * np.maximum(normal, 0.0)
 
     def with_bound(self, bound: np.ndarray) -> FrictionRows:
         """The Tresca problem with slip bound ``bound`` (a Coulomb fixed point's step)."""

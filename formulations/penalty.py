@@ -56,7 +56,8 @@ from formulations.contact import contact_trace, gap_interpolant
 from formulations.discretisation import Discretisation, discrete_solution
 from formulations.elasticity import assemble_elasticity, check_order
 from formulations.evaluation import drop_roundoff, normal_trace_matrix
-from formulations.registry import register_formulation
+from formulations.penalty_friction import penalty_friction_qp, penalty_friction_state
+from formulations.registry import planar_friction, register_formulation
 from formulations.semismooth import SemismoothSystem
 from scenes import Scene
 from scenes.base import is_number
@@ -122,7 +123,9 @@ def penalty_pressure(elasticity, trace, gap_h, epsilon: np.ndarray, u_free: np.n
 
 
 @register_formulation("penalty", "primal penalty, eps = eps_0 h_e / (p^2 E) (eps_0 = 1e-3), "
-                                 "lambda_h = (u_hn - g_h)_+ / eps")
+                                 "lambda_h = (u_hn - g_h)_+ / eps; Tresca or Coulomb "
+                                 "friction regularised with the same eps (2D)",
+                      planar_friction, friction=True)
 def discretise(scene: Scene, mesh: MeshTri, epsilon_0: float = DEFAULT_EPSILON_0,
                order: int = 1) -> Discretisation:
     if not (is_number(epsilon_0) and np.isfinite(epsilon_0) and epsilon_0 > 0):
@@ -154,13 +157,17 @@ def discretise(scene: Scene, mesh: MeshTri, epsilon_0: float = DEFAULT_EPSILON_0
                   order**2 * young / epsilon_0 * np.tile(w, nf)
                   * np.repeat(trace.measure / trace.diameter, nq), young)
     pressure_floor = young * np.abs(gap).max(initial=0.0) / trace.measure.sum()
+    if scene.friction.active:  # the regularised friction law on its own QP, no system
+        qp = penalty_friction_qp(scene, elasticity, P, gap.ravel(),
+                                 np.asarray(qp.K.diagonal())[n:], trace, t, row_length)
+        system = None
 
     def recover(answer: QPSolution, residuals: Residuals, status: str,
                 reason: str) -> DiscreteSolution:
         u_free = answer.u[:n]
         penetration_at_points = P @ u_free - gap.ravel()
         if answer.u.size > n:  # the QP: u, then the slacks; multipliers per row
-            slacks, row_multipliers = answer.u[n:], answer.multipliers[:ns]
+            slacks, row_multipliers = answer.u[n:n + ns], answer.multipliers[:ns]
         else:  # the system: u alone; its multipliers are the pressures at the Gauss points
             slacks = np.maximum(penetration_at_points, 0.0)
             row_multipliers = answer.multipliers * row_length
@@ -180,10 +187,12 @@ def discretise(scene: Scene, mesh: MeshTri, epsilon_0: float = DEFAULT_EPSILON_0
                 else np.zeros(0)),
             active_constraints=penetrating,
             pressure_mismatch=mismatch,
-            details=PenaltyDetails(epsilon_0=epsilon_0, epsilon=epsilon, slacks=slacks))
+            details=PenaltyDetails(epsilon_0=epsilon_0, epsilon=epsilon, slacks=slacks),
+            friction=None if qp.friction is None else penalty_friction_state(
+                qp, answer.u, answer.multipliers, answer.tangential, trace, t, row_length))
 
     # warm starts: the previous pressure at the Gauss points (the system's unknowns)
     return Discretisation(formulation="penalty", elasticity=elasticity, trace=trace, qp=qp,
                           recover=recover,
                           row_coordinate=trace.row_coordinates(t), system=system,
-                          qp_is_slack_form=True)
+                          qp_is_slack_form=qp.friction is None)

@@ -14,6 +14,8 @@ from bench.matrix.task import why_skipped
 from bench.sequence.loop import run_sequence
 
 PEAK_SAMPLES = 20001  # points over +-b where the predicted peak shear is sought
+FACET_SAMPLES = np.linspace(0.0, 1.0, 9)  # where sigma_t,h is sampled on each facet
+FORCE_POINTS = 4  # Gauss points per facet for P and Q (exact for cubic tractions)
 
 
 def partial_slip_table(run: dict) -> pd.DataFrame:
@@ -42,11 +44,14 @@ def partial_slip_table(run: dict) -> pd.DataFrame:
 
 def compare(scene, solution) -> dict:
     """The forces, the stick zone and the peak shear of ``solution`` beside the prediction: P
-    the normal and Q the tangential force on the body (sums of the nodal reactions; the shear
-    traction is -lambda_t / w)."""
+    the normal and Q the tangential force on the body (the integrals of lambda_h and
+    sigma_t,h), the stick zone from the friction points' states, the peak of |sigma_t,h| on
+    every contact facet."""
     state = solution.friction
-    normal_force = float(solution.multipliers.sum())
-    tangential_force = float(-state.tangential_reactions.sum())
+    trace = solution.trace
+    t, w = trace.rule(2 * FORCE_POINTS - 1)
+    normal_force = solution.contact_force(FORCE_POINTS)
+    tangential_force = float(trace.integrate(state.traction(t), w).sum())
     predicted = scene.predict_stick(normal_force, tangential_force)
     start, end = state.zone("stick")
     b = predicted.half_width
@@ -54,5 +59,5 @@ def compare(scene, solution) -> dict:
     return {"contact_force": normal_force, "tangential_force": tangential_force,
             "stick_half_width": 0.5 * (end - start), "stick_centre": 0.5 * (end + start),
             "predicted_stick_half_width": predicted.stick_half_width, "half_width": b,
-            "peak_shear": float(np.abs(state.shear).max()),
+            "peak_shear": float(np.abs(state.traction(FACET_SAMPLES)).max()),
             "predicted_peak_shear": float(np.abs(predicted.shear(samples)).max())}

@@ -5,11 +5,11 @@ the normal reactions of the Tresca problem with bound b^k, until mu (lambda_n^k)
 b^k by at most ``rtol`` relative to its size. For small mu the map contracts with w = 1 (Necas,
 Jarusek, Haslinger: the discrete Coulomb problem has a unique solution for mu below a
 mesh-dependent constant); for large mu it may settle into a cycle (paper, vi P1, mu = 10: a
-change of 3.5e-2 repeated for 200 steps). A step whose change is not below 0.9 times the last
-halves w (down to 1/16): the same cycle then converges in 37 steps at w = 1/2. If the changes
-still do not fall the solve fails with what it saw, never with a half-converged answer called
-ok. Every step solves a Tresca problem with whatever ``solve_tresca`` is given: the
-exact active-set one, or the reference solver.
+change of 3.5e-2 repeated for 200 steps). A step whose change is not below the last halves w
+(down to 1/16): the same cycle then converges in 37 steps at w = 1/2. A slow but steady descent
+keeps its w. If the changes still do not fall the solve fails with what it saw, never with a
+half-converged answer called ok. Every step solves a Tresca problem with whatever
+``solve_tresca`` is given: the exact active-set one, or the reference solver.
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ import numpy as np
 from formulations.base import STATUS_FAILED, ContactQP, QPSolution
 
 MAX_STEPS = 100
-SLOW, SMALLEST_RELAXATION = 0.9, 1 / 16
+SLOW, SMALLEST_RELAXATION = 0.9, 1 / 16  # SLOW: what counts as settled at the noise floor
 
 
 def coulomb_fixed_point(qp: ContactQP, solve_tresca: Callable[[ContactQP, QPSolution | None],
@@ -32,7 +32,7 @@ def coulomb_fixed_point(qp: ContactQP, solve_tresca: Callable[[ContactQP, QPSolu
     """The Coulomb answer of ``qp`` (whose ``friction`` is Coulomb's); ``solve_tresca(qp,
     previous)`` solves one Tresca step, warm-started from the previous step's answer. It stops
     when the change is at most ``rtol``, or when it is at most ``noise_floor`` and no longer
-    falls (halving at least per step): an inexact step solver's own noise, said in the
+    falls (not below 0.9 times the last): an inexact step solver's own noise, said in the
     reason."""
     friction = qp.friction
     bound = np.zeros(friction.bound.size)
@@ -49,9 +49,9 @@ def coulomb_fixed_point(qp: ContactQP, solve_tresca: Callable[[ContactQP, QPSolu
         changes.append(float(np.abs(new - bound).max(initial=0.0)
                              / max(np.abs(new).max(initial=0.0), np.finfo(float).tiny)))
         settled = (len(changes) > 1 and changes[-1] <= noise_floor
-                   and changes[-1] > 0.5 * changes[-2])
-        if len(changes) > 1 and changes[-1] > SLOW * changes[-2] and not settled:
-            relaxation = max(relaxation / 2, SMALLEST_RELAXATION)
+                   and changes[-1] > SLOW * changes[-2])
+        if len(changes) > 1 and changes[-1] >= changes[-2] and not settled:
+            relaxation = max(relaxation / 2, SMALLEST_RELAXATION)  # a cycle, not a slow descent
         bound = (1 - relaxation) * bound + relaxation * new
         if changes[-1] <= rtol or settled:
             why = " (settled at the step solver's noise)" if changes[-1] > rtol else ""

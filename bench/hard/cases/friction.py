@@ -14,7 +14,7 @@ from formulations.registry import FORMULATIONS
 from formulations.solvers.registry import FAST_SOLVER
 from scenes import get_scene
 
-COEFFICIENTS = (0.0, 0.1, 0.3, 1.0, 3.0, 10.0, 30.0)
+COEFFICIENTS = (0.0, 0.1, 0.3, 1.0, 10.0, 30.0)
 LEVEL = 3  # 2112 P1 DOFs: at level 2 every mu >= 1 sticks everywhere, no cycle to see
 
 

@@ -1,0 +1,70 @@
+"""Friction in the penalty method: the regularised friction law (docs/theory.md, 17.2).
+
+With the penalty's eps on each facet, the tangential traction at a quadrature point is
+lambda_t = P_[-s, s]((u_t - w) / eps) (w: the obstacle's slide): a stick zone softened to
+|u_t - w| <= eps s, and the exact bound where it slips. Its energy is the Huber function
+int min_r (r^2 / (2 eps) + s |u_t - w - r|) ds. The QP has one normal slack q_q and one
+tangential slack r_q per point, both costed 1/2 D_q (.)^2 (D_q = w_q |e| / eps_e):
+
+    min 1/2 u'Ku - F'u + 1/2 sum_q D_q (q_q^2 + r_q^2) + sum_q b_q |u_t(x_q) - w - r_q|
+    s.t. u_n(x_q) - q_q <= g(x_q),
+
+with q_q free (its minimum is (u_n - g)_+: the frictionless slack QP's second row q_q >= 0 is
+not needed, and without it the rows stay independent where a P1 trace has fewer nodes than
+points) and b_q = w_q |e| s(x_q) (Tresca) or mu times the multiplier of the point's normal row,
+which is the penalty pressure times w_q |e| (Coulomb). The fast solver is the frictional active
+set on that QP (``formulations.solvers.friction``), and the reference takes the same QP.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy import sparse
+
+from formulations.base import ContactQP, FrictionRows, FrictionState
+from formulations.evaluation import evaluate_on_trace
+from formulations.friction_state import friction_state
+
+
+def penalty_friction_qp(scene, elasticity, P: sparse.csr_matrix, gap: np.ndarray,
+                        weights: np.ndarray, trace, t: np.ndarray,
+                        row_length: np.ndarray) -> ContactQP:
+    """The QP of the module docstring: unknowns u, the normal slacks, the tangential slacks
+    (both weighted by ``weights``, D); P the normal rows at the points ``t``."""
+    law, ns = scene.friction, row_length.size
+    tangent = np.array([-trace.normal[1], trace.normal[0]])
+    at_points = elasticity.restrict(evaluate_on_trace(elasticity.basis, trace, t).matrix(
+        np.repeat(tangent, t.shape[-1], axis=1)))
+    zero, eye = sparse.csr_matrix((ns, ns)), sparse.identity(ns, format="csr")
+    T = sparse.hstack([at_points, zero, -eye], format="csr")
+    bound = np.zeros(ns)
+    if law.kind == "tresca":
+        bound = row_length * np.ravel(law.slip_bound(trace.points(t)))
+        if np.any(bound < 0) or not np.all(np.isfinite(bound)):
+            raise ValueError("slip_bound is negative or not finite on Gamma_C (it must be a "
+                             "finite function >= 0)")
+    friction = FrictionRows(T=T, bound=bound, coefficient=law.coefficient,
+                            shift=np.full(ns, law.slide) if law.slide else None)
+    D = sparse.diags(weights)
+    return ContactQP(K=sparse.block_diag([elasticity.K_free, D, D], format="csr"),
+                     F=np.concatenate([elasticity.F_free, np.zeros(2 * ns)]),
+                     B=sparse.hstack([P, -eye, zero], format="csr"), G=gap,
+                     row_scale=np.ones(ns),
+                     objective_scale=float(scene.material.young_modulus), friction=friction)
+
+
+def penalty_friction_state(qp: ContactQP, x: np.ndarray, normal: np.ndarray,
+                           tangential: np.ndarray | None, trace, t: np.ndarray,
+                           row_length: np.ndarray) -> FrictionState:
+    """The points' states and sigma_t,h along the facets: the interpolant of the points'
+    tractions -lambda_t,q / (w_q |e|) (the penalty pressure's interpolation)."""
+    friction, ns = qp.friction, row_length.size
+    if tangential is None:  # a failed solve: NaN, never a silent zero
+        tangential = np.full(ns, np.nan)
+    at_points = (-tangential / row_length).reshape(trace.size, -1)
+
+    def traction(tt):
+        return at_points @ trace.interpolation(t, np.asarray(tt, dtype=float))
+
+    return friction_state(friction, x, normal[:ns], tangential, 1.0 / row_length,
+                          trace.row_coordinates(t), traction)
