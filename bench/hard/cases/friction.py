@@ -1,7 +1,6 @@
-"""Friction from none to full stick: the Coulomb coefficient mu = 0 .. 30 on the paper scene
-(the fixed point's contraction, its relaxation from mu = 10 and its verdict at mu = 30, where
-it contracts too slowly), and a stick-slip boundary inside an element (docs/theory.md, 17.3
-and 17.6)."""
+"""Friction from none to almost full stick: the Coulomb coefficient mu = 0, 0.3 and 10 on the
+paper scene (at 10 the plain fixed point cycles and is relaxed), and a stick-slip boundary
+inside an element (docs/theory.md, 17.3 and 17.6)."""
 
 from __future__ import annotations
 
@@ -14,7 +13,9 @@ from formulations.registry import FORMULATIONS
 from formulations.solvers.registry import FAST_SOLVER
 from scenes import get_scene
 
-COEFFICIENTS = (0.0, 0.1, 0.3, 1.0, 10.0, 30.0)
+# mu = 30, where the fixed point contracts too slowly and fails (vi, penalty), is a unit test
+# (tests/formulations/test_nodal_friction.py): its reference solves alone take ~25 s
+COEFFICIENTS = (0.0, 0.3, 10.0)
 LEVEL = 3  # 2112 P1 DOFs: at level 2 every mu >= 1 sticks everywhere, no cycle to see
 
 
@@ -41,9 +42,9 @@ def _finding(row: dict, solution) -> str:
            "Tresca iterations in all"
 
 
-@hard_case("friction", "Coulomb friction mu = 0 .. 30 on the paper scene (frictionless to full "
-                       "stick; the fixed point needs relaxation from mu = 10 and is too slow at "
-                       "30) and a stick-slip boundary inside an element")
+@hard_case("friction", "Coulomb friction mu = 0, 0.3, 10 on the paper scene (frictionless to "
+                       "almost full stick; the fixed point cycles at 10 and is relaxed) and a "
+                       "stick-slip boundary inside an element")
 def friction_sweep() -> list[dict]:
     records = []
     for mu in COEFFICIENTS:  # mu = 0: the frictionless scene, every formulation
