@@ -130,7 +130,8 @@ def test_p2_nodal_pressure_of_vi_converges():
     assert max(zones) < 1.0
 
 
-@pytest.mark.parametrize("scene_name", ["paper-3d", "free-boundary-3d"])
+@pytest.mark.parametrize("scene_name", ["paper-3d", pytest.param("free-boundary-3d",
+                                                                  marks=pytest.mark.slow)])
 def test_nitsche_and_mixed_converge_to_one_energy_in_3d(scene_name):
     # both exact solves at uniform levels 1 and 2 (1944, 13 872 DOFs): the energy difference
     # must at least halve over one refinement (measured 69.6 -> 9.19 on paper-3d, 1.17e-6 ->

@@ -65,6 +65,7 @@ def test_a_level_that_would_not_fit_in_memory_is_refused_before_it_is_built(monk
     assert last.reason.startswith("memory: level 4 needs ~") and "available" in last.reason
 
 
+@pytest.mark.slow  # ~10 s: a level large enough for the route to matter
 @pytest.mark.skipif("amg" not in backends.available_backends(), reason="pyamg missing")
 def test_a_level_too_large_for_a_factorisation_is_solved_by_the_iterative_back_end(
         monkeypatch):

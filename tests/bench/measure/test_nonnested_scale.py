@@ -19,6 +19,7 @@ def measured_and_exact(refinements: int, reference_dofs: int, tmp_path, monkeypa
     return reference, reference.errors(sol), exact_errors(scene, sol)
 
 
+@pytest.mark.slow  # ~11 s: a P3 reference of its own
 def test_p1_error_against_a_p3_reference_is_its_exact_error(tmp_path, monkeypatch):
     # 33 024 uniform P1 DOFs against a ~40 000-DOF adaptive P3 reference: the reference's own
     # error (about 3e-6) is below 5 % of the judged error (about 2e-4), so the measured value
