@@ -26,6 +26,7 @@ constant on patches of contact triangles, each holding the whole star of a verte
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 from math import comb
 
@@ -46,11 +47,7 @@ from formulations.discretisation import Discretisation, discrete_solution
 from formulations.elasticity import assemble_elasticity, check_order
 from formulations.evaluation import drop_roundoff, normal_trace_matrix
 from formulations.kkt import count_active
-from formulations.mixed_friction import (
-    mixed_friction_rows,
-    mixed_friction_state,
-    tangential_rows,
-)
+from formulations.mixed_friction import mixed_friction_rows, mixed_friction_state
 from formulations.registry import planar_friction, register_formulation
 from scenes import Scene
 from scenes.base import is_integer, is_number
@@ -134,6 +131,18 @@ def segment_weights(trace, segment: np.ndarray, breaks: np.ndarray, degree: int,
                              shape=(m, nf * nq))
 
 
+def checked_options(h_over_H: float, order: int, multiplier_degree: int | None):
+    """(order, q) after checking the options of ``discretise`` (one-line errors)."""
+    if not (is_number(h_over_H) and 0.0 < h_over_H <= 1.0):
+        raise ValueError(f"h_over_H={h_over_H!r} is not in (0, 1]")
+    order = check_order(order)
+    degree = order - 1 if multiplier_degree is None else multiplier_degree
+    if not (is_integer(degree) and 0 <= degree <= order):
+        raise ValueError(f"multiplier_degree={multiplier_degree!r} is not an integer in "
+                         f"[0, order={order}]")
+    return order, degree
+
+
 @register_formulation("mixed", "Haslinger's mixed method: multiplier of degree p - 1 "
                                "(piecewise constant for P1) on a coarser contact mesh, "
                                "h/H <= 1/2 (seed paper, eq. (3)); in 3D piecewise constant "
@@ -151,13 +160,7 @@ def discretise(scene: Scene, mesh: MeshTri, h_over_H: float = 0.5, order: int = 
     means star patches, 1 the contact triangles, and q is 0."""
     if scene.dim == 3:
         return discretise_surface(scene, mesh, h_over_H, order, multiplier_degree)
-    if not (is_number(h_over_H) and 0.0 < h_over_H <= 1.0):
-        raise ValueError(f"h_over_H={h_over_H!r} is not in (0, 1]")
-    order = check_order(order)
-    degree = order - 1 if multiplier_degree is None else multiplier_degree
-    if not (is_integer(degree) and 0 <= degree <= order):
-        raise ValueError(f"multiplier_degree={multiplier_degree!r} is not an integer in "
-                         f"[0, order={order}]")
+    order, degree = checked_options(h_over_H, order, multiplier_degree)
     elasticity = assemble_elasticity(scene, mesh, order)
     trace = contact_trace(scene, mesh)
     segment = family_of(mesh).multiplier_groups(mesh, trace, h_over_H)
@@ -172,13 +175,11 @@ def discretise(scene: Scene, mesh: MeshTri, h_over_H: float = 0.5, order: int = 
     t, w = gauss_legendre(order + 1)
     B = segment_weights(trace, segment, breaks, degree, t, w) @ normal_trace_matrix(
         elasticity.basis, trace, t)
-    friction = (tangential_rows(elasticity, trace, segment_weights(
-        trace, segment, breaks, degree, t, w), t) if scene.friction.active else None)
+    friction = mixed_friction_rows(scene, elasticity, trace, functools.partial(
+        segment_weights, trace, segment, breaks, degree), order, GAP_QUADRATURE_POINTS)
     t, w = gauss_legendre(GAP_QUADRATURE_POINTS)
-    fine = segment_weights(trace, segment, breaks, degree, t, w)
-    G = fine @ np.ravel(scene.gap(trace.points(t)))
-    if friction is not None:
-        friction = mixed_friction_rows(scene, friction, trace, fine, t)
+    G = segment_weights(trace, segment, breaks, degree, t, w) @ np.ravel(
+        scene.gap(trace.points(t)))
     qp = ContactQP(K=elasticity.K_free, F=elasticity.F_free,
                    B=elasticity.restrict(B), G=G, row_scale=np.repeat(H, degree + 1),
                    objective_scale=float(scene.material.young_modulus),

@@ -18,6 +18,7 @@ import numpy as np
 from scipy import sparse
 
 from formulations.base import FrictionRows, FrictionState
+from formulations.contact import gauss_legendre
 from formulations.evaluation import evaluate_on_trace
 from formulations.friction_state import friction_state
 
@@ -32,13 +33,19 @@ def tangential_rows(elasticity, trace, weights: sparse.csr_matrix,
     return elasticity.restrict(weights @ at_points)
 
 
-def mixed_friction_rows(scene, T: sparse.csr_matrix, trace, weights: sparse.csr_matrix,
-                        t: np.ndarray) -> FrictionRows | None:
-    """The ``FrictionRows`` of ``scene``'s law on the coefficients (None without friction);
-    ``weights`` at the points ``t`` integrate s and 1 against each B_k."""
+def mixed_friction_rows(scene, elasticity, trace, weights_at, order: int,
+                        points: int) -> FrictionRows | None:
+    """The ``FrictionRows`` of ``scene``'s law on the coefficients (None without friction):
+    ``weights_at(t, w)`` integrates values at the points t of every facet against each B_k
+    (``mixed.segment_weights``); the rows with order + 1 Gauss points per facet (exact, as the
+    normal rows), the bounds with ``points``."""
     law = scene.friction
     if not law.active:
         return None
+    t, w = gauss_legendre(order + 1)
+    T = tangential_rows(elasticity, trace, weights_at(t, w), t)
+    t, w = gauss_legendre(points)
+    weights = weights_at(t, w)
     mass = np.asarray(weights @ np.ones(weights.shape[1])).ravel()  # int_S B_k ds
     bound = np.zeros(mass.size)
     if law.kind == "tresca":

@@ -122,16 +122,35 @@ def penalty_pressure(elasticity, trace, gap_h, epsilon: np.ndarray, u_free: np.n
     return interpolant
 
 
+def checked_epsilon(epsilon_0: float) -> float:
+    if not (is_number(epsilon_0) and np.isfinite(epsilon_0) and epsilon_0 > 0):
+        raise ValueError(f"epsilon_0={epsilon_0!r} is not a finite number > 0")
+    return epsilon_0
+
+
+def penalty_problems(scene, elasticity, trace, t: np.ndarray, P, gap: np.ndarray,
+                     weights: np.ndarray, row_length: np.ndarray, row_epsilon: np.ndarray):
+    """(qp, system): the slack QP and the penalised equation (module docstring); with friction
+    the QP of ``penalty_friction`` and no system."""
+    if scene.friction.active:  # the regularised friction law on its own QP
+        return penalty_friction_qp(scene, elasticity, P, gap, weights, trace, t,
+                                   row_length), None
+    young = float(scene.material.young_modulus)
+    system = SemismoothSystem(K=elasticity.K_free, F=elasticity.F_free,
+                              S=sparse.csr_matrix((0, elasticity.free.size)), N=P, gap=gap,
+                              weight=row_length, gamma=1.0 / row_epsilon, theta=0.0,
+                              objective_scale=young, near_null=elasticity.rigid_modes)
+    return slack_qp(elasticity.K_free, elasticity.F_free, P, gap, weights, young), system
+
+
 @register_formulation("penalty", "primal penalty, eps = eps_0 h_e / (p^2 E) (eps_0 = 1e-3), "
                                  "lambda_h = (u_hn - g_h)_+ / eps; Tresca or Coulomb "
                                  "friction regularised with the same eps (2D)",
                       planar_friction, friction=True)
 def discretise(scene: Scene, mesh: MeshTri, epsilon_0: float = DEFAULT_EPSILON_0,
                order: int = 1) -> Discretisation:
-    if not (is_number(epsilon_0) and np.isfinite(epsilon_0) and epsilon_0 > 0):
-        raise ValueError(f"epsilon_0={epsilon_0!r} is not a finite number > 0")
-    elasticity = assemble_elasticity(scene, mesh, check_order(order))
-    order = elasticity.order
+    epsilon_0, order = checked_epsilon(epsilon_0), check_order(order)  # before any assembly
+    elasticity = assemble_elasticity(scene, mesh, order)
     trace = contact_trace(scene, mesh)
     young = float(scene.material.young_modulus)
     t, w = trace.rule(2 * order)  # 2D: the p + 1 Gauss points; 3D: 3 (P1) or 6 (P2) points
@@ -147,20 +166,12 @@ def discretise(scene: Scene, mesh: MeshTri, epsilon_0: float = DEFAULT_EPSILON_0
     # per Gauss point: eps, and Gauss weight x facet measure (its share of Gamma_C)
     row_epsilon, row_length = np.repeat(epsilon, nq), np.tile(w, nf) * np.repeat(trace.measure,
                                                                                  nq)
-    system = SemismoothSystem(K=elasticity.K_free, F=elasticity.F_free,
-                              S=sparse.csr_matrix((0, n)), N=P, gap=gap.ravel(),
-                              weight=row_length, gamma=1.0 / row_epsilon, theta=0.0,
-                              objective_scale=young,
-                              near_null=elasticity.rigid_modes)
     # D_q = w_q |e| / eps_e = p^2 E w_q / eps_0 (|e| / h_e: 1 in 2D, exactly)
-    qp = slack_qp(elasticity.K_free, elasticity.F_free, P, gap.ravel(),
-                  order**2 * young / epsilon_0 * np.tile(w, nf)
-                  * np.repeat(trace.measure / trace.diameter, nq), young)
+    weights = (order**2 * young / epsilon_0 * np.tile(w, nf)
+               * np.repeat(trace.measure / trace.diameter, nq))
+    qp, system = penalty_problems(scene, elasticity, trace, t, P, gap.ravel(), weights,
+                                  row_length, row_epsilon)
     pressure_floor = young * np.abs(gap).max(initial=0.0) / trace.measure.sum()
-    if scene.friction.active:  # the regularised friction law on its own QP, no system
-        qp = penalty_friction_qp(scene, elasticity, P, gap.ravel(),
-                                 np.asarray(qp.K.diagonal())[n:], trace, t, row_length)
-        system = None
 
     def recover(answer: QPSolution, residuals: Residuals, status: str,
                 reason: str) -> DiscreteSolution:

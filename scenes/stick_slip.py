@@ -82,23 +82,11 @@ def profiles(material: Material, push: float, half_width: float, stick_half_widt
     return p, tau, omega, q
 
 
-@register_scene("stick-slip", "exact elastic contact with friction on the unit square: stick "
-                              "zone |x| < b and slip zones b < |x| < a inside Gamma_C "
-                              "(manufactured; tresca or coulomb)", tags=("exact",), dim=2)
-def stick_slip(young_modulus: float = 1.0, poisson_ratio: float = 0.3, plane: str = "strain",
-               push: float = 0.01, half_width: float = 0.4, stick_half_width: float = 0.2,
-               gap_curvature: float = 0.1, mu: float = 0.3, slide: float = 0.05,
-               friction: str = "tresca", initial_divisions: int = 4) -> Scene:
-    if not (0 < stick_half_width < half_width < 1):
-        raise SceneError(f"stick_half_width={stick_half_width!r}, half_width={half_width!r}: "
-                         "need 0 < stick_half_width < half_width < 1")
-    if friction not in ("tresca", "coulomb") or not mu > 0:
-        raise SceneError(f"friction={friction!r}, mu={mu!r}: need 'tresca' or 'coulomb' and "
-                         "mu > 0")
-    material = Material(young_modulus, poisson_ratio, plane)
+def fields(material: Material, push: float, tau, omega, q):
+    """(displacement, gradient, body force, side traction) of u from its x-profiles (module
+    docstring)."""
     lam, shear = material.lame
-    stiff, c, a, k = lam + 2 * shear, push, half_width, gap_curvature
-    p, tau, omega, q = profiles(material, push, half_width, stick_half_width, mu, slide)
+    stiff, c = lam + 2 * shear, push
 
     def gradient(x):
         (s0, s1, _), (f0, f1, _) = _psi(x[1]), _phi(x[1])
@@ -125,6 +113,28 @@ def stick_slip(young_modulus: float = 1.0, poisson_ratio: float = 0.3, plane: st
         t, w, q_ = tau(x[0]), omega(x[0]), q(x[0])
         return np.array([_psi(x[1])[0] * t[0] + _phi(x[1])[0] * w[0],
                          c * (1 - x[1]) / 2 + _phi(x[1])[0] * q_[0]])
+
+    return displacement, gradient, body_force, traction
+
+
+@register_scene("stick-slip", "exact elastic contact with friction on the unit square: stick "
+                              "zone |x| < b and slip zones b < |x| < a inside Gamma_C "
+                              "(manufactured; tresca or coulomb)", tags=("exact",), dim=2)
+def stick_slip(young_modulus: float = 1.0, poisson_ratio: float = 0.3, plane: str = "strain",
+               push: float = 0.01, half_width: float = 0.4, stick_half_width: float = 0.2,
+               gap_curvature: float = 0.1, mu: float = 0.3, slide: float = 0.05,
+               friction: str = "tresca", initial_divisions: int = 4) -> Scene:
+    if not (0 < stick_half_width < half_width < 1):
+        raise SceneError(f"stick_half_width={stick_half_width!r}, half_width={half_width!r}: "
+                         "need 0 < stick_half_width < half_width < 1")
+    if friction not in ("tresca", "coulomb") or not mu > 0:
+        raise SceneError(f"friction={friction!r}, mu={mu!r}: need 'tresca' or 'coulomb' and "
+                         "mu > 0")
+    material = Material(young_modulus, poisson_ratio, plane)
+    c, a, k = push, half_width, gap_curvature
+    p, tau, omega, q = profiles(material, push, half_width, stick_half_width, mu, slide)
+
+    displacement, gradient, body_force, traction = fields(material, push, tau, omega, q)
 
     def shear_traction(s):  # sigma_t = -mu_f p chi along Gamma_C
         s = np.asarray(s, dtype=float)
