@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 from skfem import Basis
 
-from estimators.base import Estimate, combine, planar_friction, register_estimator
+from estimators.base import Estimate, combine, register_estimator
 from estimators.contact_terms import contact_terms
 from formulations import DiscreteSolution
 from formulations.cells import family_of
@@ -90,6 +90,6 @@ def averaging_indicators(solution: DiscreteSolution) -> np.ndarray:
 @register_estimator("averaging", "Zienkiewicz-Zhu nodal stress averaging in the energy norm "
                                  "plus the geometric and complementarity contact terms of (8); "
                                  "with friction the friction complementarity (2D)",
-                    families=("tri", "tet", "quad"), applies=planar_friction, friction=True)
+                    families=("tri", "tet", "quad"), friction=True)
 def estimate(scene, solution: DiscreteSolution) -> Estimate:
     return combine("averaging", averaging_indicators(solution), contact_terms(scene, solution))

@@ -70,13 +70,6 @@ def planar_only(name: str, why: str):
     return applies
 
 
-def planar_friction(scene=None, **_) -> str | None:
-    """An ``applies`` check of an estimator whose friction terms are built in 2D only."""
-    if scene is not None and scene.friction.active and scene.dim != 2:
-        return "the friction terms are built in 2D only"
-    return None
-
-
 ESTIMATORS = Registry("estimator")
 # "estimator@family" -> the estimate function of an estimator on other cells
 ESTIMATOR_VARIANTS = Registry("estimator variant")

@@ -73,7 +73,7 @@ def friction_complementarity(scene, solution: DiscreteSolution, at_points, t: np
     tangent = np.repeat(np.array([-trace.normal[1], trace.normal[0]]), t.size, axis=1)
     u_t = np.einsum("in,in->n", at_points.value(solution.u), tangent).reshape(trace.size, -1)
     u_t = u_t - law.slide  # the slip relative to the obstacle
-    bound = (law.slip_bound(trace.points(t)) if law.kind == "tresca"
+    bound = (law.slip_bound_at(trace.points(t)) if law.kind == "tresca"
              else law.coefficient * solution.pressure(t))
     return np.abs(trace.integrate(bound * np.abs(u_t) + solution.friction.traction(t) * u_t, w))
 

@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 from skfem import Basis, ElementTetP0, ElementTriP0
 
-from estimators.base import Estimate, combine, planar_friction, register_estimator
+from estimators.base import Estimate, combine, register_estimator
 from estimators.contact_terms import contact_terms
 from estimators.residual_3d import face_residuals_3d, stress_divergence_3d
 from formulations import DiscreteSolution
@@ -144,7 +144,7 @@ def edge_residuals(scene, solution: DiscreteSolution) -> np.ndarray:
 @register_estimator("residual", "residual eta_0 (seed paper, section 5) plus the geometric and "
                                 "complementarity contact terms of eq. (8); with friction the "
                                 "shear residual and the friction complementarity (2D)",
-                    applies=planar_friction, friction=True)
+                    friction=True)
 def estimate(scene, solution: DiscreteSolution) -> Estimate:
     return combine("residual", volume_terms(scene, solution), contact_terms(scene, solution))
 

@@ -48,7 +48,7 @@ from formulations.elasticity import assemble_elasticity, check_order
 from formulations.evaluation import drop_roundoff, normal_trace_matrix
 from formulations.kkt import count_active
 from formulations.mixed_friction import mixed_friction_rows, mixed_friction_state
-from formulations.registry import planar_friction, register_formulation
+from formulations.registry import register_formulation
 from scenes import Scene
 from scenes.base import is_integer, is_number
 
@@ -148,7 +148,7 @@ def checked_options(h_over_H: float, order: int, multiplier_degree: int | None):
                                "h/H <= 1/2 (seed paper, eq. (3)); in 3D piecewise constant "
                                "on vertex-star patches of contact triangles; Tresca or "
                                "Coulomb friction with a tangential multiplier in the same "
-                               "space (2D)", planar_friction, friction=True)
+                               "space (2D)", friction=True)
 def discretise(scene: Scene, mesh: MeshTri, h_over_H: float = 0.5, order: int = 1,
                multiplier_degree: int | None = None) -> Discretisation:
     """``h_over_H``: the largest allowed ratio of a facet to its multiplier segment. The

@@ -49,10 +49,7 @@ def mixed_friction_rows(scene, elasticity, trace, weights_at, order: int,
     mass = np.asarray(weights @ np.ones(weights.shape[1])).ravel()  # int_S B_k ds
     bound = np.zeros(mass.size)
     if law.kind == "tresca":
-        bound = (weights @ np.ravel(law.slip_bound(trace.points(t)))) / mass
-        if np.any(bound < 0) or not np.all(np.isfinite(bound)):
-            raise ValueError("slip_bound is negative or not finite on Gamma_C (it must be a "
-                             "finite function >= 0)")
+        bound = (weights @ np.ravel(law.slip_bound_at(trace.points(t)))) / mass
     shift = law.slide * mass if law.slide else None  # int_S B_k (obstacle's slide) ds
     return FrictionRows(T=T, bound=bound, coefficient=law.coefficient, shift=shift)
 

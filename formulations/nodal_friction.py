@@ -17,7 +17,10 @@ from formulations.friction_state import friction_state
 
 
 def tangents(normal: np.ndarray) -> np.ndarray:
-    """t_i = (-n_2, n_1): the unit normals turned by +90 degrees (2D)."""
+    """t_i = (-n_2, n_1): the unit normals turned by +90 degrees (2D; the cell family
+    refuses friction on tetrahedra, where the bound is a disc)."""
+    if normal.shape[0] != 2:
+        raise ValueError(f"tangential rows need 2D normals, not {normal.shape[0]}D ones")
     return np.array([-normal[1], normal[0]])
 
 
@@ -27,11 +30,8 @@ def friction_rows(scene, nodes, T) -> FrictionRows | None:
     law = scene.friction
     if not law.active:
         return None
-    bound = (nodes.weight * np.asarray(law.slip_bound(nodes.points), dtype=float)
-             if law.kind == "tresca" else np.zeros(nodes.weight.size))
-    if np.any(bound < 0) or not np.all(np.isfinite(bound)):
-        raise ValueError("slip_bound is negative or not finite at a contact node (it must be "
-                         "a finite function >= 0 on Gamma_C)")
+    bound = (nodes.weight * law.slip_bound_at(nodes.points) if law.kind == "tresca"
+             else np.zeros(nodes.weight.size))
     shift = np.full(nodes.weight.size, law.slide) if law.slide else None
     return FrictionRows(T=T, bound=bound, coefficient=law.coefficient, shift=shift)
 

@@ -57,7 +57,7 @@ from formulations.discretisation import Discretisation, discrete_solution
 from formulations.elasticity import assemble_elasticity, check_order
 from formulations.evaluation import drop_roundoff, normal_trace_matrix
 from formulations.penalty_friction import penalty_friction_qp, penalty_friction_state
-from formulations.registry import planar_friction, register_formulation
+from formulations.registry import register_formulation
 from formulations.semismooth import SemismoothSystem
 from scenes import Scene
 from scenes.base import is_number
@@ -146,7 +146,7 @@ def penalty_problems(scene, elasticity, trace, t: np.ndarray, P, gap: np.ndarray
 @register_formulation("penalty", "primal penalty, eps = eps_0 h_e / (p^2 E) (eps_0 = 1e-3), "
                                  "lambda_h = (u_hn - g_h)_+ / eps; Tresca or Coulomb "
                                  "friction regularised with the same eps (2D)",
-                      planar_friction, friction=True)
+                      friction=True)
 def discretise(scene: Scene, mesh: MeshTri, epsilon_0: float = DEFAULT_EPSILON_0,
                order: int = 1) -> Discretisation:
     epsilon_0, order = checked_epsilon(epsilon_0), check_order(order)  # before any assembly

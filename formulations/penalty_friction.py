@@ -39,10 +39,7 @@ def penalty_friction_qp(scene, elasticity, P: sparse.csr_matrix, gap: np.ndarray
     T = sparse.hstack([at_points, zero, -eye], format="csr")
     bound = np.zeros(ns)
     if law.kind == "tresca":
-        bound = row_length * np.ravel(law.slip_bound(trace.points(t)))
-        if np.any(bound < 0) or not np.all(np.isfinite(bound)):
-            raise ValueError("slip_bound is negative or not finite on Gamma_C (it must be a "
-                             "finite function >= 0)")
+        bound = row_length * np.ravel(law.slip_bound_at(trace.points(t)))
     friction = FrictionRows(T=T, bound=bound, coefficient=law.coefficient,
                             shift=np.full(ns, law.slide) if law.slide else None)
     D = sparse.diags(weights)

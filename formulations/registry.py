@@ -20,14 +20,6 @@ def frictionless_only(kind: str, name: str, applies=None):
     return check
 
 
-def planar_friction(scene=None, **_) -> str | None:
-    """An ``applies`` check of a formulation whose friction is built in 2D only (in 3D each
-    point's bound is a disc: a second-order cone)."""
-    if scene is not None and scene.friction.active and scene.dim == 3:
-        return "friction is built in 2D only (in 3D the bound is a disc: a second-order cone)"
-    return None
-
-
 def register_formulation(name: str, description: str, applies=None, *,
                          friction: bool = False):
     """Register ``discretise(scene, mesh, **options)`` under ``name``; ``applies(scene=...)``

@@ -38,7 +38,7 @@ from formulations.nodal_friction import (
     nodal_friction,
     tangents,
 )
-from formulations.registry import planar_friction, register_formulation
+from formulations.registry import register_formulation
 from formulations.surface_nodes import (
     nodal_pressures,
     surface_nodes,
@@ -109,7 +109,7 @@ def constraint_rows(elasticity, trace, nodes: TraceNodes,
 @register_formulation("vi", "primal variational inequality: nodal constraints "
                             "u_h(x_i).n_i <= g(x_i) at every Lagrange node of Gamma_C, "
                             "lambda_h from the nodal reactions; Tresca or Coulomb friction "
-                            "on the same nodes (2D)", planar_friction, friction=True)
+                            "on the same nodes (2D)", friction=True)
 def discretise(scene: Scene, mesh: MeshTri, order: int = 1) -> Discretisation:
     elasticity = assemble_elasticity(scene, mesh, check_order(order))
     trace = contact_trace(scene, mesh)
@@ -124,7 +124,7 @@ def discretise(scene: Scene, mesh: MeshTri, order: int = 1) -> Discretisation:
     # rows of B are dimensionless (a normal), so the multipliers are forces; row_scale 1
     friction = (friction_rows(scene, nodes, elasticity.restrict(
         constraint_rows(elasticity, trace, nodes, tangents(nodes.normal))))
-        if scene.friction.active and trace.dim == 2 else None)
+        if scene.friction.active else None)
     qp = ContactQP(K=elasticity.K_free, F=elasticity.F_free,
                    B=elasticity.restrict(B), G=G, row_scale=np.ones(m),
                    objective_scale=float(scene.material.young_modulus),

@@ -43,6 +43,14 @@ class FrictionLaw:
             raise SceneError(f"friction={self.kind!r}: a slip bound is given exactly for "
                              "'tresca'")
 
+    def slip_bound_at(self, x: np.ndarray) -> np.ndarray:
+        """Tresca's s at points x (d, ...): SceneError if it is negative or not finite."""
+        bound = np.asarray(self.slip_bound(x), dtype=float)
+        if np.any(bound < 0) or not np.all(np.isfinite(bound)):
+            raise SceneError("slip_bound is negative or not finite on Gamma_C (it must be a "
+                             "finite function >= 0)")
+        return bound
+
     @property
     def active(self) -> bool:
         """Whether there is friction at all."""
