@@ -15,6 +15,7 @@ import numpy as np
 from scenes.base import Material, Scene, SceneError, is_integer, is_number
 from scenes.budget import LOAD_VERTICES, tensor_mesh, vertex_budget
 from scenes.expressions import Expression, ExpressionError
+from scenes.friction import LAWS, FrictionLaw, friction_law
 from scenes.mesh_file import on_segments, read_mesh_file
 from scenes.registry import register_scene
 
@@ -24,6 +25,7 @@ TABLES = {"geometry": ("rectangle", "divisions", "mesh"),
           "boundary": ("clamped", "contact", "loaded"),
           "contact": ("gap", "coordinate"),
           "load": ("traction", "body_force"),
+          "friction": ("law", "mu", "slip_bound", "slide"),
           "parameters": None}
 TOP_LEVEL = ("name", "description", "tags")
 
@@ -104,6 +106,7 @@ def _scene(path, data, name, description, values, digest) -> Scene:
                                  f"{path}: [contact] coordinate")
         traction = _vector(load.get("traction"), values, f"{path}: [load] traction")
         body_force = _vector(load.get("body_force"), values, f"{path}: [load] body_force")
+        friction = _friction(path, data.get("friction", {}), values)
     except ExpressionError as error:
         raise SceneError(str(error)) from None
     if traction is not None and loaded is None:
@@ -116,7 +119,29 @@ def _scene(path, data, name, description, values, digest) -> Scene:
         is_dirichlet=is_dirichlet, is_contact=is_contact, gap=gap,
         contact_coordinate=coordinate, body_force=body_force,
         traction=None if traction is None else _only_on(loaded, traction),
-        parameters={**values, "source": digest}, tags=tuple(data.get("tags", ())))
+        parameters={**values, "source": digest}, tags=tuple(data.get("tags", ())),
+        friction=friction)
+
+
+def _friction(path: Path, table: dict, values) -> FrictionLaw:
+    """[friction]: ``law`` (none, tresca, coulomb), Coulomb's ``mu`` and the obstacle's
+    ``slide`` (constants of the parameters), Tresca's ``slip_bound`` s(x, y)."""
+    where = f"{path}: [friction]"
+    law = table.get("law", "none")
+    if law not in LAWS:
+        raise SceneError(f"{where} law={law!r} is not one of {', '.join(LAWS)}")
+    mu, slide = (_expression(table.get(key, 0), values, f"{where} {key}").constant()
+                 for key in ("mu", "slide"))
+    bound = table.get("slip_bound")
+    if bound is not None and law != "tresca":
+        raise SceneError(f"{where} slip_bound needs law='tresca' (law={law!r})")
+    if law == "tresca" and bound is None:
+        raise SceneError(f"{where} law='tresca' needs slip_bound (an expression of x and y)")
+    function = None if bound is None else _expression(bound, values, f"{where} slip_bound")
+    try:
+        return friction_law(law, mu, tresca_bound=function, slide=slide)
+    except SceneError as error:
+        raise SceneError(f"{where} {error}") from None
 
 
 def _body(path: Path, geometry: dict):

@@ -122,6 +122,19 @@ class Expression:
         else:
             self._refuse(node, f"'{ast.unparse(node)}'")
 
+    @property
+    def uses_position(self) -> bool:
+        """Whether the text names x or y (else it is a constant of the parameters)."""
+        return any(isinstance(node, ast.Name) and node.id in VARIABLES
+                   for node in ast.walk(self.tree))
+
+    def constant(self) -> float:
+        """The value of a text that does not name x or y; ExpressionError if it does."""
+        if self.uses_position:
+            raise ExpressionError(f"{self.where}={_shown(self.text)} depends on x or y (a "
+                                  "constant of numbers and [parameters] is needed)")
+        return float(self(np.zeros((2, 1)))[0])
+
     def __call__(self, points: np.ndarray) -> np.ndarray:
         points = np.asarray(points, dtype=float)
         values = {"x": points[0], "y": points[1], **CONSTANTS,

@@ -87,6 +87,49 @@ def test_paper_on_a_gmsh_mesh_reproduces_the_builtin_scene(tmp_path, registered)
     assert_same_sequence(get_scene("paper"), scene, rtol=1e-10)
 
 
+@pytest.mark.parametrize("table, builtin", [
+    ('law = "coulomb"\nmu = "friction_mu"', dict(friction="coulomb", mu=0.3)),
+    ('law = "tresca"\nslip_bound = "100 * friction_mu"', dict(friction="tresca",
+                                                             slip_bound=30.0)),
+])
+def test_a_friction_table_reproduces_the_builtin_law(tmp_path, registered, table, builtin):
+    text = (PAPER_TOML.format(name="toml-friction", geometry=RECTANGLE, clamped="top",
+                              contact="bottom")
+            + f"[friction]\n{table}\n[parameters]\nfriction_mu = 0.3\n")
+    name = register(tmp_path / "friction.toml", text, registered)
+    config = LoopConfig(strategy="uniform", max_dofs=600, diagnostics=False)
+    mine, paper = ([level.row for level in run_sequence(scene, "vi", "active-set", "residual",
+                                                        config)]
+                   for scene in (get_scene(name), get_scene("paper", **builtin)))
+    assert [r.ndofs for r in mine] == [r.ndofs for r in paper] == [40, 144, 544]
+    for a, b in zip(mine, paper, strict=True):
+        assert a.friction == b.friction != "none"
+        # the same mesh, law and solver: equal to the fast solver's round-off
+        for column in ("energy", "contact_force", "eta"):
+            assert getattr(a, column) == pytest.approx(getattr(b, column), rel=1e-9), column
+        assert (a.stick_points, a.slip_points) == (b.stick_points, b.slip_points)
+    assert mine[-1].slip_points > 0  # the law acts: the body slips somewhere
+
+
+@pytest.mark.parametrize("table, message", [
+    ('law = "stiction"', "[friction] law='stiction' is not one of none, tresca, coulomb"),
+    ('law = "coulomb"\nmu = "0.1 * x"', "[friction] mu='0.1 * x' depends on x or y"),
+    ('law = "tresca"', "[friction] law='tresca' needs slip_bound"),
+    ('law = "coulomb"\nmu = 0.3\nslip_bound = "1"', "slip_bound needs law='tresca'"),
+    ('mu = 0.3', "[friction] mu=0.3 needs friction='coulomb'"),
+    ('law = "coulomb"', "[friction] mu=0.0 is not > 0"),
+    ('law = "coulomb"\nmu = 0.3\nfriction = 1', "[friction] friction is not one of law"),
+])
+def test_bad_friction_tables_are_refused_in_one_line(tmp_path, table, message):
+    path = tmp_path / "bad.toml"
+    path.write_text(PAPER_TOML.format(name="bad", geometry=RECTANGLE, clamped="top",
+                                      contact="bottom") + f"[friction]\n{table}\n")
+    with pytest.raises(SceneError) as error:
+        register_toml_scene(path)
+    assert message in str(error.value) and "\n" not in str(error.value)
+    assert "bad" not in SCENES.names()
+
+
 def test_parameters_are_overridable_and_part_of_the_scene(tmp_path, registered):
     text = PAPER_TOML.format(name="toml-depth", geometry=RECTANGLE, clamped="top",
                              contact="bottom").replace(
