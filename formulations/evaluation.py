@@ -46,9 +46,17 @@ class PointEvaluation:
                              ) -> sparse.csr_matrix:
         """The sparse operator u -> sigma_nn(u_h)(x_i) = n_i . sigma(u_h) n_i with
         sigma = lam tr(eps) I + 2 mu eps (docs/theory.md, section 1)."""
+        return self.stress_matrix(normal, normal, lame)
+
+    def stress_matrix(self, normal: np.ndarray, direction: np.ndarray,
+                      lame: tuple[float, float]) -> sparse.csr_matrix:
+        """u -> d_i . sigma(u_h)(x_i) n_i for directions d_i: sigma_nn for d = n, the shear
+        sigma_nt for the tangent d = t (docs/theory.md, section 1)."""
         lam, mu = lame
-        vals = np.concatenate([lam * np.trace(g)
-                               + 2 * mu * np.einsum("in,ijn,jn->n", normal, g, normal)
+        along = np.einsum("in,in->n", normal, direction)
+        vals = np.concatenate([lam * np.trace(g) * along
+                               + mu * (np.einsum("in,ijn,jn->n", direction, g, normal)
+                                       + np.einsum("in,ijn,jn->n", normal, g, direction))
                                for g in self.gradients])
         rows = np.tile(np.arange(self.size), len(self.gradients))
         cols = self.basis.element_dofs[:, self.cells].ravel()

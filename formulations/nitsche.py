@@ -40,6 +40,7 @@ from formulations.contact import contact_trace, gap_interpolant
 from formulations.discretisation import Discretisation, discrete_solution
 from formulations.elasticity import assemble_elasticity, check_order
 from formulations.evaluation import evaluate_on_trace
+from formulations.nitsche_friction import nitsche_friction_qp, nitsche_friction_state
 from formulations.registry import register_formulation
 from formulations.semismooth import SemismoothSystem
 from scenes import Scene
@@ -114,12 +115,22 @@ def nitsche_system(scene: Scene, elasticity, trace, gap_h, t: np.ndarray, w: np.
         near_null=elasticity.rigid_modes)
 
 
+def check_friction(scene: Scene, theta: float) -> None:
+    if scene.friction.active and theta != 1:
+        raise ValueError(f"theta={theta:g} with friction ({scene.friction.label}) is not "
+                         "allowed: Nitsche's method models friction for theta = 1 only (the "
+                         "optimality condition of a convex functional)")
+
+
 @register_formulation("nitsche", "Nitsche's method, theta = 1 (symmetric, default), 0 or -1 "
                                  "(option theta), gamma = gamma_0 E / h_F (option gamma_0, "
-                                 f"default {DEFAULT_GAMMA_0:g}), lambda_h = -[P_gamma(u_h)]_-")
+                                 f"default {DEFAULT_GAMMA_0:g}), lambda_h = -[P_gamma(u_h)]_-; "
+                                 "Tresca or Coulomb friction with theta = 1 (2D)",
+                      friction=True)
 def discretise(scene: Scene, mesh: MeshTri, theta: float = 1.0,
                gamma_0: float = DEFAULT_GAMMA_0, order: int = 1) -> Discretisation:
     check_options(theta, gamma_0)
+    check_friction(scene, theta)
     elasticity = assemble_elasticity(scene, mesh, check_order(order))
     trace = contact_trace(scene, mesh)
     t, w = trace.rule(2 * elasticity.order)  # 2D: the p + 1 Gauss points
@@ -128,22 +139,30 @@ def discretise(scene: Scene, mesh: MeshTri, theta: float = 1.0,
     system = nitsche_system(scene, elasticity, trace, gap_h, t, w, gamma_facet, theta)
     n, s_points = system.n, trace.row_coordinates(t)
     details = NitscheDetails(theta=float(theta), gamma_0=float(gamma_0), gamma=gamma_facet)
+    friction = (nitsche_friction_qp(scene, system, elasticity, trace, t)
+                if scene.friction.active else None)
 
     def recover(answer: QPSolution, residuals: Residuals, status: str,
                 reason: str) -> DiscreteSolution:
         u_free = answer.u[:n]  # the QP route carries one slack per Gauss point after u
         pressure_at_points = system.pressure(u_free)
+        pressure = pressure_function(gap_h, elasticity, trace, gamma_facet, u_free)
         return discrete_solution(
             "nitsche", elasticity, trace, replace(answer, multipliers=pressure_at_points),
-            residuals, status, reason, u_free=u_free,
-            pressure=pressure_function(gap_h, elasticity, trace, gamma_facet, u_free),
+            residuals, status, reason, u_free=u_free, pressure=pressure,
             multiplier_breaks=(np.append(trace.coordinate[0], trace.coordinate[1, -1])
                                if trace.dim == 2 else np.zeros(0)),
-            active_constraints=int((pressure_at_points > 0).sum()), details=details)
+            active_constraints=int((pressure_at_points > 0).sum()), details=details,
+            friction=None if friction is None else nitsche_friction_state(
+                scene, friction, answer, elasticity, trace, t, system.weight, gamma_facet,
+                pressure))
 
     def transfer(previous: DiscreteSolution) -> np.ndarray:
         return previous.pressure_at(s_points)  # > 0 where the previous level pressed
 
+    if friction is not None:  # the QP alone: the system has no friction law
+        return Discretisation(formulation="nitsche", elasticity=elasticity, trace=trace,
+                              qp=friction, recover=recover, row_coordinate=s_points)
     symmetric = theta == 1
     return Discretisation(
         formulation="nitsche", elasticity=elasticity, trace=trace,

@@ -21,33 +21,20 @@ from __future__ import annotations
 import numpy as np
 from scipy import sparse
 
-from formulations.base import ContactQP, FrictionRows, FrictionState
-from formulations.evaluation import evaluate_on_trace
+from formulations.base import ContactQP, FrictionState
 from formulations.friction_state import friction_state
+from formulations.slack_friction import slack_friction_qp, tangential_rows
 
 
 def penalty_friction_qp(scene, elasticity, P: sparse.csr_matrix, gap: np.ndarray,
                         weights: np.ndarray, trace, t: np.ndarray,
                         row_length: np.ndarray) -> ContactQP:
-    """The QP of the module docstring: unknowns u, the normal slacks, the tangential slacks
-    (both weighted by ``weights``, D); P the normal rows at the points ``t``."""
-    law, ns = scene.friction, row_length.size
-    tangent = np.array([-trace.normal[1], trace.normal[0]])
-    at_points = elasticity.restrict(evaluate_on_trace(elasticity.basis, trace, t).matrix(
-        np.repeat(tangent, t.shape[-1], axis=1)))
-    zero, eye = sparse.csr_matrix((ns, ns)), sparse.identity(ns, format="csr")
-    T = sparse.hstack([at_points, zero, -eye], format="csr")
-    bound = np.zeros(ns)
-    if law.kind == "tresca":
-        bound = row_length * np.ravel(law.slip_bound_at(trace.points(t)))
-    friction = FrictionRows(T=T, bound=bound, coefficient=law.coefficient,
-                            shift=np.full(ns, law.slide) if law.slide else None)
-    D = sparse.diags(weights)
-    return ContactQP(K=sparse.block_diag([elasticity.K_free, D, D], format="csr"),
-                     F=np.concatenate([elasticity.F_free, np.zeros(2 * ns)]),
-                     B=sparse.hstack([P, -eye, zero], format="csr"), G=gap,
-                     row_scale=np.ones(ns),
-                     objective_scale=float(scene.material.young_modulus), friction=friction)
+    """The QP of the module docstring (``formulations.slack_friction`` with R the tangential
+    displacement at the points ``t``): unknowns u, the normal slacks, the tangential slacks
+    (both weighted by ``weights``, D); P the normal rows at the points."""
+    return slack_friction_qp(scene, elasticity.K_free, elasticity.F_free, P,
+                             tangential_rows(elasticity, trace, t), gap, weights, row_length,
+                             trace.points(t))
 
 
 def penalty_friction_state(qp: ContactQP, x: np.ndarray, normal: np.ndarray,

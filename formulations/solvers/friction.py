@@ -32,7 +32,7 @@ from formulations.solvers.backends import (
     factorise_condensed,
     iterative,
 )
-from formulations.solvers.box import AT_LOWER, FREE, box_pdas, initial_state
+from formulations.solvers.box import AT_LOWER, FREE, box_bvls, box_pdas, initial_state
 from formulations.solvers.coulomb import coulomb_fixed_point
 from formulations.solvers.registry import FAST_SOLVER
 
@@ -72,7 +72,8 @@ def tresca_step(S: np.ndarray, r: np.ndarray, qp: ContactQP, previous: QPSolutio
     previous step's sets (a node pinned there by a zero bound sticks instead), the warm
     start's contact zone with every node sticking, the unconstrained solution's sets. The
     iteration is not globally convergent (it can cycle from a poor start, as the frictionless
-    one can), and the next start is then tried."""
+    one can), and the next start is then tried; if every start fails, bounded least squares
+    (``box.box_bvls``) finds the sets."""
     m, bound = qp.m, qp.friction.bound  # a Tresca step: Coulomb's steps have their bound
     lower = np.concatenate([np.zeros(m), -bound])
     upper = np.concatenate([np.full(m, np.inf), bound])
@@ -85,13 +86,14 @@ def tresca_step(S: np.ndarray, r: np.ndarray, qp: ContactQP, previous: QPSolutio
         starts.append(np.concatenate([np.where(np.asarray(warm_start) > 0, FREE, AT_LOWER),
                                       np.full(bound.size, FREE)]))
     starts.append(initial_state(r, lower, upper))
-    changes: tuple[int, ...] = ()
+    changes, cycled = (), False
     for state in starts:
         result = box_pdas(S, r, lower, upper, state, max_iter)
-        changes += result.changes
+        changes, cycled = changes + result.changes, cycled or result.cycled
         if result.status == STATUS_OK:
-            break
-    return replace(result, changes=changes)
+            return replace(result, changes=changes, cycled=cycled)
+    result = box_bvls(S, r, lower, upper, max_iter)
+    return replace(result, changes=changes + result.changes, cycled=cycled)
 
 
 def solve_frictional(qp: ContactQP, warm_start: np.ndarray | None = None, max_iter: int = 100,
@@ -109,7 +111,8 @@ def solve_frictional(qp: ContactQP, warm_start: np.ndarray | None = None, max_it
         clock = time.perf_counter()
         result = tresca_step(S, r, step_qp, previous, warm_start, max_iter)
         diagnostics = SolverDiagnostics(active_set_changes=result.changes,
-                                        cycled=result.cycled, sets=result.state)
+                                        cycled=result.cycled, sets=result.state,
+                                        safeguard=result.safeguard)
         if result.status != STATUS_OK:
             return QPSolution(None, None, result.status, f"frictional active set failed "
                               f"({result.reason})", result.iterations,

@@ -1,4 +1,4 @@
-"""Friction in the nodal VI: the box iteration, the fast solve against the reference, the
+"""Friction in the nodal VI: the box iteration, its bounded least-squares safeguard, the
 Coulomb fixed point and its verdict, and the refusals of the formulations without it."""
 
 from dataclasses import replace
@@ -12,7 +12,14 @@ from formulations.cells import family_for
 from formulations.kkt import RESIDUAL_TOLERANCE, qp_residuals
 from formulations.registry import FORMULATIONS
 from formulations.solvers.backends import available_backends, iterative
-from formulations.solvers.box import AT_LOWER, AT_UPPER, FREE, box_pdas, initial_state
+from formulations.solvers.box import (
+    AT_LOWER,
+    AT_UPPER,
+    FREE,
+    box_bvls,
+    box_pdas,
+    initial_state,
+)
 from scenes import get_scene
 from scenes.friction import friction_law
 
@@ -38,28 +45,24 @@ def test_box_pdas_reports_a_cycle_instead_of_looping():
     assert result.status == "failed" and "still changing" in result.reason
 
 
-CASES = [("paper", dict(friction="tresca", slip_bound=300.0), 1),
-         ("paper", dict(friction="coulomb", mu=0.3), 1),
-         ("paper", dict(friction="coulomb", mu=1.0), 2),
-         ("stick-slip", dict(), 3),
-         ("stick-slip", dict(friction="coulomb"), 2)]
+def test_bounded_least_squares_solves_the_box_qps_where_the_iteration_cycles():
+    rng = np.random.default_rng(0)
+    cycling = 0
+    for _ in range(2000):
+        A = rng.normal(size=(6, 6))
+        S, r = A @ A.T + 0.01 * np.eye(6), 3 * rng.normal(size=6)
+        lower, upper = -rng.uniform(0, 1, 6), rng.uniform(0, 1, 6)
+        if box_pdas(S, r, lower, upper, initial_state(r, lower, upper)).status == "ok":
+            continue
+        cycling += 1
+        result = box_bvls(S, r, lower, upper)
+        assert result.status == "ok" and result.safeguard == "bounded least squares"
+        # the KKT conditions of the box QP: lam is its own projected gradient step; the
+        # confirming PDAS iteration leaves round-off of an SPD solve of size 6
+        step = np.clip(result.lam - (S @ result.lam - r), lower, upper)
+        assert np.abs(result.lam - step).max() < 1e-12 * max(1.0, np.abs(r).max())
+    assert cycling > 10  # the plain iteration does cycle on such problems (measured 30 of 2000)
 
-
-@pytest.mark.parametrize("name, parameters, order", CASES)
-def test_the_fast_solve_is_exact_and_agrees_with_the_reference(name, parameters, order):
-    scene = get_scene(name, **parameters)
-    disc = get_formulation("vi")(scene, scene.mesh.refined(2), order=order)
-    fast, reference = solve(disc, "active-set"), solve(disc, "reference")
-    assert fast.status == "ok" and reference.status == "ok", (fast.reason, reference.reason)
-    # exact box sets: every residual at round-off (the Coulomb fixed point stops at 1e-11)
-    assert max(vars(fast.residuals).values()) < 1e-10, fast.residuals
-    energy, pressure = solution_difference(disc, fast, reference)
-    shear = (np.abs(fast.friction.shear - reference.friction.shear).max()
-             / np.abs(reference.friction.shear).max())
-    # Clarabel at 1e-12 (1e-10 where it stalls) leaves ~2e-9 in u and ~2e-8 in the tractions
-    # on these meshes; a wrong stick/slip set differs by 1e-3 or more
-    assert energy < 1e-7 and pressure < 1e-5 and shear < 1e-5, (energy, pressure, shear)
-    assert list(fast.friction.state) == list(reference.friction.state)
 
 
 @pytest.mark.parametrize("backend", available_backends())

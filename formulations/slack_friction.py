@@ -1,0 +1,56 @@
+"""The friction QP shared by the penalty and Nitsche's method (docs/theory.md, 17.2): a
+squared positive part per quadrature point for the normal law and a Huber function for the
+tangential one, each with one slack.
+
+With normal rows P (a length per point), tangential rows R (a length per point), weights D_q
+(a stress per length times the point's share of Gamma_C) and bounds b_q (a force),
+
+    min 1/2 u'Ku - F'u + 1/2 sum_q D_q (q_q^2 + r_q^2) + sum_q b_q |R u - w - r_q|
+    s.t. P u - q_q <= g_q,
+
+with q_q and r_q free: min_q {q^2 : q >= x} is (x)_+^2, and min_r (D r^2 / 2 + b |x - r|) is
+D times Huber's function of x with threshold b / D, whose derivative is the projection of D x
+onto [-b, b]. b_q is w_q s(x_q) (Tresca) or mu times the multiplier of the point's normal row,
+which is w_q times the pressure at x_q (Coulomb). The frictional active set solves it
+(``formulations.solvers.friction``) and the reference judges it.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy import sparse
+
+from formulations.base import ContactQP, FrictionRows
+from formulations.evaluation import evaluate_on_trace
+
+
+def contact_tangent(trace) -> np.ndarray:
+    """t = n turned by +90 degrees on every contact facet (2D): the direction of u_t."""
+    return np.array([-trace.normal[1], trace.normal[0]])
+
+
+def tangential_rows(elasticity, trace, t: np.ndarray) -> sparse.csr_matrix:
+    """u -> u_h . t at the points ``t`` of every contact facet, over the free DOFs."""
+    tangent = np.repeat(contact_tangent(trace), t.shape[-1], axis=1)
+    return elasticity.restrict(evaluate_on_trace(elasticity.basis, trace, t).matrix(tangent))
+
+
+def slack_friction_qp(scene, K: sparse.spmatrix, F: np.ndarray, P: sparse.spmatrix,
+                      R: sparse.spmatrix, gap: np.ndarray, weights: np.ndarray,
+                      row_length: np.ndarray, points: np.ndarray) -> ContactQP:
+    """The QP of the module docstring: unknowns u, the normal slacks, the tangential slacks;
+    ``row_length`` the points' shares w_q |e| of Gamma_C, ``points`` their positions."""
+    law, ns = scene.friction, row_length.size
+    zero, eye = sparse.csr_matrix((ns, ns)), sparse.identity(ns, format="csr")
+    bound = np.zeros(ns)
+    if law.kind == "tresca":
+        bound = row_length * np.ravel(law.slip_bound_at(points))
+    friction = FrictionRows(T=sparse.hstack([R, zero, -eye], format="csr"), bound=bound,
+                            coefficient=law.coefficient,
+                            shift=np.full(ns, law.slide) if law.slide else None)
+    D = sparse.diags(weights)
+    return ContactQP(K=sparse.block_diag([K, D, D], format="csr"),
+                     F=np.concatenate([F, np.zeros(2 * ns)]),
+                     B=sparse.hstack([P, -eye, zero], format="csr"), G=gap,
+                     row_scale=np.ones(ns),
+                     objective_scale=float(scene.material.young_modulus), friction=friction)
