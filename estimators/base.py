@@ -15,13 +15,17 @@ class BoundTerms:
     """The parts of a guaranteed bound's A and N (docs/theory.md, 13.1), each in energy-norm
     units, so that a user sees which one dominates: ``symmetric`` the compliance norm of
     sym sigma* - sigma_h, ``skew`` C_K ||skw sigma*||, ``oscillation`` C_G osc, ``load``
-    C_F ||rho||, ``negative_traction`` C_T ||lambda*_-||."""
+    C_F ||rho||, ``negative_traction`` C_T ||lambda*_-||; with Tresca friction
+    ``excess_shear`` C_T ||(|sigma*_t| - s)_+|| and ``friction_complementarity`` sqrt(B_t^+)
+    (docs/theory.md, 17.5; 0 without friction)."""
 
     symmetric: float
     skew: float
     oscillation: float
     load: float
     negative_traction: float
+    excess_shear: float = 0.0
+    friction_complementarity: float = 0.0
 
     def columns(self) -> dict[str, float]:
         """As result columns: eta_symmetric, eta_skew, ..."""

@@ -35,9 +35,11 @@ from estimators.guaranteed_contact import (
     FacetPolynomial,
     balanced_traction,
     contact_bound,
+    extension,
     projected_pressure,
     traction_at,
 )
+from estimators.guaranteed_friction import balanced_shear, friction_bound, raw_shear, shear_at
 from estimators.patch_data import interior_data, rebalanced
 from estimators.residual import stress_tensor
 from formulations import DiscreteSolution
@@ -52,13 +54,32 @@ class NotEquilibrated(RuntimeError):
     """The discrete solution does not balance the auxiliary problem's hat functions."""
 
 
+def tresca_only(scene=None, **context) -> str | None:
+    """Coulomb is refused (not a minimisation: no bound, docs/theory.md 17.5); 3D too."""
+    if scene is not None and scene.friction.kind == "coulomb":
+        return (f"estimator 'equilibrated' bounds the error under Tresca friction only "
+                f"(the scene's law is {scene.friction.label}: Coulomb's is not a "
+                "minimisation)")
+    return planar_only("equilibrated", "the Raviart-Thomas patch equilibration is built on "
+                                       "triangles")(scene=scene, **context)
+
+
+def friction_terms(friction, trace_constant: float) -> dict[str, float]:
+    """The friction parts of ``BoundTerms``: N_t and sqrt(B_t^+) (0 without friction)."""
+    if friction is None:
+        return {}
+    return {"excess_shear": trace_constant * friction.excess,
+            "friction_complementarity": float(np.sqrt(max(friction.complementarity, 0.0)))}
+
+
 @register_estimator("equilibrated", "guaranteed upper bound: equilibrated RT stress on vertex "
                                     "patches (Prager-Synge) plus Theorem 1's contact terms, "
-                                    "every constant computed", guaranteed=True,
-                    applies=planar_only("equilibrated", "the Raviart-Thomas patch "
-                                                         "equilibration is built on triangles"))
+                                    "every constant computed; Tresca friction's terms too",
+                    guaranteed=True, applies=tresca_only, friction=True)
 def estimate(scene, solution: DiscreteSolution) -> Estimate:
-    rec, interior, load, bound, boundary, clamped = equilibrate(scene, solution)
+    rec, interior, load, bound, boundary, clamped, shear = equilibrate(scene, solution)
+    friction = (None if shear is None else
+                friction_bound(scene, solution, shear, extension(scene, solution, clamped)))
     lam, mu = solution.elasticity.lame
     constants = domain_constants(scene)
     diff = rec.values - interior.sigma_h
@@ -71,13 +92,18 @@ def estimate(scene, solution: DiscreteSolution) -> Estimate:
                        skew=constants.korn * np.sqrt(skew.sum()),
                        oscillation=grad_constant * np.sqrt((osc**2).sum()),
                        load=constants.friedrichs * np.sqrt(load.sum()),
-                       negative_traction=constants.trace * bound.negative)
+                       negative_traction=constants.trace * bound.negative,
+                       **friction_terms(friction, constants.trace))
     A = terms.symmetric + terms.skew + terms.oscillation + terms.load
-    a = A + bound.extension + terms.negative_traction
-    b = A * bound.extension + bound.complementarity
+    a = A + bound.extension + terms.negative_traction + terms.excess_shear
+    # b only grows when rounded up to 0: e^2 <= a e + b stays true (docs/theory.md, 17.5)
+    b = max(A * bound.extension + bound.complementarity
+            + (friction.complementarity if friction else 0.0), 0.0)
     eta = 0.5 * (a + np.sqrt(a * a + 4 * b))
     local = (np.sqrt(compliance) + constants.korn * np.sqrt(skew) + grad_constant * osc
              + constants.friedrichs * np.sqrt(load)) ** 2 + bound.per_element
+    if friction is not None:
+        local = local + friction.per_element
     if local.sum() > 0:  # marking shares, scaled to sum to eta^2
         local = local * eta**2 / local.sum()
     return Estimate(estimator="equilibrated", eta=float(eta), eta_0=float(A),
@@ -88,8 +114,8 @@ def estimate(scene, solution: DiscreteSolution) -> Estimate:
 
 def equilibrate(scene, solution: DiscreteSolution):
     """sigma* (a ``Reconstruction``), the patch data, ||rho||_T^2, the contact terms of
-    lambda* (a ``ContactBound``), the Neumann data of the auxiliary problem and the clamped
-    vertices (docs/theory.md, 13.2 and 13.3)."""
+    lambda* (a ``ContactBound``), the Neumann data of the auxiliary problem, the clamped
+    vertices and sigma*_t (None without friction) (docs/theory.md, 13.2, 13.3 and 17.5)."""
     elasticity = solution.elasticity
     mesh, order = elasticity.mesh, elasticity.order
     lam, mu = elasticity.lame
@@ -107,8 +133,20 @@ def equilibrate(scene, solution: DiscreteSolution):
     neumann = BoundaryData(scene.neumann_facets(mesh), scene.traction or (lambda x: 0.0 * x))
     neumann_flux = boundary_fluxes(interior, [neumann])
     reaction = interior.total - boundary_balance(n_v, neumann_flux)[0]
-    lam_star, bound = contact_traction(scene, solution, interior, reaction, clamped)
-    contact = BoundaryData(trace.facets, lambda x: traction_at(trace, lam_star, x))
+    shear = None
+    sheared = [] if solution.friction is None else [
+        BoundaryData(trace.facets, lambda x: shear_at(trace, raw_shear(solution), x))]
+    lam_star, bound = contact_traction(  # the normal balance net of sigma_t,h's own
+        scene, solution, interior,
+        reaction - boundary_balance(n_v, boundary_fluxes(interior, sheared))[0], clamped)
+    normal = BoundaryData(trace.facets, lambda x: traction_at(trace, lam_star, x))
+    contact = normal
+    if sheared:  # sigma*_t balances what is left along the tangents (17.5)
+        defect = reaction - boundary_balance(n_v, boundary_fluxes(interior,
+                                                                  [normal, *sheared]))[0]
+        shear = balanced_shear(solution, defect, clamped)
+        contact = BoundaryData(trace.facets, lambda x: traction_at(trace, lam_star, x)
+                               + shear_at(trace, shear, x))
     fluxes = neumann_flux + boundary_fluxes(interior, [contact])
     interior, load = rebalanced(interior, interior.total - boundary_balance(n_v, fluxes)[0],
                                 clamped)
@@ -116,7 +154,7 @@ def equilibrate(scene, solution: DiscreteSolution):
     if rec.imbalance > BALANCE_TOLERANCE:
         raise NotEquilibrated(f"the patch data do not balance (relative imbalance "
                               f"{rec.imbalance:.1e} > {BALANCE_TOLERANCE:g}): no bound")
-    return rec, interior, load, bound, [neumann, contact], clamped
+    return rec, interior, load, bound, [neumann, contact], clamped, shear
 
 
 def contact_traction(scene, solution, interior, reaction: np.ndarray,

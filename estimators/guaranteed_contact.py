@@ -71,20 +71,26 @@ def facet_parameter(trace, x: np.ndarray) -> np.ndarray:
     return ((x - a) * (b - a)).sum(axis=0) / ((b - a) ** 2).sum(axis=0)
 
 
-def traction_at(trace, pressure, x: np.ndarray) -> np.ndarray:
+def traction_at(trace, pressure, x: np.ndarray, direction: np.ndarray | None = None
+                ) -> np.ndarray:
     """-pressure n at points x (2, n_f, nq) of the contact facets, with ``pressure(t)`` as
-    ``DiscreteSolution.pressure`` (the same local points on every facet, in any order)."""
+    ``DiscreteSolution.pressure`` (the same local points on every facet, in any order); with
+    a ``direction`` (2, n_f) instead of -n: pressure times it (a shear traction along t)."""
     t = facet_parameter(trace, x)
     common = np.unique(np.round(t, 12))
     values = pressure(common)
     index = np.abs(t[:, :, None] - common[None, None, :]).argmin(axis=-1)
-    return -np.take_along_axis(values, index, axis=1)[None] * trace.normal[:, :, None]
+    vector = -trace.normal if direction is None else direction
+    return np.take_along_axis(values, index, axis=1)[None] * vector[:, :, None]
 
 
-def balanced_traction(trace, pressure, defect: np.ndarray, clamped: np.ndarray):
+def balanced_traction(trace, pressure, defect: np.ndarray, clamped: np.ndarray,
+                      orientation: float = -1.0, directions: np.ndarray | None = None):
     """lambda* from lambda_h and the per-vertex imbalance ``defect`` (n_vertices, 2) of the
     auxiliary problem with lambda_h: M delta = -defect . nu on the contact vertices off Gamma_D
-    (M the P1 mass matrix of Gamma_C), and the imbalance left in tangential directions."""
+    (M the P1 mass matrix of Gamma_C), and the imbalance left in tangential directions. For a
+    traction ``orientation`` x value x ``directions`` (vertex vectors, (2, n_vertices)) in
+    general: M delta = orientation defect . directions (a shear: +1 and the vertex tangents)."""
     start, end = trace.vertices
     n_v = trace.mesh.p.shape[1]
     h = trace.length
@@ -92,12 +98,12 @@ def balanced_traction(trace, pressure, defect: np.ndarray, clamped: np.ndarray):
     cols = np.concatenate([start, end, start, end])
     vals = np.concatenate([h / 3, h / 6, h / 6, h / 3])
     M = sparse.coo_matrix((vals, (rows, cols)), shape=(n_v, n_v)).tocsr()
-    nu = vertex_normals(trace)
+    nu = vertex_normals(trace) if directions is None else directions
     on = np.unique(np.concatenate([start, end]))
     on = on[~clamped[on]]
     delta = np.zeros(n_v)
     if on.size:
-        rhs = -(defect[on] * nu[:, on].T).sum(axis=1)
+        rhs = orientation * (defect[on] * nu[:, on].T).sum(axis=1)
         delta[on] = np.atleast_1d(spsolve(M[on][:, on].tocsc(), rhs))
     return ContactTraction(pressure=pressure, delta=np.array([delta[start], delta[end]]))
 
@@ -121,24 +127,36 @@ class ContactBound:
     per_element: np.ndarray  # shares of D^2 + complementarity per element
 
 
-def contact_bound(scene, solution, traction: ContactTraction, clamped: np.ndarray) -> ContactBound:
+def extension(scene, solution, clamped: np.ndarray) -> np.ndarray:
+    """d = sum_a c_a psi_a nu_a at the contact vertices, (2, n_vertices): the largest c_a <= 0
+    with d . n <= w = (g - u_hn)_- on every contact facet (module docstring)."""
     trace = solution.trace
-    mesh = trace.mesh
     s = np.linspace(0.0, 1.0, SAMPLES)
     x_gap = _gap_minus_displacement(scene, solution, s)                 # (n_f, SAMPLES)
     w_min = np.minimum(x_gap, 0.0).min(axis=1)
     nu = vertex_normals(trace)
-    c = np.zeros(mesh.p.shape[1])
+    c = np.zeros(trace.mesh.p.shape[1])
     for v in trace.vertices:
         ratio = w_min / np.einsum("if,if->f", nu[:, v], trace.normal)
         np.minimum.at(c, v, ratio)
     c[clamped] = 0.0
-    energy = _p1_energy(mesh, c * nu, solution.elasticity.lame)
+    return c * nu
+
+
+def extension_along(trace, d: np.ndarray, direction: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """d . direction at local points t of every contact facet (direction (2, n_f)), linear
+    between the facet's vertices, (n_f, len(t))."""
+    start, end = (np.einsum("if,if->f", d[:, v], direction)[:, None] for v in trace.vertices)
+    return start * (1 - t) + end * t
+
+
+def contact_bound(scene, solution, traction: ContactTraction, clamped: np.ndarray) -> ContactBound:
+    trace = solution.trace
+    mesh = trace.mesh
+    d = extension(scene, solution, clamped)
+    energy = _p1_energy(mesh, d, solution.elasticity.lame)
     t, w = gauss_legendre(QUADRATURE)
-    d_n = (np.einsum("if,if->f", nu[:, trace.vertices[0]], trace.normal)[:, None]
-           * c[trace.vertices[0]][:, None] * (1 - t)
-           + np.einsum("if,if->f", nu[:, trace.vertices[1]], trace.normal)[:, None]
-           * c[trace.vertices[1]][:, None] * t)
+    d_n = extension_along(trace, d, trace.normal, t)
     lam = traction(t)
     slack = trace.integrate(np.maximum(lam, 0.0) * (_gap_minus_displacement(scene, solution, t)
                                                     - d_n), w)

@@ -39,6 +39,8 @@ class ResultRow:
     eta_oscillation: float = math.nan
     eta_load: float = math.nan
     eta_negative_traction: float = math.nan
+    eta_excess_shear: float = math.nan  # with Tresca friction (docs/theory.md, 17.5)
+    eta_friction_complementarity: float = math.nan
     violation: float = math.nan
     dual_violation: float = math.nan
     complementarity: float = math.nan

@@ -66,7 +66,7 @@ def test_reconstruction_is_equilibrated(formulation, options):
     scene = get_scene("free-boundary")
     sol = solve(get_formulation(formulation)(scene, scene.mesh.refined(2), order=2, **options),
                 "active-set")
-    rec, interior, _, _, _, _ = equilibrate(scene, sol)
+    rec, interior, *_ = equilibrate(scene, sol)
     div = np.array([rec.basis.interpolate(s).div for s in rec.dofs])  # (2, n_el, nq)
     integral = (div * rec.basis.dx).sum(axis=-1)
     data = interior.data.sum(axis=-1)                                   # (n_el, 3, 2)
