@@ -20,14 +20,16 @@ def friction_state(friction: FrictionRows, u_free: np.ndarray, normal: np.ndarra
                    traction: Callable[[np.ndarray], np.ndarray]) -> FrictionState:
     """The states and tractions of the friction points (rows of ``friction.T``) from the
     normal and tangential multipliers; ``to_stress`` turns a multiplier into a traction (1 /
-    w_i for vi's forces, 1 for the mixed method's coefficients), ``traction(t)`` gives
-    sigma_t,h on the contact facets. A point in contact with a zero bound slides freely: it
-    slips."""
+    w_i for vi's forces, 1 for the mixed method's coefficients; one per point), ``traction(t)``
+    gives sigma_t,h on the contact facets. A point in contact with a zero bound slides freely:
+    it slips. In 3D a point has two tangential entries (``friction.block``) and |.| is their
+    norm."""
     bound = friction.bounds(normal)
-    size = np.abs(tangential)
+    size = friction.node_norms(tangential)
     contact = normal > STATE_FRACTION * max(normal.max(initial=0.0), 0.0)
     slipping = size >= bound - STATE_FRACTION * bound.max(initial=0.0)
     state = np.where(~contact, "separated", np.where(slipping, "slip", "stick"))
     return FrictionState(coordinate=coordinate, tangential_reactions=tangential,
-                         shear=-tangential * to_stress, slip=friction.slip(u_free), bound=bound,
+                         shear=-tangential * np.repeat(to_stress, friction.block),
+                         slip=friction.slip(u_free), bound=bound,
                          state=state, traction=traction, bound_traction=bound * to_stress)

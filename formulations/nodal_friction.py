@@ -11,29 +11,47 @@ sigma_t = -lambda_t,i / w_i (friction opposes the slip).
 from __future__ import annotations
 
 import numpy as np
+from scipy import sparse
 
 from formulations.base import FrictionRows, FrictionState
+from formulations.contact_surface import triangle_lagrange
 from formulations.friction_state import friction_state
 
 
-def tangents(normal: np.ndarray) -> np.ndarray:
-    """t_i = (-n_2, n_1): the unit normals turned by +90 degrees (2D; the cell family
-    refuses friction on tetrahedra, where the bound is a disc)."""
-    if normal.shape[0] != 2:
-        raise ValueError(f"tangential rows need 2D normals, not {normal.shape[0]}D ones")
-    return np.array([-normal[1], normal[0]])
+def tangent_frame(normal: np.ndarray) -> list[np.ndarray]:
+    """Unit tangents at every node, orthogonal to the normals (d, m): in 2D t = (-n_2, n_1)
+    (n turned by +90 degrees); in 3D t_1 = n x e_k / |n x e_k| with e_k the axis least aligned
+    with n, and t_2 = n x t_1."""
+    if normal.shape[0] == 2:
+        return [np.array([-normal[1], normal[0]])]
+    axis = np.eye(3)[:, np.argmin(np.abs(normal), axis=0)]
+    first = np.cross(normal, axis, axis=0)
+    first /= np.linalg.norm(first, axis=0)
+    return [first, np.cross(normal, first, axis=0)]
 
 
-def friction_rows(scene, nodes, T) -> FrictionRows | None:
+def interleaved(rows: list[sparse.csr_matrix]) -> sparse.csr_matrix:
+    """The rows of each matrix in turn per node: (T_1)_0, (T_2)_0, (T_1)_1, ... (node-major,
+    as ``FrictionRows`` has them)."""
+    m = rows[0].shape[0]
+    order = np.arange(len(rows) * m).reshape(len(rows), m).T.ravel()
+    return sparse.vstack(rows, format="csr")[order]
+
+
+def friction_rows(scene, nodes, T, block: int = 1) -> FrictionRows | None:
     """The ``FrictionRows`` of ``scene``'s law on ``nodes`` with tangential rows ``T`` (free
-    DOFs), or None without friction."""
+    DOFs, ``block`` per node), or None without friction."""
     law = scene.friction
     if not law.active:
         return None
+    if law.slide and block != 1:
+        raise ValueError(f"slide={law.slide!r} is a displacement along the one tangent of 2D; "
+                         "in 3D the obstacle does not slide")
     bound = (nodes.weight * law.slip_bound_at(nodes.points) if law.kind == "tresca"
              else np.zeros(nodes.weight.size))
     shift = np.full(nodes.weight.size, law.slide) if law.slide else None
-    return FrictionRows(T=T, bound=bound, coefficient=law.coefficient, shift=shift)
+    return FrictionRows(T=T, bound=bound, coefficient=law.coefficient, shift=shift,
+                        block=block)
 
 
 def facet_interpolant(values: np.ndarray, t: np.ndarray) -> np.ndarray:
@@ -46,8 +64,21 @@ def facet_interpolant(values: np.ndarray, t: np.ndarray) -> np.ndarray:
 
 
 def nodal_friction(friction: FrictionRows, u_free: np.ndarray, reactions: np.ndarray,
-                   tangential: np.ndarray, nodes, coordinate: np.ndarray) -> FrictionState:
-    """The node states and tractions from the returned arrays (``friction_state``)."""
-    shear = -tangential / nodes.weight
+                   tangential: np.ndarray, nodes, coordinate: np.ndarray,
+                   frame: list[np.ndarray]) -> FrictionState:
+    """The node states and tractions from the returned arrays (``friction_state``); in 3D
+    ``traction(t)`` is the shear vector sum_k sigma_k t_k, (3, n_facets, nq), interpolated
+    per component from the nodes (``frame`` the nodes' tangents)."""
+    shear = -tangential / np.repeat(nodes.weight, friction.block)
+    if friction.block == 1:
+        def traction(t):
+            return facet_interpolant(shear[nodes.facet_rows], t)
+    else:
+        vectors = sum(shear.reshape(-1, 2)[:, k] * frame[k] for k in range(2))  # (3, m)
+        basis = triangle_lagrange(nodes.facet_rows.shape[1] // 3)[1]
+
+        def traction(t):
+            at = basis(np.asarray(t, dtype=float))
+            return np.stack([vectors[c][nodes.facet_rows] @ at for c in range(3)])
     return friction_state(friction, u_free, reactions, tangential, 1.0 / nodes.weight,
-                          coordinate, lambda t: facet_interpolant(shear[nodes.facet_rows], t))
+                          coordinate, traction)

@@ -57,14 +57,17 @@ def surface_nodes(mesh, trace, order: int) -> TraceNodes:
                       vertices=vertices, edges=edges)
 
 
-def surface_rows(elasticity, nodes: TraceNodes) -> sparse.csr_matrix:
-    """B_i = n_i' u_h(x_i): at a P1 or P2 Lagrange node the value is the node's own DOFs."""
+def surface_rows(elasticity, nodes: TraceNodes,
+                 directions: np.ndarray | None = None) -> sparse.csr_matrix:
+    """B_i = n_i' u_h(x_i): at a P1 or P2 Lagrange node the value is the node's own DOFs.
+    ``directions`` (3, m) replaces the normals n_i (the tangential rows of friction)."""
     basis = elasticity.basis
+    directions = nodes.normal if directions is None else directions
     dofs = basis.nodal_dofs[:, nodes.vertices]
     if nodes.edges.size:
         dofs = np.concatenate([dofs, basis.edge_dofs[:, nodes.edges]], axis=1)
     m = dofs.shape[1]
-    rows = sparse.csr_matrix((nodes.normal.ravel(), (np.tile(np.arange(m), 3), dofs.ravel())),
+    rows = sparse.csr_matrix((directions.ravel(), (np.tile(np.arange(m), 3), dofs.ravel())),
                              shape=(m, basis.N))
     # a component a normal does not have is no column of B: on a plane Gamma_C the condensed
     # solvers' Schur set is then one DOF per node, not three (a dense block 9x smaller)

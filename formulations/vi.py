@@ -35,8 +35,9 @@ from formulations.kkt import count_active
 from formulations.nodal_friction import (
     facet_interpolant,
     friction_rows,
+    interleaved,
     nodal_friction,
-    tangents,
+    tangent_frame,
 )
 from formulations.registry import register_formulation
 from formulations.surface_nodes import (
@@ -109,7 +110,7 @@ def constraint_rows(elasticity, trace, nodes: TraceNodes,
 @register_formulation("vi", "primal variational inequality: nodal constraints "
                             "u_h(x_i).n_i <= g(x_i) at every Lagrange node of Gamma_C, "
                             "lambda_h from the nodal reactions; Tresca or Coulomb friction "
-                            "on the same nodes (2D)", friction=True)
+                            "on the same nodes", friction=True)
 def discretise(scene: Scene, mesh: MeshTri, order: int = 1) -> Discretisation:
     elasticity = assemble_elasticity(scene, mesh, check_order(order))
     trace = contact_trace(scene, mesh)
@@ -122,8 +123,10 @@ def discretise(scene: Scene, mesh: MeshTri, order: int = 1) -> Discretisation:
     m = nodes.weight.size
     G = np.asarray(scene.gap(nodes.points), dtype=float)
     # rows of B are dimensionless (a normal), so the multipliers are forces; row_scale 1
-    friction = (friction_rows(scene, nodes, elasticity.restrict(
-        constraint_rows(elasticity, trace, nodes, tangents(nodes.normal))))
+    frame = tangent_frame(nodes.normal)
+    friction = (friction_rows(scene, nodes, elasticity.restrict(interleaved([
+        surface_rows(elasticity, nodes, t) if trace.dim == 3
+        else constraint_rows(elasticity, trace, nodes, t) for t in frame])), len(frame))
         if scene.friction.active else None)
     qp = ContactQP(K=elasticity.K_free, F=elasticity.F_free,
                    B=elasticity.restrict(B), G=G, row_scale=np.ones(m),
@@ -156,7 +159,7 @@ def discretise(scene: Scene, mesh: MeshTri, order: int = 1) -> Discretisation:
             details=NodalDetails(reactions=reaction, nodal_pressure=lam,
                                  contact_nodes=nodes.vertices),
             friction=None if friction is None else nodal_friction(
-                friction, answer.u, reaction, tangential_of(answer), nodes, coordinate))
+                friction, answer.u, reaction, tangential_of(answer), nodes, coordinate, frame))
 
     return Discretisation(formulation="vi", elasticity=elasticity, trace=trace, qp=qp,
                           recover=recover, row_coordinate=coordinate)

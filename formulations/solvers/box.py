@@ -37,7 +37,7 @@ AT_LOWER, FREE, AT_UPPER = -1, 0, 1
 @dataclass(frozen=True)
 class BoxResult:
     lam: np.ndarray
-    state: np.ndarray  # AT_LOWER, FREE or AT_UPPER per entry
+    state: np.ndarray | None  # AT_LOWER, FREE or AT_UPPER per entry (None: discs, no sets)
     iterations: int
     status: str
     reason: str

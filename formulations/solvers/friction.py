@@ -13,7 +13,8 @@ a node in contact, a free tangential one a node that sticks, one at a bound a no
 K is factorised once and S comes from the same factorisation, as in the frictionless
 ``active_set``; Coulomb's fixed point (``coulomb``) reuses both for every step, so a Coulomb
 level costs one factorisation too. Two tangential directions per node (3D) make the bound a
-disc, not a box: that is not solved here (``FrictionError``).
+disc, not a box: the same condensed problem is then solved by semismooth Newton
+(``disc.disc_ssn``), warm-started by the previous Coulomb step.
 """
 
 from __future__ import annotations
@@ -32,8 +33,16 @@ from formulations.solvers.backends import (
     factorise_condensed,
     iterative,
 )
-from formulations.solvers.box import AT_LOWER, FREE, box_bvls, box_pdas, initial_state
+from formulations.solvers.box import (
+    AT_LOWER,
+    FREE,
+    BoxResult,
+    box_bvls,
+    box_pdas,
+    initial_state,
+)
 from formulations.solvers.coulomb import coulomb_fixed_point
+from formulations.solvers.disc import disc_ssn
 from formulations.solvers.registry import FAST_SOLVER
 
 # the exact active-set steps leave round-off; the fixed point stops when the bound has settled
@@ -96,20 +105,32 @@ def tresca_step(S: np.ndarray, r: np.ndarray, qp: ContactQP, previous: QPSolutio
     return replace(result, changes=changes + result.changes, cycled=cycled)
 
 
+def disc_step(S: np.ndarray, r: np.ndarray, qp: ContactQP, previous: QPSolution | None,
+              max_iter: int) -> BoxResult:
+    """One Tresca solve with discs (3D), from the previous step's multipliers if any."""
+    start = None
+    if previous is not None and previous.u is not None:
+        start = np.concatenate([previous.multipliers, previous.tangential])
+    result = disc_ssn(S, r, qp.m, qp.friction.bound, start, max_iter)
+    return BoxResult(result.lam, None, result.iterations, result.status,
+                     result.reason and f"semismooth Newton on the discs: {result.reason}", (),
+                     False)
+
+
 def solve_frictional(qp: ContactQP, warm_start: np.ndarray | None = None, max_iter: int = 100,
                      backend: str | None = None) -> QPSolution:
     """Tresca or Coulomb (a fixed point on the bound, ``coulomb``) on one factorisation."""
-    if qp.friction.block != 1:
+    if qp.friction.block not in (1, 2):
         raise FrictionError(f"friction with {qp.friction.block} tangential directions per "
-                            "node (3D) needs a second-order-cone solve; the active-set solver "
-                            "has only the 2D box")
+                            "node: only 1 (2D, a box) and 2 (3D, a disc) are solved")
     start = time.perf_counter()
     backend = check_backend(backend)
     solve, C, S, r, phases = condensed_system(qp, backend)
 
     def tresca(step_qp: ContactQP, previous: QPSolution | None) -> QPSolution:
         clock = time.perf_counter()
-        result = tresca_step(S, r, step_qp, previous, warm_start, max_iter)
+        result = (disc_step(S, r, step_qp, previous, max_iter) if qp.friction.block == 2
+                  else tresca_step(S, r, step_qp, previous, warm_start, max_iter))
         diagnostics = SolverDiagnostics(active_set_changes=result.changes,
                                         cycled=result.cycled, sets=result.state,
                                         safeguard=result.safeguard)

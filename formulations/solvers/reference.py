@@ -54,10 +54,12 @@ def solve_reference(qp: ContactQP, warm_start=None, backend=None,
                                    COULOMB_RTOL, COULOMB_NOISE_FLOOR)
     if qp.friction is not None and not clarabel_options:
         answer = solve_reference(qp, **FRICTION_TOLERANCES)
-        if answer.status != STATUS_INACCURATE:
+        if answer.status == STATUS_OK:
             return answer
-        retry = solve_reference(qp, **CLARABEL_TOLERANCES)  # the tighter tolerances stalled
-        return replace(retry, reason=joined(retry.reason, "stalled at the friction "
+        # the tighter tolerances stalled (inaccurate) or broke down (failed: seen with the
+        # cones of 3D friction on paper-3d)
+        retry = solve_reference(qp, **CLARABEL_TOLERANCES)
+        return replace(retry, reason=joined(retry.reason, f"{answer.status} at the friction "
                                              "tolerances 1e-12, answered at 1e-10"),
                        solve_time=answer.solve_time + retry.solve_time)
     settings = {**CLARABEL_TOLERANCES, **clarabel_options}
@@ -90,10 +92,8 @@ def solve_reference(qp: ContactQP, warm_start=None, backend=None,
                           iterations, elapsed, REFERENCE_SOLVER, "clarabel")
     mu = np.asarray(constraints[0].dual_value if qp.m else np.zeros(0), dtype=float).ravel()
     tangential = None
-    if qp.friction is not None:  # the two one-sided rows' multipliers, in force units
-        plus, minus = (np.asarray(c.dual_value, dtype=float) for c in constraints[-2:])
-        tangential = (qp.objective_scale * d * (plus - minus)
-                      / qp.row_scale[:qp.friction.T.shape[0]])
+    if qp.friction is not None:
+        tangential = tangential_reactions(qp, constraints, d)
     status, reason = STATUS_OK, ""
     if problem.status == cp.OPTIMAL_INACCURATE:
         status, reason = STATUS_INACCURATE, "Clarabel stopped short of its tolerances " \
@@ -106,16 +106,38 @@ def solve_reference(qp: ContactQP, warm_start=None, backend=None,
 
 def friction_term(qp: ContactQP, u: cp.Variable, objective, d: float):
     """The Tresca term sum_i b_i |T_i u - w_i| in the scaled units (u = d v, objective / (E d^2),
-    each row of T divided by its B row's ``row_scale``, r): a slip variable
-    z >= |T v / r - w / (r d)| per row, costed (b r / (E d)) z; the rows' multipliers are the
-    tangential reactions (times r / (E d))."""
+    each row of T divided by its node's B row's ``row_scale``, r): a slip variable
+    z_i >= |T_i v / r_i - w_i / (r_i d)| per node, costed (b r / (E d)) z; in 2D two one-sided
+    rows whose multipliers are the tangential reactions (times r / (E d)), in 3D a second-order
+    cone per node (``tangential_reactions``)."""
     friction = qp.friction
-    if friction.block != 1:
-        raise ValueError(f"friction with {friction.block} tangential directions per node "
-                         "needs a second-order cone; the reference has only the 2D form")
-    z = cp.Variable(friction.T.shape[0])
-    scale = qp.row_scale[:friction.T.shape[0]]  # the points' normal rows come first in B
+    nodes = friction.bound.size
+    if friction.block not in (1, 2):
+        raise ValueError(f"friction with {friction.block} tangential directions per node: "
+                         "the reference has the 2D and 3D forms only")
+    z = cp.Variable(nodes)
+    scale = qp.row_scale[:nodes]  # the points' normal rows come first in B
     weight = friction.bound * scale / (qp.objective_scale * d)
-    T = (sparse.diags(1.0 / scale) @ friction.T).tocsr()
-    shift = np.zeros(T.shape[0]) if friction.shift is None else friction.shift / (scale * d)
-    return objective + weight @ z, [T @ u - shift - z <= 0, -(T @ u - shift) - z <= 0]
+    row_scale = np.repeat(scale, friction.block)
+    T = (sparse.diags(1.0 / row_scale) @ friction.T).tocsr()
+    shift = (np.zeros(T.shape[0]) if friction.shift is None
+             else friction.shift / (row_scale * d))
+    slip = T @ u - shift
+    if friction.block == 1:
+        return objective + weight @ z, [slip - z <= 0, -slip - z <= 0]
+    return objective + weight @ z, [cp.SOC(z, cp.reshape(slip, (nodes, 2), order="C"),
+                                           axis=1)]
+
+
+def tangential_reactions(qp: ContactQP, constraints: list, d: float) -> np.ndarray:
+    """lambda_t in force units from the friction constraints' multipliers: in 2D the two
+    one-sided rows' difference, in 3D minus the cone's vector part (Clarabel's dual of
+    |x| <= z pairs x with -lambda_t)."""
+    friction = qp.friction
+    scale = np.repeat(qp.row_scale[:friction.bound.size], friction.block)
+    if friction.block == 1:
+        plus, minus = (np.asarray(c.dual_value, dtype=float) for c in constraints[-2:])
+        values = plus - minus
+    else:
+        values = -np.asarray(constraints[-1].dual_value[1], dtype=float).ravel()
+    return qp.objective_scale * d * values / scale

@@ -1,0 +1,80 @@
+"""Friction in 3D on the nodal VI: the tangent frame, the disc QP's semismooth Newton solve,
+and the fast solve of paper-3d with Tresca and Coulomb friction against the second-order-cone
+reference (docs/theory.md, 17.3)."""
+
+from dataclasses import replace
+
+import cvxpy as cp
+import numpy as np
+import pytest
+
+from bench.measure.difference import solution_difference
+from formulations import get_formulation, solve
+from formulations.nodal_friction import tangent_frame
+from formulations.solvers.disc import disc_ssn
+from scenes import get_scene
+from scenes.friction import friction_law
+
+
+def test_the_tangent_frame_is_orthonormal_and_orthogonal_to_the_normal():
+    normal = np.random.default_rng(0).normal(size=(3, 50))
+    normal /= np.linalg.norm(normal, axis=0)
+    normal[:, 0] = [0.0, 0.0, -1.0]  # a plane Gamma_C's normal
+    first, second = tangent_frame(normal)
+    for a, b in [(first, second), (first, normal), (second, normal)]:
+        assert np.abs((a * b).sum(axis=0)).max() < 1e-15  # round-off of one cross product
+    for t in (first, second):
+        assert np.linalg.norm(t, axis=0) == pytest.approx(1.0, abs=1e-15)
+
+
+def test_semismooth_newton_solves_random_disc_qps():
+    rng = np.random.default_rng(1)
+    for _ in range(20):
+        m = 6
+        A = rng.normal(size=(3 * m, 3 * m))
+        S, r = A @ A.T + 0.05 * np.eye(3 * m), 3 * rng.normal(size=3 * m)
+        bound = rng.uniform(0, 1, m)
+        bound[0] = 0.0  # a node that slides freely
+        result = disc_ssn(S, r, m, bound)
+        assert result.status == "ok", result.reason
+        lam = result.lam
+        # the optimality condition, written here independently: lam is its own projected
+        # gradient step (normal entries onto [0, inf), pairs onto their discs)
+        z = lam - (S @ lam - r)
+        pairs = z[m:].reshape(-1, 2)
+        size = np.linalg.norm(pairs, axis=1)
+        shrink = np.minimum(1.0, bound / np.where(size > 0, size, 1.0))
+        step = np.concatenate([np.maximum(z[:m], 0.0), (pairs * shrink[:, None]).ravel()])
+        assert np.abs(lam - step).max() < 1e-11 * max(1.0, np.abs(r).max())
+        x = cp.Variable(3 * m)
+        cp.Problem(cp.Minimize(0.5 * cp.quad_form(x, S) - r @ x),
+                   [x[:m] >= 0, cp.SOC(cp.Constant(bound), cp.reshape(x[m:], (m, 2), order="C"),
+                                       axis=1)]).solve(
+            solver=cp.CLARABEL, tol_gap_abs=1e-10, tol_gap_rel=1e-10, tol_feas=1e-10)
+        # and Clarabel's answer at 1e-10: agreement to its accuracy at the cones' apex
+        # (measured <= 1.1e-6)
+        assert np.abs(lam - x.value).max() < 1e-5 * max(1.0, np.abs(x.value).max())
+        assert np.all(lam[:m] >= 0)
+        assert np.all(np.linalg.norm(lam[m:].reshape(-1, 2), axis=1) <= bound * (1 + 1e-12))
+
+
+@pytest.mark.parametrize("law", [friction_law("coulomb", mu=0.3),
+                                 friction_law("tresca", slip_bound=35.0)])
+def test_the_fast_3d_solve_is_exact_and_agrees_with_the_cone_reference(law):
+    scene = replace(get_scene("paper-3d"), friction=law)
+    disc = get_formulation("vi")(scene, scene.mesh.refined(1))
+    assert disc.qp.friction.block == 2
+    fast, reference = solve(disc, "active-set"), solve(disc, "reference")
+    assert fast.status == "ok" and reference.status == "ok", (fast.reason, reference.reason)
+    # the semismooth Newton iteration stops at round-off: every KKT residual, the discs' dual
+    # violation and slip complementarity included, is tiny (measured <= 2e-13)
+    assert max(vars(fast.residuals).values()) < 1e-10, fast.residuals
+    energy, pressure = solution_difference(disc, fast, reference)
+    shear = (np.abs(fast.friction.shear - reference.friction.shear).max()
+             / np.abs(reference.friction.shear).max())
+    # the interior-point cones converge slowly at their apex (the sticking nodes): measured
+    # 1.4e-7 / 4.5e-7 in energy, 2e-7 in the pressure and 2e-5 / 3e-3 in the shear (a slip
+    # direction fixed by slips of 4e-3 against u of 0.15) for Coulomb / Tresca
+    assert energy < 2e-6 and pressure < 1e-5 and shear < 1e-2, (energy, pressure, shear)
+    states = set(fast.friction.state)
+    assert "slip" in states and "separated" in states
