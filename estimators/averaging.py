@@ -89,7 +89,7 @@ def averaging_indicators(solution: DiscreteSolution) -> np.ndarray:
 
 @register_estimator("averaging", "Zienkiewicz-Zhu nodal stress averaging in the energy norm "
                                  "plus the geometric and complementarity contact terms of (8); "
-                                 "with friction the friction complementarity (2D)",
-                    families=("tri", "tet", "quad"), friction=True)
+                                 "with friction the friction complementarity",
+                    families=("tri", "tet", "quad"), friction=(2, 3))
 def estimate(scene, solution: DiscreteSolution) -> Estimate:
     return combine("averaging", averaging_indicators(solution), contact_terms(scene, solution))

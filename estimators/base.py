@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from formulations.registry import frictionless_only
+from formulations.registry import friction_dims, frictionless_only
 from scenes.registry import Registry
 
 
@@ -81,16 +81,20 @@ SIMPLICES = ("tri", "tet")  # the cell families (formulations.cells) most estima
 
 
 def register_estimator(name: str, description: str, applies=None, guaranteed: bool = False,
-                       families: tuple[str, ...] = SIMPLICES, friction: bool = False):
+                       families: tuple[str, ...] = SIMPLICES,
+                       friction: bool | tuple[int, ...] = False):
     """Register ``estimate(scene, solution) -> Estimate`` under ``name``; ``guaranteed``: its
     eta is an upper bound of the energy error with every constant computed (what
     ``--target-error`` needs); ``families``: the cell families it runs on (others can add
     their own ``register_cell_variant``); ``friction``: whether it has the friction terms
-    (else a scene with friction is refused with that reason)."""
-    check = applies if friction else frictionless_only("estimator", name, applies)
+    (True: in 2D; or the dimensions, e.g. (2, 3)), else a scene with friction is refused with
+    that reason."""
+    dims = friction_dims(friction)
+    check = frictionless_only("estimator", name, applies, dims)
     return ESTIMATORS.register(name, description, check,
                                meta={"guaranteed": bool(guaranteed),
-                                     "families": tuple(families), "friction": bool(friction)})
+                                     "families": tuple(families), "friction": bool(dims),
+                                     "friction_dims": dims})
 
 
 def register_cell_variant(name: str, family: str):

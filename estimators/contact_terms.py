@@ -66,16 +66,26 @@ def tangential_derivatives(scene, trace, t: np.ndarray, gradient: np.ndarray) ->
 
 def friction_complementarity(scene, solution: DiscreteSolution, at_points, t: np.ndarray,
                              w: np.ndarray) -> np.ndarray:
-    """|int_e (s |u_th| + sigma_t,h u_th) ds| per contact facet (2D; docs/theory.md, 17.5):
-    zero where the friction law holds pointwise (stick: u_th = 0; slip: sigma_t,h = -s u_th /
-    |u_th|), with s the Tresca bound or mu lambda_h (Coulomb)."""
+    """|int_e (s |u_th| + sigma_t,h . u_th) ds| per contact facet (docs/theory.md, 17.5): zero
+    where the friction law holds pointwise (stick: u_th = 0; slip: sigma_t,h = -s u_th /
+    |u_th|), with s the Tresca bound or mu lambda_h (Coulomb). In 3D u_th = u_h - u_hn n and
+    sigma_t,h are vectors."""
     trace, law = solution.trace, scene.friction
-    tangent = np.repeat(np.array([-trace.normal[1], trace.normal[0]]), t.size, axis=1)
-    u_t = np.einsum("in,in->n", at_points.value(solution.u), tangent).reshape(trace.size, -1)
-    u_t = u_t - law.slide  # the slip relative to the obstacle
+    nq = t.shape[-1]
+    u = at_points.value(solution.u)
+    if trace.dim == 2:
+        tangent = np.repeat(np.array([-trace.normal[1], trace.normal[0]]), nq, axis=1)
+        u_t = np.einsum("in,in->n", u, tangent).reshape(trace.size, -1) - law.slide
+        size, work = np.abs(u_t), solution.friction.traction(t) * u_t
+    else:
+        normal = np.repeat(trace.normal, nq, axis=1)
+        u_t = u - np.einsum("in,in->n", u, normal) * normal
+        size = np.linalg.norm(u_t, axis=0).reshape(trace.size, nq)
+        work = np.einsum("in,in->n", solution.friction.traction(t).reshape(3, -1),
+                         u_t).reshape(trace.size, nq)
     bound = (law.slip_bound_at(trace.points(t)) if law.kind == "tresca"
              else law.coefficient * solution.pressure(t))
-    return np.abs(trace.integrate(bound * np.abs(u_t) + solution.friction.traction(t) * u_t, w))
+    return np.abs(trace.integrate(bound * size + work, w))
 
 
 def contact_terms(scene, solution: DiscreteSolution) -> ContactTerms:

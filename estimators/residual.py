@@ -143,8 +143,8 @@ def edge_residuals(scene, solution: DiscreteSolution) -> np.ndarray:
 
 @register_estimator("residual", "residual eta_0 (seed paper, section 5) plus the geometric and "
                                 "complementarity contact terms of eq. (8); with friction the "
-                                "shear residual and the friction complementarity (2D)",
-                    friction=True)
+                                "shear residual and the friction complementarity",
+                    friction=(2, 3))
 def estimate(scene, solution: DiscreteSolution) -> Estimate:
     return combine("residual", volume_terms(scene, solution), contact_terms(scene, solution))
 

@@ -4,7 +4,8 @@
     eta_0^2 = (1/E) sum_T ( (h_T/p)^2 ||f + div sigma(u_h)||_T^2 + sum_{F in T} (h_F/p) R_F^2 ),
 
 R_F = 1/2 ||[sigma_n(u_h)]||_F inside, ||sigma_n(u_h) - q||_F on Gamma_N and
-||sigma_nn(u_h) + lambda_h||_F + ||sigma_nt(u_h)||_F on Gamma_C; h_F is the face's diameter.
+||sigma_nn(u_h) + lambda_h||_F + ||sigma_nt(u_h) - sigma_t,h||_F on Gamma_C (sigma_t,h = 0
+without friction); h_F is the face's diameter.
 For P1 and P2 on affine tetrahedra sigma(u_h) is of degree p - 1, so div sigma(u_h) is 0 (P1)
 or constant per element (P2, ``stress_divergence_3d``); the element residual itself is
 ``estimators.residual.element_residual``, the same in both dimensions.
@@ -95,7 +96,10 @@ def face_residuals_3d(scene, solution: DiscreteSolution) -> np.ndarray:
     sigma = stress_at(solution, trace.points(t).reshape(3, -1), np.repeat(trace.element, nq))
     sn = np.einsum("ijn,jn->in", sigma, normal)
     snn = np.einsum("in,in->n", sn, normal)
-    snt2 = ((sn - snn * normal) ** 2).sum(axis=0).reshape(-1, nq)
+    shear = sn - snn * normal
+    if solution.friction is not None:  # sigma_nt(u_h) - sigma_t,h (docs/theory.md, 17.5)
+        shear = shear - solution.friction.traction(t).reshape(3, -1)
+    snt2 = (shear**2).sum(axis=0).reshape(-1, nq)
     normal_part = np.sqrt(trace.integrate((snn.reshape(-1, nq) + solution.pressure(t)) ** 2, w))
     r_f = normal_part + np.sqrt(trace.integrate(snt2, w))
     out += np.bincount(trace.element, trace.diameter / order * r_f**2, n_elements)

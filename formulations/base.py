@@ -86,9 +86,10 @@ class FrictionState:
     bound_traction: np.ndarray  # the bound as a stress (s(x_i), or mu lambda_h(x_i))
 
     def zone(self, state: str) -> tuple[float, float]:
-        """The end points of the points in ``state`` (NaN, NaN if there are none)."""
-        where = self.coordinate[self.state == state]
-        if where.size == 0:
+        """The end points of the points in ``state`` along a 2D Gamma_C (NaN, NaN if there
+        are none, or in 3D, where a zone is not an interval)."""
+        where = self.coordinate[..., self.state == state]
+        if where.size == 0 or self.coordinate.ndim != 1:
             return float("nan"), float("nan")
         return float(where.min()), float(where.max())
 

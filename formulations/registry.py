@@ -8,12 +8,22 @@ formulation_descriptions = FORMULATIONS.descriptions
 get_formulation = FORMULATIONS.get
 
 
-def frictionless_only(kind: str, name: str, applies=None):
-    """``applies`` (or nothing) plus the refusal of a scene with friction, for a ``kind``
-    ('formulation', 'estimator') ``name`` that does not model it (docs/theory.md, 17)."""
+def friction_dims(friction) -> tuple[int, ...]:
+    """The dimensions a registration models friction in: True is 2D, False none, or a tuple."""
+    if friction is True:
+        return (2,)
+    if friction is False:
+        return ()
+    return tuple(int(d) for d in friction)
+
+
+def frictionless_only(kind: str, name: str, applies=None, dims: tuple[int, ...] = ()):
+    """``applies`` (or nothing) plus the refusal of a scene with friction in a dimension not in
+    ``dims``, for a ``kind`` ('formulation', 'estimator') ``name`` (docs/theory.md, 17)."""
     def check(scene=None, **context) -> str | None:
-        if scene is not None and scene.friction.active:
-            return (f"{kind} {name!r} does not model friction (the scene's law is "
+        if scene is not None and scene.friction.active and scene.dim not in dims:
+            where = f" in {scene.dim}D" if dims else ""
+            return (f"{kind} {name!r} does not model friction{where} (the scene's law is "
                     f"{scene.friction.label})")
         return applies(scene=scene, **context) if applies is not None else None
 
@@ -21,9 +31,12 @@ def frictionless_only(kind: str, name: str, applies=None):
 
 
 def register_formulation(name: str, description: str, applies=None, *,
-                         friction: bool = False):
+                         friction: bool | tuple[int, ...] = False):
     """Register ``discretise(scene, mesh, **options)`` under ``name``; ``applies(scene=...)``
     says why a scene is refused (optional); ``friction``: whether it models a scene's
-    friction law (else a scene with friction is refused with that reason)."""
-    check = applies if friction else frictionless_only("formulation", name, applies)
-    return FORMULATIONS.register(name, description, check, meta={"friction": bool(friction)})
+    friction law (True: in 2D; or the dimensions, e.g. (2, 3)), else a scene with friction is
+    refused with that reason."""
+    dims = friction_dims(friction)
+    check = frictionless_only("formulation", name, applies, dims)
+    return FORMULATIONS.register(name, description, check,
+                                 meta={"friction": bool(dims), "friction_dims": dims})

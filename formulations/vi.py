@@ -110,7 +110,7 @@ def constraint_rows(elasticity, trace, nodes: TraceNodes,
 @register_formulation("vi", "primal variational inequality: nodal constraints "
                             "u_h(x_i).n_i <= g(x_i) at every Lagrange node of Gamma_C, "
                             "lambda_h from the nodal reactions; Tresca or Coulomb friction "
-                            "on the same nodes", friction=True)
+                            "on the same nodes (2D and 3D)", friction=(2, 3))
 def discretise(scene: Scene, mesh: MeshTri, order: int = 1) -> Discretisation:
     elasticity = assemble_elasticity(scene, mesh, check_order(order))
     trace = contact_trace(scene, mesh)

@@ -4,6 +4,8 @@ Omega = (-1, 1)^3, Gamma_C the bottom face (outer normal (0, 0, -1)), Gamma_D th
 traction-free sides, f = 0, E = 70000 N/mm^2, nu = 0.33 (3D elasticity). The obstacle is the
 ball of radius 1 centred at (0, 0, -1.85): its surface z = sqrt(1 - r^2) - 1.85 gives the
 linearised gap g(x, y) = 0.85 - sqrt(1 - r^2) along n = (0, 0, -1), r^2 = x^2 + y^2.
+Frictionless by default; ``friction``, ``mu`` and ``slip_bound`` give it a friction law
+(scenes.friction), as for ``paper``.
 """
 
 from __future__ import annotations
@@ -12,6 +14,7 @@ import numpy as np
 
 from scenes.base import Material, Scene, SceneError, is_integer
 from scenes.budget import tensor_mesh
+from scenes.friction import friction_law
 from scenes.registry import register_scene
 
 _TOL = 1e-10
@@ -26,10 +29,15 @@ def ball_gap(x: np.ndarray) -> np.ndarray:
                             "pressed up by a ball",
                 tags=("paper", "3d"), dim=3)
 def paper_3d(young_modulus: float = 70000.0, poisson_ratio: float = 0.33,
-             initial_divisions: int = 4) -> Scene:
+             initial_divisions: int = 4, friction: str = "none", mu: float = 0.0,
+             slip_bound: float = 0.0) -> Scene:
     if not (is_integer(initial_divisions) and initial_divisions >= 2):
         raise SceneError(f"initial_divisions={initial_divisions!r} is not an integer >= 2")
     grid = np.linspace(-1.0, 1.0, int(initial_divisions) + 1)
+    law = friction_law(friction, mu, slip_bound)
+    # the frictionless scene keeps its parameters, and so its cached references' keys
+    with_friction = ({"friction": friction, "mu": float(mu), "slip_bound": float(slip_bound)}
+                     if law.active else {})
     return Scene(
         name="paper-3d",
         description="Omega=(-1,1)^3 clamped on top, pressed up by the ball of radius 1 centred "
@@ -41,6 +49,7 @@ def paper_3d(young_modulus: float = 70000.0, poisson_ratio: float = 0.33,
         gap=ball_gap,
         contact_coordinate=lambda x: np.asarray(x)[:2],
         parameters={"young_modulus": float(young_modulus), "poisson_ratio": float(poisson_ratio),
-                    "initial_divisions": int(initial_divisions)},
+                    "initial_divisions": int(initial_divisions), **with_friction},
         tags=("paper", "3d"),
+        friction=law,
     )

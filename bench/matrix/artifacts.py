@@ -78,11 +78,11 @@ def save_artifact(path: Path, result, scene=None) -> Path | None:
 
 
 def friction_fields(sol) -> dict:
-    """With friction, per friction point: its contact coordinate, the shear traction, the
+    """With friction in 2D, per friction point: its contact coordinate, the shear traction, the
     bound as a stress and the state (0 separated, 1 stick, 2 slip: FRICTION_STATES); and the
     normal and tangential forces on the body (sums of the reactions)."""
     state = sol.friction
-    if state is None:
+    if state is None or state.coordinate.ndim != 1:  # 3D: no curve along Gamma_C to draw
         return {}
     code = (state.state[:, None] == np.array(FRICTION_STATES)[None, :]).argmax(axis=1)
     return dict(friction_coordinate=state.coordinate, friction_shear=state.shear,

@@ -14,8 +14,10 @@ from formulations.tet_stiffness import tet_stiffness
 
 class Tetrahedra(Triangles):
     name, cell, dim, shape = "tet", "tri", 3, "tetrahedra"
-    # friction in 3D bounds a disc per point (a second-order cone): not built for any formulation
-    friction = False
+    # friction in 3D bounds a disc per point (a second-order cone); the registered formulations
+    # and estimators say for themselves whether they model it (register_formulation(...,
+    # friction=(2, 3)))
+    friction = True
     mesh_type = MeshTet1
     elements = {1: ElementTetP1, 2: ElementTetP2}
     centroid_rule = (np.full((3, 1), 1.0 / 4.0), np.array([1.0 / 6.0]))  # weight = the volume

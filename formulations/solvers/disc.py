@@ -53,16 +53,33 @@ def project(z: np.ndarray, m: int, bound: np.ndarray) -> tuple[np.ndarray, np.nd
     return projected, (normal > 0).astype(float), blocks
 
 
-def jacobian_projection(m: int, normal: np.ndarray, blocks: np.ndarray) -> np.ndarray:
-    """D, the block diagonal derivative of P, as a dense matrix."""
-    n = m + 2 * blocks.shape[0]
-    D = np.zeros((n, n))
-    D[np.arange(m), np.arange(m)] = normal
+def newton_matrix(S: np.ndarray, c: float, m: int, normal: np.ndarray,
+                  blocks: np.ndarray) -> np.ndarray:
+    """I - D (I - c S) with D the block diagonal derivative of P, formed block row by block
+    row (O(n^2), not a dense product)."""
+    DS = np.empty_like(S)
+    DS[:m] = normal[:, None] * S[:m]
+    pairs = S[m:].reshape(blocks.shape[0], 2, -1)
+    DS[m:] = np.einsum("kij,kjn->kin", blocks, pairs).reshape(-1, S.shape[1])
+    J = c * DS
+    diagonal = np.concatenate([1.0 - normal, np.zeros(2 * blocks.shape[0])])
+    J[np.arange(S.shape[0]), np.arange(S.shape[0])] += diagonal
     index = m + 2 * np.arange(blocks.shape[0])
     for i in range(2):
         for j in range(2):
-            D[index + i, index + j] = blocks[:, i, j]
-    return D
+            J[index + i, index + j] += (i == j) - blocks[:, i, j]
+    return J
+
+
+def newton_step(J: np.ndarray, residual: np.ndarray, kept: np.ndarray) -> np.ndarray:
+    """J^-1 (-residual), where the rows of J outside ``kept`` (D = 0 there: a normal entry
+    out of contact, a node with a zero bound) are rows of the identity: only the kept block
+    is solved densely (in contact problems most nodes of Gamma_C are separated)."""
+    step = -residual.copy()
+    if kept.any():
+        rhs = -residual[kept] - J[np.ix_(kept, ~kept)] @ step[~kept]
+        step[kept] = linalg.solve(J[np.ix_(kept, kept)], rhs)
+    return step
 
 
 def disc_ssn(S: np.ndarray, r: np.ndarray, m: int, bound: np.ndarray,
@@ -71,7 +88,7 @@ def disc_ssn(S: np.ndarray, r: np.ndarray, m: int, bound: np.ndarray,
     first, then two tangential entries per node (node-major), ``bound`` b per node."""
     c = 1.0 / max(float(np.mean(np.diag(S))), np.finfo(float).tiny) if r.size else 1.0
     lam = np.zeros(r.size) if start is None else np.asarray(start, dtype=float).copy()
-    eye, history = np.eye(r.size), []
+    history = []
 
     def phi(x):
         projected, normal, blocks = project(x - c * (S @ x - r), m, bound)
@@ -83,9 +100,10 @@ def disc_ssn(S: np.ndarray, r: np.ndarray, m: int, bound: np.ndarray,
         history.append(float(np.linalg.norm(residual) / size))
         if history[-1] <= TOLERANCE:
             return DiscResult(lam, iteration - 1, STATUS_OK, "", tuple(history))
-        D = jacobian_projection(m, normal, blocks)
         try:
-            step = linalg.solve(eye - D @ (eye - c * S), -residual)
+            step = newton_step(newton_matrix(S, c, m, normal, blocks), residual,
+                               np.concatenate([normal > 0, np.repeat(
+                                   np.abs(blocks).sum(axis=(1, 2)) > 0, 2)]))
         except linalg.LinAlgError:
             return DiscResult(lam, iteration, STATUS_FAILED, "singular Newton matrix",
                               tuple(history))

@@ -9,8 +9,11 @@ import numpy as np
 import pytest
 
 from bench.measure.difference import solution_difference
+from bench.sequence.loop import LoopConfig, run_sequence
+from estimators.base import ESTIMATORS
 from formulations import get_formulation, solve
 from formulations.nodal_friction import tangent_frame
+from formulations.registry import FORMULATIONS
 from formulations.solvers.disc import disc_ssn
 from scenes import get_scene
 from scenes.friction import friction_law
@@ -78,3 +81,21 @@ def test_the_fast_3d_solve_is_exact_and_agrees_with_the_cone_reference(law):
     assert energy < 2e-6 and pressure < 1e-5 and shear < 1e-2, (energy, pressure, shear)
     states = set(fast.friction.state)
     assert "slip" in states and "separated" in states
+
+
+def test_a_3d_sequence_with_friction_runs_where_it_is_modelled():
+    scene = get_scene("paper-3d", friction="coulomb", mu=0.3)
+    assert "vi" in [f for f in FORMULATIONS.names() if FORMULATIONS.why_not(f, scene=scene)
+                    is None]
+    modelled = [e for e in ESTIMATORS.names()
+                if ESTIMATORS.why_not(e, scene=scene, formulation="vi") is None]
+    assert {"residual", "averaging"} <= set(modelled)
+    for estimator in modelled:
+        rows = [level.row for level in run_sequence(
+            scene, "vi", "active-set", estimator,
+            LoopConfig(strategy="adaptive", max_dofs=1500))]
+        assert all(r.status == "ok" for r in rows), [r.reason for r in rows]
+        last = rows[-1]
+        assert last.friction == "coulomb(mu=0.3)" and last.stick_points + last.slip_points > 0
+        assert np.isnan(last.stick_zone_start)  # a zone is no interval in 3D
+        assert np.isfinite(last.eta) and last.eta > 0
