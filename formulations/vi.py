@@ -15,6 +15,7 @@ end); both are exact for a constant pressure, and on uniform meshes for a linear
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 from scipy import sparse
@@ -116,17 +117,17 @@ def discretise(scene: Scene, mesh: MeshTri, order: int = 1) -> Discretisation:
     trace = contact_trace(scene, mesh)
     if trace.dim == 3:
         nodes = surface_nodes(mesh, trace, elasticity.order)
-        B = surface_rows(elasticity, nodes)
+        rows = partial(surface_rows, elasticity, nodes)
     else:
         nodes = trace_nodes(mesh, trace, elasticity.order)
-        B = constraint_rows(elasticity, trace, nodes)
+        rows = partial(constraint_rows, elasticity, trace, nodes)
+    B = rows()  # along the normals; with a direction per node, along it
     m = nodes.weight.size
     G = np.asarray(scene.gap(nodes.points), dtype=float)
     # rows of B are dimensionless (a normal), so the multipliers are forces; row_scale 1
     frame = tangent_frame(nodes.normal)
-    friction = (friction_rows(scene, nodes, elasticity.restrict(interleaved([
-        surface_rows(elasticity, nodes, t) if trace.dim == 3
-        else constraint_rows(elasticity, trace, nodes, t) for t in frame])), len(frame))
+    friction = (friction_rows(scene, nodes, elasticity.restrict(
+        interleaved([rows(t) for t in frame])), len(frame))
         if scene.friction.active else None)
     qp = ContactQP(K=elasticity.K_free, F=elasticity.F_free,
                    B=elasticity.restrict(B), G=G, row_scale=np.ones(m),
