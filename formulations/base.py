@@ -86,10 +86,11 @@ class FrictionState:
     bound_traction: np.ndarray  # the bound as a stress (s(x_i), or mu lambda_h(x_i))
 
     def zone(self, state: str) -> tuple[float, float]:
-        """The end points of the points in ``state`` along a 2D Gamma_C (NaN, NaN if there
-        are none, or in 3D, where a zone is not an interval)."""
-        where = self.coordinate[..., self.state == state]
-        if where.size == 0 or self.coordinate.ndim != 1:
+        """The end points of the points in ``state`` along a 2D Gamma_C, in 3D the zone's
+        extent along the first contact coordinate (NaN, NaN if there are none)."""
+        first = self.coordinate if self.coordinate.ndim == 1 else self.coordinate[0]
+        where = first[self.state == state]
+        if where.size == 0:
             return float("nan"), float("nan")
         return float(where.min()), float(where.max())
 

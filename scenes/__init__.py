@@ -14,6 +14,7 @@ from scenes import (  # noqa: F401  (register themselves)
     paper,
     paper_3d,
     stick_slip,
+    stick_slip_3d,
 )
 from scenes.base import ContactPrediction, ExactSolution, Material, Scene, SceneError
 from scenes.registry import get_scene, register_scene, scene_descriptions, scene_names

@@ -51,6 +51,16 @@ def _chi(x, b):
     return value, 3 * (1 - rc**2) / (2 * b) * inside, -3 * rc / b**2 * inside
 
 
+def check_zones(half_width: float, stick_half_width: float, friction: str, mu: float) -> None:
+    """The stick and slip zones inside Gamma_C, and a law the exact solution solves."""
+    if not (0 < stick_half_width < half_width < 1):
+        raise SceneError(f"stick_half_width={stick_half_width!r}, half_width={half_width!r}: "
+                         "need 0 < stick_half_width < half_width < 1")
+    if friction not in ("tresca", "coulomb") or not mu > 0:
+        raise SceneError(f"friction={friction!r}, mu={mu!r}: need 'tresca' or 'coulomb' and "
+                         "mu > 0")
+
+
 def profiles(material: Material, push: float, half_width: float, stick_half_width: float,
              mu_f: float, slide: float):
     """The x-profiles (value, first, second, third derivative as needed): p, tau, omega, q."""
@@ -124,12 +134,7 @@ def stick_slip(young_modulus: float = 1.0, poisson_ratio: float = 0.3, plane: st
                push: float = 0.01, half_width: float = 0.4, stick_half_width: float = 0.2,
                gap_curvature: float = 0.1, mu: float = 0.3, slide: float = 0.05,
                friction: str = "tresca", initial_divisions: int = 4) -> Scene:
-    if not (0 < stick_half_width < half_width < 1):
-        raise SceneError(f"stick_half_width={stick_half_width!r}, half_width={half_width!r}: "
-                         "need 0 < stick_half_width < half_width < 1")
-    if friction not in ("tresca", "coulomb") or not mu > 0:
-        raise SceneError(f"friction={friction!r}, mu={mu!r}: need 'tresca' or 'coulomb' and "
-                         "mu > 0")
+    check_zones(half_width, stick_half_width, friction, mu)
     material = Material(young_modulus, poisson_ratio, plane)
     c, a, k = push, half_width, gap_curvature
     p, tau, omega, q = profiles(material, push, half_width, stick_half_width, mu, slide)

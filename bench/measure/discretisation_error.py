@@ -58,12 +58,14 @@ def pressure_error(solution: DiscreteSolution, true_pressure, trace=None) -> flo
 
 
 def shear_error(solution: DiscreteSolution, true_shear) -> float:
-    """||sigma_t - sigma_t,h||_{0,Gamma_C} on u_h's contact facets (2D), with
-    ``true_shear(s)`` a function of the contact coordinate."""
+    """||sigma_t - sigma_t,h||_{0,Gamma_C} on u_h's contact facets, with ``true_shear(s)`` a
+    function of the contact coordinate (in 3D a vector, (3, ...), as sigma_t,h is)."""
     trace = solution.trace
-    t, w = gauss_legendre(PRESSURE_POINTS)
+    t, w = (trace.rule(2 * PRESSURE_POINTS - 1) if trace.dim == 3
+            else gauss_legendre(PRESSURE_POINTS))
     diff = true_shear(trace.coordinates_at(t)) - solution.friction.traction(t)
-    return float(np.sqrt(trace.integrate(diff**2, w).sum()))
+    square = (diff**2).sum(axis=0) if trace.dim == 3 else diff**2
+    return float(np.sqrt(trace.integrate(square, w).sum()))
 
 
 def errors_from(energy_error: float, solution: DiscreteSolution, true_pressure,
