@@ -125,8 +125,8 @@ def check_friction(scene: Scene, theta: float) -> None:
 @register_formulation("nitsche", "Nitsche's method, theta = 1 (symmetric, default), 0 or -1 "
                                  "(option theta), gamma = gamma_0 E / h_F (option gamma_0, "
                                  f"default {DEFAULT_GAMMA_0:g}), lambda_h = -[P_gamma(u_h)]_-; "
-                                 "Tresca or Coulomb friction with theta = 1 (2D)",
-                      friction=True)
+                                 "Tresca or Coulomb friction with theta = 1 (2D and 3D)",
+                      friction=(2, 3))
 def discretise(scene: Scene, mesh: MeshTri, theta: float = 1.0,
                gamma_0: float = DEFAULT_GAMMA_0, order: int = 1) -> Discretisation:
     check_options(theta, gamma_0)

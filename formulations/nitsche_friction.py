@@ -2,8 +2,9 @@
 
 With the tangent t, sigma_nt = t . sigma n and the slip w of the obstacle, the tangential
 Nitsche traction P_t(u) = sigma_nt(u) - gamma (u_t - w) is projected onto the friction disc:
-sigma_t,h = [P_t(u_h)]_s, s the Tresca bound or mu lambda_h (Coulomb). The discrete equation
-adds to the frictionless one (formulations.nitsche)
+sigma_t,h = [P_t(u_h)]_s, s the Tresca bound or mu lambda_h (Coulomb); in 3D P_t is a vector
+of the two tangents' components and [.]_s its projection onto the disc of radius s. The discrete
+equation adds to the frictionless one (formulations.nitsche)
 
     - theta/gamma (sigma_nt(u_h), sigma_nt(v))_C + 1/gamma ([P_t(u_h)]_s, theta sigma_nt(v)
       - gamma v_t)_C,
@@ -25,53 +26,68 @@ from scipy import sparse
 from formulations.base import ContactQP, FrictionState
 from formulations.evaluation import evaluate_on_trace
 from formulations.friction_state import friction_state
+from formulations.nodal_friction import interleaved
 from formulations.semismooth import SemismoothSystem
-from formulations.slack_friction import contact_tangent, slack_friction_qp, tangential_rows
+from formulations.slack_friction import (
+    contact_tangents,
+    shear_vectors,
+    slack_friction_qp,
+    tangential_rows,
+)
 
 
 def shear_stress_rows(elasticity, trace, t: np.ndarray) -> sparse.csr_matrix:
-    """u -> sigma_nt(u_h) at the points ``t`` of every contact facet, over the free DOFs."""
+    """u -> sigma_nt(u_h) at the points ``t`` of every contact facet, over the free DOFs (in
+    3D both tangents per point, point-major)."""
     nq = t.shape[-1]
     at = evaluate_on_trace(elasticity.basis, trace, t)
-    return elasticity.restrict(at.stress_matrix(np.repeat(trace.normal, nq, axis=1),
-                                                np.repeat(contact_tangent(trace), nq, axis=1),
-                                                elasticity.lame))
+    normal = np.repeat(trace.normal, nq, axis=1)
+    return elasticity.restrict(interleaved([
+        at.stress_matrix(normal, np.repeat(tangent, nq, axis=1), elasticity.lame)
+        for tangent in contact_tangents(trace)]))
 
 
 def nitsche_friction_qp(scene, system: SemismoothSystem, elasticity, trace,
                         t: np.ndarray) -> ContactQP:
     """The theta = 1 QP of the module docstring."""
     shear = shear_stress_rows(elasticity, trace, t)
+    block = shear.shape[0] // system.gamma.size
     inverse = sparse.diags(1.0 / system.gamma)
     scaled = sparse.diags(system.weight / system.gamma)
-    K = system.K - system.S.T @ scaled @ system.S - shear.T @ scaled @ shear
+    K = (system.K - system.S.T @ scaled @ system.S
+         - shear.T @ sparse.diags(np.repeat(system.weight / system.gamma, block)) @ shear)
     return slack_friction_qp(scene, K.tocsr(), system.F, system.N - inverse @ system.S,
-                             tangential_rows(elasticity, trace, t) - inverse @ shear,
+                             tangential_rows(elasticity, trace, t)
+                             - sparse.diags(np.repeat(1.0 / system.gamma, block)) @ shear,
                              system.gap, system.weight * system.gamma, system.weight,
                              trace.points(t))
 
 
 def shear_function(scene, elasticity, trace, gamma_facet: np.ndarray, u_free: np.ndarray,
                    pressure):
-    """sigma_t,h(t) = [P_t(u_h)]_s at local coordinates t of every contact facet."""
+    """sigma_t,h(t) = [P_t(u_h)]_s at local coordinates t of every contact facet (in 3D the
+    vector P_t projected onto the disc of radius s)."""
     u, law = elasticity.expand(u_free), scene.friction
+    tangents = contact_tangents(trace)
 
     def shear(tt):
         tt = np.asarray(tt, dtype=float)
         nq = tt.shape[-1]
         at = evaluate_on_trace(elasticity.basis, trace, tt)
         normal = np.repeat(trace.normal, nq, axis=1)
-        tangent = np.repeat(contact_tangent(trace), nq, axis=1)
-        sigma = at.stress_matrix(normal, tangent, elasticity.lame) @ u
-        u_t = at.matrix(tangent) @ u
-        argument = (sigma - np.repeat(gamma_facet, nq) * (u_t - law.slide)).reshape(
-            trace.size, nq)
+        argument = np.stack([
+            (at.stress_matrix(normal, np.repeat(tangent, nq, axis=1), elasticity.lame) @ u
+             - np.repeat(gamma_facet, nq) * (at.matrix(np.repeat(tangent, nq, axis=1)) @ u
+                                             - law.slide)).reshape(trace.size, nq)
+            for tangent in tangents], axis=-1)  # (facet, point, tangent)
         bound = (law.coefficient * pressure(tt) if law.kind == "coulomb"
                  else law.slip_bound_at(trace.points(tt)).reshape(trace.size, nq))
-        return np.clip(argument, -bound, bound)
+        size = np.linalg.norm(argument, axis=-1)
+        projected = argument * (np.minimum(size, bound) / np.where(size > 0, size, 1.0))[
+            ..., None]
+        return projected[..., 0] if trace.dim == 2 else shear_vectors(projected, tangents)
 
     return shear
-
 
 
 def nitsche_friction_state(scene, qp: ContactQP, answer, elasticity, trace, t: np.ndarray,
@@ -80,7 +96,8 @@ def nitsche_friction_state(scene, qp: ContactQP, answer, elasticity, trace, t: n
     """The points' states from the QP's multipliers (``formulations.friction_state``; a
     multiplier is w_q |e| times a traction) and sigma_t,h = [P_t(u_h)]_s along the facets."""
     ns = row_length.size
-    tangential = np.full(ns, np.nan) if answer.tangential is None else answer.tangential
+    tangential = (np.full(qp.friction.block * ns, np.nan) if answer.tangential is None
+                  else answer.tangential)
     return friction_state(qp.friction, answer.u, answer.multipliers[:ns], tangential,
                           1.0 / row_length, trace.row_coordinates(t),
                           shear_function(scene, elasticity, trace, gamma_facet,

@@ -145,8 +145,8 @@ def penalty_problems(scene, elasticity, trace, t: np.ndarray, P, gap: np.ndarray
 
 @register_formulation("penalty", "primal penalty, eps = eps_0 h_e / (p^2 E) (eps_0 = 1e-3), "
                                  "lambda_h = (u_hn - g_h)_+ / eps; Tresca or Coulomb "
-                                 "friction regularised with the same eps (2D)",
-                      friction=True)
+                                 "friction regularised with the same eps (2D and 3D)",
+                      friction=(2, 3))
 def discretise(scene: Scene, mesh: MeshTri, epsilon_0: float = DEFAULT_EPSILON_0,
                order: int = 1) -> Discretisation:
     epsilon_0, order = checked_epsilon(epsilon_0), check_order(order)  # before any assembly

@@ -23,7 +23,12 @@ from scipy import sparse
 
 from formulations.base import ContactQP, FrictionState
 from formulations.friction_state import friction_state
-from formulations.slack_friction import slack_friction_qp, tangential_rows
+from formulations.slack_friction import (
+    contact_tangents,
+    shear_vectors,
+    slack_friction_qp,
+    tangential_rows,
+)
 
 
 def penalty_friction_qp(scene, elasticity, P: sparse.csr_matrix, gap: np.ndarray,
@@ -41,14 +46,19 @@ def penalty_friction_state(qp: ContactQP, x: np.ndarray, normal: np.ndarray,
                            tangential: np.ndarray | None, trace, t: np.ndarray,
                            row_length: np.ndarray) -> FrictionState:
     """The points' states and sigma_t,h along the facets: the interpolant of the points'
-    tractions -lambda_t,q / (w_q |e|) (the penalty pressure's interpolation)."""
+    tractions -lambda_t,q / (w_q |e|) (the penalty pressure's interpolation; in 3D per
+    tangential component, then the vector sum_k sigma_k t_k)."""
     friction, ns = qp.friction, row_length.size
     if tangential is None:  # a failed solve: NaN, never a silent zero
-        tangential = np.full(ns, np.nan)
-    at_points = (-tangential / row_length).reshape(trace.size, -1)
+        tangential = np.full(friction.block * ns, np.nan)
+    at_points = (-tangential / np.repeat(row_length, friction.block)).reshape(
+        trace.size, -1, friction.block)  # (facet, point, tangent)
+    tangents = contact_tangents(trace)
 
     def traction(tt):
-        return at_points @ trace.interpolation(t, np.asarray(tt, dtype=float))
+        values = np.einsum("fqk,qt->ftk", at_points,
+                           trace.interpolation(t, np.asarray(tt, dtype=float)))
+        return values[..., 0] if friction.block == 1 else shear_vectors(values, tangents)
 
     return friction_state(friction, x, normal[:ns], tangential, 1.0 / row_length,
                           trace.row_coordinates(t), traction)

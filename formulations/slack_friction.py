@@ -11,7 +11,9 @@ With normal rows P (a length per point), tangential rows R (a length per point),
 with q_q and r_q free: min_q {q^2 : q >= x} is (x)_+^2, and min_r (D r^2 / 2 + b |x - r|) is
 D times Huber's function of x with threshold b / D, whose derivative is the projection of D x
 onto [-b, b]. b_q is w_q s(x_q) (Tresca) or mu times the multiplier of the point's normal row,
-which is w_q times the pressure at x_q (Coulomb). The frictional active set solves it
+which is w_q times the pressure at x_q (Coulomb). In 3D R u - w and r_q are vectors of the
+two tangents' components, |.| their length, and the projection is onto the disc of radius b
+(a second-order cone per point). The frictional active set solves it
 (``formulations.solvers.friction``) and the reference judges it.
 """
 
@@ -22,6 +24,7 @@ from scipy import sparse
 
 from formulations.base import ContactQP, FrictionRows
 from formulations.evaluation import evaluate_on_trace
+from formulations.nodal_friction import interleaved, tangent_frame
 
 
 def contact_tangent(trace) -> np.ndarray:
@@ -29,10 +32,25 @@ def contact_tangent(trace) -> np.ndarray:
     return np.array([-trace.normal[1], trace.normal[0]])
 
 
+def contact_tangents(trace) -> list[np.ndarray]:
+    """The tangents of every contact facet: t (2D), or the frame t_1, t_2 of
+    ``nodal_friction.tangent_frame`` (3D)."""
+    return [contact_tangent(trace)] if trace.dim == 2 else tangent_frame(trace.normal)
+
+
 def tangential_rows(elasticity, trace, t: np.ndarray) -> sparse.csr_matrix:
-    """u -> u_h . t at the points ``t`` of every contact facet, over the free DOFs."""
-    tangent = np.repeat(contact_tangent(trace), t.shape[-1], axis=1)
-    return elasticity.restrict(evaluate_on_trace(elasticity.basis, trace, t).matrix(tangent))
+    """u -> u_h . t_k at the points ``t`` of every contact facet, over the free DOFs (in 3D
+    both tangents per point, point-major)."""
+    at = evaluate_on_trace(elasticity.basis, trace, t)
+    nq = t.shape[-1]
+    return elasticity.restrict(interleaved([at.matrix(np.repeat(tangent, nq, axis=1))
+                                            for tangent in contact_tangents(trace)]))
+
+
+def shear_vectors(values: np.ndarray, tangents: list[np.ndarray]) -> np.ndarray:
+    """sum_k values_k t_k (3, n_facets, nt) from the components ``values`` (n_facets, nt, 2)
+    along each facet's tangents (3D)."""
+    return sum(values[..., k][None] * tangent[:, :, None] for k, tangent in enumerate(tangents))
 
 
 def slack_friction_qp(scene, K: sparse.spmatrix, F: np.ndarray, P: sparse.spmatrix,
@@ -41,16 +59,23 @@ def slack_friction_qp(scene, K: sparse.spmatrix, F: np.ndarray, P: sparse.spmatr
     """The QP of the module docstring: unknowns u, the normal slacks, the tangential slacks;
     ``row_length`` the points' shares w_q |e| of Gamma_C, ``points`` their positions."""
     law, ns = scene.friction, row_length.size
-    zero, eye = sparse.csr_matrix((ns, ns)), sparse.identity(ns, format="csr")
+    block = R.shape[0] // ns  # tangential directions per point: d - 1
+    if law.slide and block != 1:
+        raise ValueError(f"slide={law.slide!r} is a displacement along the one tangent of 2D; "
+                         "in 3D the obstacle does not slide")
+    eye, eye_t = sparse.identity(ns, format="csr"), sparse.identity(block * ns, format="csr")
     bound = np.zeros(ns)
     if law.kind == "tresca":
         bound = row_length * np.ravel(law.slip_bound_at(points))
-    friction = FrictionRows(T=sparse.hstack([R, zero, -eye], format="csr"), bound=bound,
-                            coefficient=law.coefficient,
+    friction = FrictionRows(T=sparse.hstack([R, sparse.csr_matrix((block * ns, ns)), -eye_t],
+                                            format="csr"),
+                            bound=bound, coefficient=law.coefficient, block=block,
                             shift=np.full(ns, law.slide) if law.slide else None)
-    D = sparse.diags(weights)
-    return ContactQP(K=sparse.block_diag([K, D, D], format="csr"),
-                     F=np.concatenate([F, np.zeros(2 * ns)]),
-                     B=sparse.hstack([P, -eye, zero], format="csr"), G=gap,
+    return ContactQP(K=sparse.block_diag([K, sparse.diags(weights),
+                                          sparse.diags(np.repeat(weights, block))],
+                                         format="csr"),
+                     F=np.concatenate([F, np.zeros((1 + block) * ns)]),
+                     B=sparse.hstack([P, -eye, sparse.csr_matrix((ns, block * ns))],
+                                     format="csr"), G=gap,
                      row_scale=np.ones(ns),
                      objective_scale=float(scene.material.young_modulus), friction=friction)

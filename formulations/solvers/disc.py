@@ -53,32 +53,31 @@ def project(z: np.ndarray, m: int, bound: np.ndarray) -> tuple[np.ndarray, np.nd
     return projected, (normal > 0).astype(float), blocks
 
 
-def newton_matrix(S: np.ndarray, c: float, m: int, normal: np.ndarray,
-                  blocks: np.ndarray) -> np.ndarray:
-    """I - D (I - c S) with D the block diagonal derivative of P, formed block row by block
-    row (O(n^2), not a dense product)."""
-    DS = np.empty_like(S)
-    DS[:m] = normal[:, None] * S[:m]
-    pairs = S[m:].reshape(blocks.shape[0], 2, -1)
-    DS[m:] = np.einsum("kij,kjn->kin", blocks, pairs).reshape(-1, S.shape[1])
-    J = c * DS
-    diagonal = np.concatenate([1.0 - normal, np.zeros(2 * blocks.shape[0])])
-    J[np.arange(S.shape[0]), np.arange(S.shape[0])] += diagonal
-    index = m + 2 * np.arange(blocks.shape[0])
+def newton_rows(S: np.ndarray, c: float, m: int, normal: np.ndarray, blocks: np.ndarray,
+                kept: np.ndarray) -> np.ndarray:
+    """The rows ``kept`` of I - D (I - c S), D the block diagonal derivative of P: the normal
+    entries in contact (rows c S_i) and the discs with D != 0 (both rows of each), formed from
+    those rows of S alone (O(k n) for k kept rows, not a dense product)."""
+    normal_rows = np.flatnonzero(kept[:m])
+    nodes = np.flatnonzero(kept[m::2])
+    pair_rows = m + 2 * nodes[:, None] + np.arange(2)[None, :]  # (k, 2)
+    J_pairs = c * np.einsum("kij,kjn->kin", blocks[nodes], S[pair_rows])
+    rest = np.eye(2)[None] - blocks[nodes]  # I - D on the disc's own entries
     for i in range(2):
         for j in range(2):
-            J[index + i, index + j] += (i == j) - blocks[:, i, j]
-    return J
+            J_pairs[np.arange(nodes.size), i, pair_rows[:, j]] += rest[:, i, j]
+    return np.vstack([c * S[normal_rows], J_pairs.reshape(-1, S.shape[1])])
 
 
-def newton_step(J: np.ndarray, residual: np.ndarray, kept: np.ndarray) -> np.ndarray:
-    """J^-1 (-residual), where the rows of J outside ``kept`` (D = 0 there: a normal entry
-    out of contact, a node with a zero bound) are rows of the identity: only the kept block
-    is solved densely (in contact problems most nodes of Gamma_C are separated)."""
+def newton_step(J_kept: np.ndarray, residual: np.ndarray, kept: np.ndarray) -> np.ndarray:
+    """J^-1 (-residual) from J's rows ``kept`` (``newton_rows``): the other rows (D = 0 there:
+    a normal entry out of contact, a node with a zero bound) are rows of the identity, so only
+    the kept block is solved densely (in contact problems most points of Gamma_C are
+    separated)."""
     step = -residual.copy()
     if kept.any():
-        rhs = -residual[kept] - J[np.ix_(kept, ~kept)] @ step[~kept]
-        step[kept] = linalg.solve(J[np.ix_(kept, kept)], rhs)
+        rhs = -residual[kept] - J_kept[:, ~kept] @ step[~kept]
+        step[kept] = linalg.solve(J_kept[:, kept], rhs)
     return step
 
 
@@ -100,10 +99,9 @@ def disc_ssn(S: np.ndarray, r: np.ndarray, m: int, bound: np.ndarray,
         history.append(float(np.linalg.norm(residual) / size))
         if history[-1] <= TOLERANCE:
             return DiscResult(lam, iteration - 1, STATUS_OK, "", tuple(history))
+        kept = np.concatenate([normal > 0, np.repeat(np.abs(blocks).sum(axis=(1, 2)) > 0, 2)])
         try:
-            step = newton_step(newton_matrix(S, c, m, normal, blocks), residual,
-                               np.concatenate([normal > 0, np.repeat(
-                                   np.abs(blocks).sum(axis=(1, 2)) > 0, 2)]))
+            step = newton_step(newton_rows(S, c, m, normal, blocks, kept), residual, kept)
         except linalg.LinAlgError:
             return DiscResult(lam, iteration, STATUS_FAILED, "singular Newton matrix",
                               tuple(history))
