@@ -47,7 +47,12 @@ from formulations.discretisation import Discretisation, discrete_solution
 from formulations.elasticity import assemble_elasticity, check_order
 from formulations.evaluation import drop_roundoff, normal_trace_matrix
 from formulations.kkt import count_active
-from formulations.mixed_friction import mixed_friction_rows, mixed_friction_state
+from formulations.mixed_friction import (
+    mixed_friction_rows,
+    mixed_friction_state,
+    surface_friction_rows,
+    surface_friction_state,
+)
 from formulations.registry import register_formulation
 from scenes import Scene
 from scenes.base import is_integer, is_number
@@ -148,7 +153,7 @@ def checked_options(h_over_H: float, order: int, multiplier_degree: int | None):
                                "h/H <= 1/2 (seed paper, eq. (3)); in 3D piecewise constant "
                                "on vertex-star patches of contact triangles; Tresca or "
                                "Coulomb friction with a tangential multiplier in the same "
-                               "space (2D)", friction=True)
+                               "space (2D and 3D)", friction=(2, 3))
 def discretise(scene: Scene, mesh: MeshTri, h_over_H: float = 0.5, order: int = 1,
                multiplier_degree: int | None = None) -> Discretisation:
     """``h_over_H``: the largest allowed ratio of a facet to its multiplier segment. The
@@ -229,13 +234,15 @@ def discretise_surface(scene: Scene, mesh, h_over_H: float, order: int,
     t, w = surface.rule(elasticity.order)  # phi_j . n has degree p on a flat triangle
     weights = patch_sum(patch, t.shape[1]) @ sparse.diags(np.outer(surface.measure, w).ravel())
     B = weights @ normal_trace_matrix(elasticity.basis, surface, t)
+    friction, frame = surface_friction_rows(scene, elasticity, surface, patch, weights, t,
+                                            surface.rule(GAP_RULE_DEGREE))
     t, w = surface.rule(GAP_RULE_DEGREE)
     G = patch_sum(patch, t.shape[1]) @ (np.asarray(scene.gap(surface.points(t)))
                                         * np.outer(surface.measure, w)).ravel()
     qp = ContactQP(K=elasticity.K_free, F=elasticity.F_free,
                    B=drop_roundoff(elasticity.restrict(B)), G=G, row_scale=area,
                    objective_scale=float(scene.material.young_modulus),
-                   near_null=elasticity.rigid_modes)
+                   near_null=elasticity.rigid_modes, friction=friction)
     centroid = np.array([np.bincount(patch, weights=c * surface.measure) / area
                          for c in surface.coordinate.mean(axis=1)])
 
@@ -247,7 +254,9 @@ def discretise_surface(scene: Scene, mesh, h_over_H: float, order: int,
             pressure=lambda tt: np.repeat(lam[patch][:, None], np.shape(tt)[-1], axis=1),
             multiplier_breaks=np.zeros(0), active_constraints=count_active(qp, answer.u, lam),
             max_h_over_H=float(np.sqrt(surface.measure / area[patch]).max()),
-            details=MixedDetails(segment_of_facet=patch))
+            details=MixedDetails(segment_of_facet=patch),
+            friction=None if friction is None else surface_friction_state(
+                friction, answer.u, lam, answer.tangential, centroid, patch, frame))
 
     # sum_P H_P ||mu||_{0,P}^2 = H_P |P| mu_P^2 (in 2D H_S^2, as |S| = H_S)
     return Discretisation(formulation="mixed", elasticity=elasticity, trace=surface, qp=qp,

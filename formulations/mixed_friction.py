@@ -7,7 +7,9 @@ bound on each coefficient |lambda_t,(S,k)| <= b_(S,k): Tresca's
 b = int_S B_k s ds / int_S B_k ds (for q = 0 the mean of s on S), Coulomb's mu lambda_n,(S,k).
 By the Bernstein basis' convex hull property the Coulomb bound on the coefficients gives
 |lambda_t,H| <= mu lambda_n,H everywhere on S; Tresca's holds where s is its own mean. The
-multipliers are tractions: sigma_t,H = -lambda_t,H.
+multipliers are tractions: sigma_t,H = -lambda_t,H. On a 3D contact surface lambda_t,H is a
+constant vector per patch of the normal multiplier's (two tangential rows per patch), bounded by
+a disc.
 """
 
 from __future__ import annotations
@@ -19,8 +21,9 @@ from scipy import sparse
 
 from formulations.base import FrictionRows, FrictionState
 from formulations.contact import gauss_legendre
-from formulations.evaluation import evaluate_on_trace
+from formulations.evaluation import drop_roundoff, evaluate_on_trace
 from formulations.friction_state import friction_state
+from formulations.nodal_friction import interleaved, tangent_frame
 
 
 def tangential_rows(elasticity, trace, weights: sparse.csr_matrix,
@@ -69,4 +72,49 @@ def mixed_friction_state(friction: FrictionRows, u_free: np.ndarray, normal: np.
         return -np.einsum("kft,fk->ft", basis_at(t), coefficients[segment])
 
     return friction_state(friction, u_free, normal, tangential, np.ones(tangential.size),
+                          coordinate, traction)
+
+
+def surface_friction_rows(scene, elasticity, surface, patch: np.ndarray, weights, t: np.ndarray,
+                          bound_points: tuple[np.ndarray, np.ndarray]):
+    """(FrictionRows, frame) of ``scene``'s law on the patches of a 3D contact surface (None,
+    None without friction): lambda_t,P a constant vector per patch in its tangent plane (the
+    frame of the patch's area-weighted normal), rows T_(P,k) u = int_P u_h . t_k ds
+    (``weights`` integrates values at the points ``t`` of every facet over each patch), and
+    |lambda_t,P| <= the mean of s on P (Tresca, by the rule ``bound_points``) or
+    mu lambda_n,P (Coulomb)."""
+    law = scene.friction
+    if not law.active:
+        return None, None
+    if law.slide:
+        raise ValueError(f"slide={law.slide!r} is a displacement along the one tangent of 2D; "
+                         "in 3D the obstacle does not slide")
+    area = np.bincount(patch, weights=surface.measure)
+    normal = np.array([np.bincount(patch, weights=surface.measure * n) for n in surface.normal])
+    frame = tangent_frame(normal / np.linalg.norm(normal, axis=0))
+    at = evaluate_on_trace(elasticity.basis, surface, t)
+    nq = t.shape[-1]
+    T = interleaved([drop_roundoff(elasticity.restrict(
+        weights @ at.matrix(np.repeat(tangent[:, patch], nq, axis=1)))) for tangent in frame])
+    bound = np.zeros(area.size)
+    if law.kind == "tresca":
+        tb, wb = bound_points
+        s = np.asarray(law.slip_bound_at(surface.points(tb))).reshape(patch.size, -1)
+        bound = np.bincount(patch, weights=(s * wb[None, :]).sum(axis=1) * surface.measure) / area
+    return FrictionRows(T=T, bound=bound, coefficient=law.coefficient, block=2), frame
+
+
+def surface_friction_state(friction: FrictionRows, u_free: np.ndarray, normal: np.ndarray,
+                           tangential: np.ndarray | None, coordinate: np.ndarray,
+                           patch: np.ndarray, frame: list[np.ndarray]) -> FrictionState:
+    """The patches' states and sigma_t,H = -lambda_t,P (a vector, constant on each patch)."""
+    if tangential is None:  # a failed solve: NaN, never a silent zero
+        tangential = np.full(friction.T.shape[0], np.nan)
+    pairs = tangential.reshape(-1, 2)
+    vectors = -(pairs[:, 0] * frame[0] + pairs[:, 1] * frame[1])  # (3, n_patches)
+
+    def traction(tt):
+        return np.repeat(vectors[:, patch][:, :, None], np.shape(tt)[-1], axis=2)
+
+    return friction_state(friction, u_free, normal, tangential, np.ones(pairs.shape[0]),
                           coordinate, traction)

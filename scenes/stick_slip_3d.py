@@ -15,8 +15,10 @@ On the bottom (psi = 1, psi' = 0, phi = 0, phi' = 1): u_t = T, u_n = -c, sigma_z
 r < b sticks, the ring b < r < a slips outwards against the bound mu_f p, and r > a is
 separated (the gap is free-boundary-3d's g = -c + k (r - a)_+^2). The law: ``tresca`` with
 s = mu_f p, or ``coulomb`` with mu = mu_f: the same u solves both. The default zones (a = 0.6,
-b = 0.3) are wider than the 2D scene's so that a 3D mesh of 1e4 DOFs has some 20 nodes in the
-stick disc and 50 in the slip ring.
+b = 0.3) are wider than the 2D scene's, so that a 3D mesh of 1e4 DOFs has some 20 nodes in the
+stick disc and 50 in the slip ring, and the slip amplitude d = 0.01 is smaller: T grows like
+r^3 beyond the contact zone, and at d = 0.05 its error outweighed the rest (energy error 1.7e-2
+against 4.7e-3 at 13 872 DOFs, vi P1).
 
 Every radial field is F = h(r) X, so that grad F = h I + (h'/r) X X', div F = 2 h + r h' and,
 F being a gradient, Lap F = grad div F = (3 h'/r + h'') X; chi(r) / r is a polynomial inside the
@@ -144,7 +146,7 @@ def fields(material: Material, push: float, at):
                 dim=3)
 def stick_slip_3d(young_modulus: float = 1.0, poisson_ratio: float = 0.3, push: float = 0.01,
                   half_width: float = 0.6, stick_half_width: float = 0.3,
-                  gap_curvature: float = 0.1, mu: float = 0.3, slide: float = 0.05,
+                  gap_curvature: float = 0.1, mu: float = 0.3, slide: float = 0.01,
                   friction: str = "tresca", initial_divisions: int = 4) -> Scene:
     check_zones(half_width, stick_half_width, friction, mu)
     if not (is_integer(initial_divisions) and initial_divisions >= 2):

@@ -28,12 +28,13 @@ SLOW, SMALLEST_RELAXATION = 0.9, 1 / 16  # SLOW: what counts as settled at the n
 def coulomb_fixed_point(qp: ContactQP, solve_tresca: Callable[[ContactQP, QPSolution | None],
                                                               QPSolution],
                         rtol: float, noise_floor: float = 0.0,
-                        max_steps: int = MAX_STEPS) -> QPSolution:
+                        max_steps: int = MAX_STEPS, zero: float = 0.0) -> QPSolution:
     """The Coulomb answer of ``qp`` (whose ``friction`` is Coulomb's); ``solve_tresca(qp,
     previous)`` solves one Tresca step, warm-started from the previous step's answer. It stops
     when the change is at most ``rtol``, or when it is at most ``noise_floor`` and no longer
     falls (not below 0.9 times the last): an inexact step solver's own noise, said in the
-    reason."""
+    reason. Bounds all at most ``zero`` (a force) are no contact: the change is then 0 (an
+    interior point leaves multipliers of round-off size where nothing touches)."""
     friction = qp.friction
     bound = np.zeros(friction.bound.size)
     changes: list[float] = []
@@ -46,8 +47,10 @@ def coulomb_fixed_point(qp: ContactQP, solve_tresca: Callable[[ContactQP, QPSolu
             return replace(answer, status=STATUS_FAILED, solve_time=elapsed,
                            reason=f"Coulomb fixed point, step {step}: {answer.reason}")
         new = friction.bounds(answer.multipliers)
-        changes.append(float(np.abs(new - bound).max(initial=0.0)
-                             / max(np.abs(new).max(initial=0.0), np.finfo(float).tiny)))
+        size = max(np.abs(new).max(initial=0.0), np.abs(bound).max(initial=0.0))
+        changes.append(0.0 if size <= zero else float(
+            np.abs(new - bound).max(initial=0.0) / max(np.abs(new).max(initial=0.0),
+                                                       np.finfo(float).tiny)))
         settled = (len(changes) > 1 and changes[-1] <= noise_floor
                    and changes[-1] > SLOW * changes[-2])
         if len(changes) > 1 and changes[-1] >= changes[-2] and not settled:

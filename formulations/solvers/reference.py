@@ -42,6 +42,14 @@ FRICTION_TOLERANCES = {"tol_gap_abs": 1e-12, "tol_gap_rel": 1e-12, "tol_feas": 1
 COULOMB_RTOL, COULOMB_NOISE_FLOOR = 1e-8, 1e-4
 
 
+def no_contact_bound(qp: ContactQP) -> float:
+    """The largest Coulomb bound that is round-off: mu times a multiplier of 1e-9 in the scaled
+    units (lambda = E d mu / row_scale; Clarabel at 1e-12 leaves ~1e-12 there where nothing
+    touches)."""
+    d = qp.gap_scale if 0 < qp.gap_scale < np.inf else 1.0
+    return 1e-9 * qp.friction.coefficient * qp.objective_scale * d / float(qp.row_scale.min())
+
+
 @register_solver(REFERENCE_SOLVER, "CVXPY + Clarabel interior point (the judge of correctness)")
 def solve_reference(qp: ContactQP, warm_start=None, backend=None,
                     **clarabel_options) -> QPSolution:
@@ -51,7 +59,7 @@ def solve_reference(qp: ContactQP, warm_start=None, backend=None,
     (``coulomb``)."""
     if qp.friction is not None and qp.friction.coulomb:
         return coulomb_fixed_point(qp, lambda step, _: solve_reference(step, **clarabel_options),
-                                   COULOMB_RTOL, COULOMB_NOISE_FLOOR)
+                                   COULOMB_RTOL, COULOMB_NOISE_FLOOR, zero=no_contact_bound(qp))
     if qp.friction is not None and not clarabel_options:
         answer = solve_reference(qp, **FRICTION_TOLERANCES)
         if answer.status == STATUS_OK:
