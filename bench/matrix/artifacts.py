@@ -78,13 +78,19 @@ def save_artifact(path: Path, result, scene=None) -> Path | None:
 
 
 def friction_fields(sol) -> dict:
-    """With friction in 2D, per friction point: its contact coordinate, the shear traction, the
-    bound as a stress and the state (0 separated, 1 stick, 2 slip: FRICTION_STATES); and the
-    normal and tangential forces on the body (sums of the reactions)."""
+    """With friction, per friction point: its contact coordinate, the bound as a stress and the
+    state (0 separated, 1 stick, 2 slip: FRICTION_STATES); in 2D also the shear traction and the
+    normal and tangential forces on the body (sums of the reactions), in 3D the shear
+    traction's length (the tangents differ from point to point)."""
     state = sol.friction
-    if state is None or state.coordinate.ndim != 1:  # 3D: no curve along Gamma_C to draw
+    if state is None:
         return {}
     code = (state.state[:, None] == np.array(FRICTION_STATES)[None, :]).argmax(axis=1)
+    if state.coordinate.ndim != 1:
+        return dict(friction_coordinate=state.coordinate, friction_state=code,
+                    friction_bound=state.bound_traction,
+                    friction_shear_size=np.linalg.norm(state.shear.reshape(code.size, -1),
+                                                       axis=1))
     return dict(friction_coordinate=state.coordinate, friction_shear=state.shear,
                 friction_bound=state.bound_traction, friction_state=code,
                 friction_forces=np.array([sol.multipliers.sum(),

@@ -113,15 +113,28 @@ def field_figures(scene, name: str, artifacts: dict, preferred) -> tuple:
          "separated."))
 
 
-def field_figures_3d(artifacts: dict) -> tuple:
-    """The 3D figures drawn from the artifacts: pressure maps and mesh slices."""
+def _stick_circles(scene):
+    """The exact stick and contact zones' radii of a 3D scene with friction, or None."""
+    exact = None if scene is None else scene.exact
+    if exact is None or exact.stick_zone is None:
+        return None
+    return exact.stick_zone[1], exact.contact_zone[1]
+
+
+def field_figures_3d(artifacts: dict, scene=None) -> tuple:
+    """The 3D figures drawn from the artifacts: pressure maps, mesh slices and, with friction,
+    the friction states over Gamma_C."""
     return (
         (figures_3d.pressure_maps(artifacts), "pressure",
          "Contact pressure lambda_h on Gamma_C over the contact coordinates (x, y) (adaptive, "
          "last level) per formulation; the dashed circle has the contact zone's area."),
         (figures_3d.mesh_slices(artifacts), "meshes",
          "Final adaptive meshes cut by the plane y = 0, coloured by von Mises stress (clipped "
-         f"at its {figures.VON_MISES_PERCENTILE:g}th percentile)."))
+         f"at its {figures.VON_MISES_PERCENTILE:g}th percentile)."),
+        (friction_figures.state_maps(artifacts, _stick_circles(scene)), "friction",
+         "Where each friction point sticks, slips or is separated over Gamma_C (adaptive, last "
+         "level) per formulation, larger where |sigma_t,h| is nearer its bound; dashed: the "
+         "exact stick and contact zones."))
 
 
 def scene_section(name: str, group: pd.DataFrame, results: Path | None, figs: Figures,
@@ -145,7 +158,7 @@ def scene_section(name: str, group: pd.DataFrame, results: Path | None, figs: Fi
              "Work-precision per formulation: the error (eta without a truth) against the "
              "cumulative wall time of the sequence."),
             *(field_figures(scene, name, artifacts, preferred) if scene is None
-              or scene.dim == 2 else field_figures_3d(artifacts))):
+              or scene.dim == 2 else field_figures_3d(artifacts, scene))):
         item = figs.add(figure, file_stem(name, suffix), caption)
         if item is not None:
             section["figures"].append(item)
