@@ -23,7 +23,7 @@ from formulations.base import FrictionRows, FrictionState
 from formulations.contact import gauss_legendre
 from formulations.evaluation import drop_roundoff, evaluate_on_trace
 from formulations.friction_state import friction_state
-from formulations.nodal_friction import interleaved, tangent_frame
+from formulations.nodal_friction import interleaved, slide_components, tangent_frame
 
 
 def tangential_rows(elasticity, trace, weights: sparse.csr_matrix,
@@ -82,13 +82,11 @@ def surface_friction_rows(scene, elasticity, surface, patch: np.ndarray, weights
     frame of the patch's area-weighted normal), rows T_(P,k) u = int_P u_h . t_k ds
     (``weights`` integrates values at the points ``t`` of every facet over each patch), and
     |lambda_t,P| <= the mean of s on P (Tresca, by the rule ``bound_points``) or
-    mu lambda_n,P (Coulomb)."""
+    mu lambda_n,P (Coulomb); an obstacle sliding by w = slide e_x shifts the rows by
+    int_P w . t_k ds."""
     law = scene.friction
     if not law.active:
         return None, None
-    if law.slide:
-        raise ValueError(f"slide={law.slide!r} is a displacement along the one tangent of 2D; "
-                         "in 3D the obstacle does not slide")
     area = np.bincount(patch, weights=surface.measure)
     normal = np.array([np.bincount(patch, weights=surface.measure * n) for n in surface.normal])
     frame = tangent_frame(normal / np.linalg.norm(normal, axis=0))
@@ -101,7 +99,9 @@ def surface_friction_rows(scene, elasticity, surface, patch: np.ndarray, weights
         tb, wb = bound_points
         s = np.asarray(law.slip_bound_at(surface.points(tb))).reshape(patch.size, -1)
         bound = np.bincount(patch, weights=(s * wb[None, :]).sum(axis=1) * surface.measure) / area
-    return FrictionRows(T=T, bound=bound, coefficient=law.coefficient, block=2), frame
+    shift = slide_components(law.slide, frame)  # int_P w . t_k ds
+    return FrictionRows(T=T, bound=bound, coefficient=law.coefficient, block=2,
+                        shift=None if shift is None else shift * np.repeat(area, 2)), frame
 
 
 def surface_friction_state(friction: FrictionRows, u_free: np.ndarray, normal: np.ndarray,

@@ -26,7 +26,7 @@ from scipy import sparse
 from formulations.base import ContactQP, FrictionState
 from formulations.evaluation import evaluate_on_trace
 from formulations.friction_state import friction_state
-from formulations.nodal_friction import interleaved
+from formulations.nodal_friction import interleaved, slide_components
 from formulations.semismooth import SemismoothSystem
 from formulations.slack_friction import (
     contact_tangents,
@@ -60,7 +60,7 @@ def nitsche_friction_qp(scene, system: SemismoothSystem, elasticity, trace,
                              tangential_rows(elasticity, trace, t)
                              - sparse.diags(np.repeat(1.0 / system.gamma, block)) @ shear,
                              system.gap, system.weight * system.gamma, system.weight,
-                             trace.points(t))
+                             trace.points(t), contact_tangents(trace))
 
 
 def shear_function(scene, elasticity, trace, gamma_facet: np.ndarray, u_free: np.ndarray,
@@ -69,6 +69,9 @@ def shear_function(scene, elasticity, trace, gamma_facet: np.ndarray, u_free: np
     vector P_t projected onto the disc of radius s)."""
     u, law = elasticity.expand(u_free), scene.friction
     tangents = contact_tangents(trace)
+    # w . t_k per facet (0 if the obstacle does not slide)
+    slides = ([np.zeros(trace.size)] * len(tangents) if not law.slide else
+              list(slide_components(law.slide, tangents).reshape(trace.size, -1).T))
 
     def shear(tt):
         tt = np.asarray(tt, dtype=float)
@@ -78,8 +81,9 @@ def shear_function(scene, elasticity, trace, gamma_facet: np.ndarray, u_free: np
         argument = np.stack([
             (at.stress_matrix(normal, np.repeat(tangent, nq, axis=1), elasticity.lame) @ u
              - np.repeat(gamma_facet, nq) * (at.matrix(np.repeat(tangent, nq, axis=1)) @ u
-                                             - law.slide)).reshape(trace.size, nq)
-            for tangent in tangents], axis=-1)  # (facet, point, tangent)
+                                             - np.repeat(slide, nq))).reshape(trace.size, nq)
+            for tangent, slide in zip(tangents, slides, strict=True)], axis=-1)
+        # (facet, point, tangent)
         bound = (law.coefficient * pressure(tt) if law.kind == "coulomb"
                  else law.slip_bound_at(trace.points(tt)).reshape(trace.size, nq))
         size = np.linalg.norm(argument, axis=-1)

@@ -38,20 +38,26 @@ def interleaved(rows: list[sparse.csr_matrix]) -> sparse.csr_matrix:
     return sparse.vstack(rows, format="csr")[order]
 
 
-def friction_rows(scene, nodes, T, block: int = 1) -> FrictionRows | None:
+def slide_components(slide: float, frame: list[np.ndarray]) -> np.ndarray | None:
+    """The obstacle's slide w along each row's tangent, point-major (None if it does not
+    slide): in 2D ``slide`` along t, in 3D w = slide e_x, so w . t_k = slide (t_k)_x."""
+    if not slide:
+        return None
+    if len(frame) == 1:
+        return np.full(frame[0].shape[1], float(slide))
+    return float(slide) * np.stack([tangent[0] for tangent in frame], axis=1).ravel()
+
+
+def friction_rows(scene, nodes, T, frame: list[np.ndarray]) -> FrictionRows | None:
     """The ``FrictionRows`` of ``scene``'s law on ``nodes`` with tangential rows ``T`` (free
-    DOFs, ``block`` per node), or None without friction."""
+    DOFs, one per tangent of ``frame`` and node), or None without friction."""
     law = scene.friction
     if not law.active:
         return None
-    if law.slide and block != 1:
-        raise ValueError(f"slide={law.slide!r} is a displacement along the one tangent of 2D; "
-                         "in 3D the obstacle does not slide")
     bound = (nodes.weight * law.slip_bound_at(nodes.points) if law.kind == "tresca"
              else np.zeros(nodes.weight.size))
-    shift = np.full(nodes.weight.size, law.slide) if law.slide else None
-    return FrictionRows(T=T, bound=bound, coefficient=law.coefficient, shift=shift,
-                        block=block)
+    return FrictionRows(T=T, bound=bound, coefficient=law.coefficient,
+                        shift=slide_components(law.slide, frame), block=len(frame))
 
 
 def facet_interpolant(values: np.ndarray, t: np.ndarray) -> np.ndarray:

@@ -24,7 +24,7 @@ from scipy import sparse
 
 from formulations.base import ContactQP, FrictionRows
 from formulations.evaluation import evaluate_on_trace
-from formulations.nodal_friction import interleaved, tangent_frame
+from formulations.nodal_friction import interleaved, slide_components, tangent_frame
 
 
 def contact_tangent(trace) -> np.ndarray:
@@ -55,14 +55,13 @@ def shear_vectors(values: np.ndarray, tangents: list[np.ndarray]) -> np.ndarray:
 
 def slack_friction_qp(scene, K: sparse.spmatrix, F: np.ndarray, P: sparse.spmatrix,
                       R: sparse.spmatrix, gap: np.ndarray, weights: np.ndarray,
-                      row_length: np.ndarray, points: np.ndarray) -> ContactQP:
+                      row_length: np.ndarray, points: np.ndarray,
+                      tangents: list[np.ndarray]) -> ContactQP:
     """The QP of the module docstring: unknowns u, the normal slacks, the tangential slacks;
-    ``row_length`` the points' shares w_q |e| of Gamma_C, ``points`` their positions."""
+    ``row_length`` the points' shares w_q |e| of Gamma_C, ``points`` their positions,
+    ``tangents`` the facets' (``contact_tangents``)."""
     law, ns = scene.friction, row_length.size
     block = R.shape[0] // ns  # tangential directions per point: d - 1
-    if law.slide and block != 1:
-        raise ValueError(f"slide={law.slide!r} is a displacement along the one tangent of 2D; "
-                         "in 3D the obstacle does not slide")
     eye, eye_t = sparse.identity(ns, format="csr"), sparse.identity(block * ns, format="csr")
     bound = np.zeros(ns)
     if law.kind == "tresca":
@@ -70,7 +69,9 @@ def slack_friction_qp(scene, K: sparse.spmatrix, F: np.ndarray, P: sparse.spmatr
     friction = FrictionRows(T=sparse.hstack([R, sparse.csr_matrix((block * ns, ns)), -eye_t],
                                             format="csr"),
                             bound=bound, coefficient=law.coefficient, block=block,
-                            shift=np.full(ns, law.slide) if law.slide else None)
+                            shift=slide_components(law.slide, [
+                                np.repeat(tangent, ns // tangent.shape[1], axis=1)
+                                for tangent in tangents]))
     return ContactQP(K=sparse.block_diag([K, sparse.diags(weights),
                                           sparse.diags(np.repeat(weights, block))],
                                          format="csr"),

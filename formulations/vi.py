@@ -127,7 +127,7 @@ def discretise(scene: Scene, mesh: MeshTri, order: int = 1) -> Discretisation:
     # rows of B are dimensionless (a normal), so the multipliers are forces; row_scale 1
     frame = tangent_frame(nodes.normal)
     friction = (friction_rows(scene, nodes, elasticity.restrict(
-        interleaved([rows(t) for t in frame])), len(frame))
+        interleaved([rows(t) for t in frame])), frame)
         if scene.friction.active else None)
     qp = ContactQP(K=elasticity.K_free, F=elasticity.F_free,
                    B=elasticity.restrict(B), G=G, row_scale=np.ones(m),

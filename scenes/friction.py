@@ -11,7 +11,7 @@ Scenes take the law from three parameters, so that options and sweeps work as fo
 parameter (``paper:friction=coulomb:mu=0.1|0.3``): ``friction`` (the law's name), ``mu`` (the
 Coulomb coefficient) and ``slip_bound`` (a constant Tresca bound s, a stress). A scene may also
 let the obstacle slide along t by a constant ``slide`` (a length; Cattaneo-Mindlin's tangential
-loading): the slip is then u_t - slide.
+loading): the slip is then u_t - slide. In 3D it slides along x: the slip is u_t - slide e_x.
 """
 
 from __future__ import annotations

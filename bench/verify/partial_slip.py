@@ -15,6 +15,8 @@ from bench.sequence.loop import run_sequence
 
 PEAK_SAMPLES = 20001  # points over +-b where the predicted peak shear is sought
 FACET_SAMPLES = np.linspace(0.0, 1.0, 9)  # where sigma_t,h is sampled on each facet
+# on each contact triangle (3D): its corners, edge midpoints and centroid
+TRIANGLE_SAMPLES = np.array([[0, 1, 0, 0.5, 0.5, 0, 1 / 3], [0, 0, 1, 0, 0.5, 0.5, 1 / 3]])
 FORCE_POINTS = 4  # Gauss points per facet for P and Q (exact for cubic tractions)
 
 
@@ -51,7 +53,12 @@ def compare(scene, solution) -> dict:
     trace = solution.trace
     t, w = trace.rule(2 * FORCE_POINTS - 1)
     normal_force = solution.contact_force(FORCE_POINTS)
-    tangential_force = float(trace.integrate(state.traction(t), w).sum())
+    traction = state.traction(t)  # in 3D a vector: Q is its x component (the slide's)
+    tangential_force = float(trace.integrate(traction if trace.dim == 2 else traction[0],
+                                             w).sum())
+    samples = FACET_SAMPLES if trace.dim == 2 else TRIANGLE_SAMPLES
+    sampled = state.traction(samples)
+    peak = np.abs(sampled) if trace.dim == 2 else np.linalg.norm(sampled, axis=0)
     predicted = scene.predict_stick(normal_force, tangential_force)
     start, end = state.zone("stick")
     b = predicted.half_width
@@ -59,5 +66,5 @@ def compare(scene, solution) -> dict:
     return {"contact_force": normal_force, "tangential_force": tangential_force,
             "stick_half_width": 0.5 * (end - start), "stick_centre": 0.5 * (end + start),
             "predicted_stick_half_width": predicted.stick_half_width, "half_width": b,
-            "peak_shear": float(np.abs(state.traction(FACET_SAMPLES)).max()),
+            "peak_shear": float(peak.max()),
             "predicted_peak_shear": float(np.abs(predicted.shear(samples)).max())}

@@ -100,3 +100,29 @@ def test_a_3d_sequence_with_friction_runs_where_it_is_modelled():
         # in 3D the zone is its extent along x: inside the contact face (-1, 1)
         assert -1 <= last.stick_zone_start <= last.stick_zone_end <= 1
         assert np.isfinite(last.eta) and last.eta > 0
+
+
+def test_mindlin_stick_radius_and_shear_at_hand_worked_numbers():
+    from scenes.base import Material
+    from scenes.hertz_3d import mindlin
+    # E = 1000, nu = 0, R = 1, P = 4000/3: a = 1, p0 = 2000/pi (Hertz); Q = (7/8) mu P leaves
+    # c = a (1/8)^(1/3) = 1/2, and q(0) = mu p0 (1 - c/a) (Johnson, Contact Mechanics, 7.2)
+    P, mu = 4000.0 / 3.0, 0.3
+    predicted = mindlin(mu, 1e-3)(Material(1000.0, 0.0, "strain"), 1.0, P, 7 / 8 * mu * P)
+    assert predicted.stick_half_width == pytest.approx(0.5, rel=1e-14)
+    assert predicted.shear(np.array([0.0]))[0] == pytest.approx(mu * 2000 / np.pi * 0.5,
+                                                                  rel=1e-14)
+
+
+def test_a_sliding_obstacle_drags_the_sticking_nodes_along_x_in_3d():
+    # mu = 10 sticks every node in contact (section 17.6), so there u_h = w = slide e_x
+    scene = get_scene("hertz-3d", friction="coulomb", mu=10.0, slide=1e-3, initial_divisions=4)
+    disc = get_formulation("vi")(scene, scene.mesh.refined(1))
+    sol = solve(disc, "active-set")
+    assert sol.status == "ok", sol.reason
+    stick = sol.friction.state == "stick"
+    assert stick.sum() >= 1
+    slip = sol.friction.slip  # T u - w per node and tangent: zero where a node sticks
+    assert np.abs(slip.reshape(-1, 2)[stick]).max() < 1e-12  # exact sets: round-off
+    frame = np.array(disc.qp.friction.shift).reshape(-1, 2)
+    assert np.abs(frame).max() == pytest.approx(1e-3, rel=1e-12)  # w . t_k = slide (t_k)_x
