@@ -61,18 +61,24 @@ def hertz_contact(young_modulus: float, poisson_ratio: float, radius: float,
     return ContactPrediction(b, p0, label=f"Hertz, b = {b:.4g}, p0 = {p0:.4g}")
 
 
+def partial_slip(contact, exponent: float, name: str, mu: float, slide: float):
+    """(material, R, P, Q) -> the partial slip under Hertz's pressure ``contact(E, nu, R, P)``:
+    the stick zone c = b (1 - |Q| / (mu P))^exponent, the shear traction along the obstacle's
+    slide (1/2: Cattaneo-Mindlin's cylinder, 1/3: Mindlin's sphere; Johnson, 7.1 and 7.2)."""
+    def predict(scene_material: Material, radius: float, P: float, Q: float) -> StickPrediction:
+        hertz = contact(scene_material.young_modulus, scene_material.poisson_ratio, radius, P)
+        ratio = float(np.clip(1.0 - abs(Q) / (mu * P), 0.0, 1.0))
+        c = hertz.half_width * ratio**exponent
+        return StickPrediction(c, hertz.half_width, hertz.peak_pressure, mu,
+                               direction=float(np.sign(slide)),
+                               label=f"{name}, c = {c:.4g}, b = {hertz.half_width:.4g}")
+    return predict
+
+
 def cattaneo_mindlin(mu: float, slide: float):
     """(P, Q) -> Cattaneo-Mindlin's partial slip under Hertz's pressure: the stick zone
     c = b sqrt(1 - |Q| / (mu P)), the shear traction along the obstacle's slide."""
-    def predict(scene_material: Material, radius: float, P: float, Q: float) -> StickPrediction:
-        hertz = hertz_contact(scene_material.young_modulus, scene_material.poisson_ratio,
-                              radius, P)
-        ratio = float(np.clip(1.0 - abs(Q) / (mu * P), 0.0, 1.0))
-        c = hertz.half_width * np.sqrt(ratio)
-        return StickPrediction(c, hertz.half_width, hertz.peak_pressure, mu,
-                               direction=float(np.sign(slide)),
-                               label=f"Cattaneo-Mindlin, c = {c:.4g}, b = {hertz.half_width:.4g}")
-    return predict
+    return partial_slip(hertz_contact, 0.5, "Cattaneo-Mindlin", mu, slide)
 
 
 @register_scene("hertz", "Hertz line contact: a block pressed by a rigid parabola of radius R "

@@ -29,11 +29,11 @@ from scenes.base import (
     Material,
     Scene,
     SceneError,
-    StickPrediction,
     is_integer,
 )
 from scenes.budget import tensor_mesh
 from scenes.friction import friction_law
+from scenes.hertz import partial_slip
 from scenes.registry import register_scene
 
 _TOL = 1e-10
@@ -52,15 +52,7 @@ def hertz_sphere(young_modulus: float, poisson_ratio: float, radius: float,
 def mindlin(mu: float, slide: float):
     """(P, Q) -> Mindlin's partial slip under Hertz's sphere: the stick radius
     c = a (1 - |Q| / (mu P))^(1/3), the shear traction along the obstacle's slide."""
-    def predict(scene_material: Material, radius: float, P: float, Q: float) -> StickPrediction:
-        hertz = hertz_sphere(scene_material.young_modulus, scene_material.poisson_ratio,
-                             radius, P)
-        ratio = float(np.clip(1.0 - abs(Q) / (mu * P), 0.0, 1.0))
-        c = hertz.half_width * np.cbrt(ratio)
-        return StickPrediction(c, hertz.half_width, hertz.peak_pressure, mu,
-                               direction=float(np.sign(slide)),
-                               label=f"Mindlin, c = {c:.4g}, a = {hertz.half_width:.4g}")
-    return predict
+    return partial_slip(hertz_sphere, 1.0 / 3.0, "Mindlin", mu, slide)
 
 
 @register_scene("hertz-3d", "Hertz contact of a sphere: a block pressed by a rigid paraboloid "

@@ -94,3 +94,15 @@ def test_stick_slip_side_traction_is_sigma_n_and_the_top_is_clamped():
                                                   abs=1e-15)
     top = np.array([y, np.ones_like(y)])
     assert scene.exact.displacement(top) == pytest.approx(0.0, abs=1e-15)
+
+
+def test_cattaneo_mindlin_stick_zone_at_hand_worked_numbers():
+    from scenes.base import Material
+    from scenes.hertz import cattaneo_mindlin
+    # E = 1000, nu = 0, R = 1, P = 250 pi: b = sqrt(4 P R / (pi E*)) = 1, p0 = 2 P / (pi b) = 500;
+    # Q = (3/4) mu P leaves c = b sqrt(1/4) = 1/2 and q(0) = mu p0 (1 - c/b) (Johnson, 7.1)
+    P, mu = 250 * np.pi, 0.3
+    predicted = cattaneo_mindlin(mu, -1e-3)(Material(1000.0, 0.0, "strain"), 1.0, P,
+                                            0.75 * mu * P)
+    assert predicted.stick_half_width == pytest.approx(0.5, rel=1e-14)
+    assert predicted.shear(np.array([0.0]))[0] == pytest.approx(-mu * 500 * 0.5, rel=1e-14)
