@@ -12,6 +12,7 @@ from bench.report.figures import colour
 from formulations.base import FRICTION_STATES
 
 STATE_COLOURS = {"separated": "0.7", "stick": "tab:blue", "slip": "tab:red"}
+ZOOM = 1.4  # the 3D maps show the points in contact and this many times their reach
 
 
 def shear_traction(artifacts: dict, reference_curve=None):
@@ -79,6 +80,11 @@ def state_maps(artifacts: dict, zones=None):
         for radius in zones or ():
             ax.add_patch(Circle((0.0, 0.0), radius, fill=False, linestyle="--", color="k",
                                 linewidth=0.8))
+        touching = data["friction_state"] != FRICTION_STATES.index("separated")
+        if touching.any():  # a zoom on the points in contact (and the exact zones)
+            reach = max(np.hypot(x[touching], y[touching]).max(), *(zones or (0.0,)))
+            ax.set_xlim(-ZOOM * reach, ZOOM * reach)
+            ax.set_ylim(-ZOOM * reach, ZOOM * reach)
         ax.set_title(f"{formulation}: {int(data['ndofs'])} DOFs", fontsize=9)
         ax.set_aspect("equal")
         ax.legend(fontsize=7, loc="upper right")
