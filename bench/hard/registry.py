@@ -50,3 +50,9 @@ def hard_case_descriptions() -> dict[str, str]:
     scenes = scene_descriptions()
     return {**{name: f"scene {name!r}: {scenes[name]}" for name in hard_scene_names()},
             **HARD_CASES.descriptions()}
+
+
+def case_seconds(name: str) -> float:
+    """What a case's registration says it costs (``meta={"seconds": ...}``; 0 if it did not
+    say, as the hard scenes, a second or two each, do not)."""
+    return float(HARD_CASES.meta(name, "seconds", 0.0)) if name in HARD_CASES.names() else 0.0
