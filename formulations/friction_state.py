@@ -33,3 +33,10 @@ def friction_state(friction: FrictionRows, u_free: np.ndarray, normal: np.ndarra
                          shear=-tangential * np.repeat(to_stress, friction.block),
                          slip=friction.slip(u_free), bound=bound,
                          state=state, traction=traction, bound_traction=bound * to_stress)
+
+
+def traction_size(values: np.ndarray) -> np.ndarray:
+    """|sigma_t| from ``FrictionState.traction(t)``: the absolute value of the 2D traction
+    (n_facets, nt), the length of the 3D vector (3, n_facets, nt)."""
+    values = np.asarray(values)
+    return np.linalg.norm(values.reshape((-1,) + values.shape[-2:]), axis=0)

@@ -21,6 +21,7 @@ from bench.measure.contact import contact_zone, zone_error
 from formulations import DiscreteSolution
 from formulations.contact import gauss_legendre
 from formulations.elasticity import stress_from_gradient, stress_tensor_from_gradient
+from formulations.friction_state import traction_size
 
 EXACT_INTORDER = 6  # plus 2 (p - 1) for P_p: the u_h part of the integrand stays exact
 PRESSURE_POINTS = 6  # Gauss points per contact facet for ||lambda - lambda_h||
@@ -61,11 +62,9 @@ def shear_error(solution: DiscreteSolution, true_shear) -> float:
     """||sigma_t - sigma_t,h||_{0,Gamma_C} on u_h's contact facets, with ``true_shear(s)`` a
     function of the contact coordinate (in 3D a vector, (3, ...), as sigma_t,h is)."""
     trace = solution.trace
-    t, w = (trace.rule(2 * PRESSURE_POINTS - 1) if trace.dim == 3
-            else gauss_legendre(PRESSURE_POINTS))
+    t, w = trace.rule(2 * PRESSURE_POINTS - 1)  # 2D: PRESSURE_POINTS Gauss points
     diff = true_shear(trace.coordinates_at(t)) - solution.friction.traction(t)
-    square = (diff**2).sum(axis=0) if trace.dim == 3 else diff**2
-    return float(np.sqrt(trace.integrate(square, w).sum()))
+    return float(np.sqrt(trace.integrate(traction_size(diff) ** 2, w).sum()))
 
 
 def errors_from(energy_error: float, solution: DiscreteSolution, true_pressure,

@@ -12,6 +12,7 @@ from bench.matrix.config_files import run_fields
 from bench.matrix.spec import build_scene
 from bench.matrix.task import why_skipped
 from bench.sequence.loop import run_sequence
+from formulations.friction_state import traction_size
 
 PEAK_SAMPLES = 20001  # points over +-b where the predicted peak shear is sought
 FACET_SAMPLES = np.linspace(0.0, 1.0, 9)  # where sigma_t,h is sampled on each facet
@@ -56,9 +57,7 @@ def compare(scene, solution) -> dict:
     traction = state.traction(t)  # in 3D a vector: Q is its x component (the slide's)
     tangential_force = float(trace.integrate(traction if trace.dim == 2 else traction[0],
                                              w).sum())
-    samples = FACET_SAMPLES if trace.dim == 2 else TRIANGLE_SAMPLES
-    sampled = state.traction(samples)
-    peak = np.abs(sampled) if trace.dim == 2 else np.linalg.norm(sampled, axis=0)
+    peak = traction_size(state.traction(FACET_SAMPLES if trace.dim == 2 else TRIANGLE_SAMPLES))
     predicted = scene.predict_stick(normal_force, tangential_force)
     start, end = state.zone("stick")
     b = predicted.half_width
