@@ -43,3 +43,14 @@ def test_every_3d_estimator_has_a_bounded_effectivity(estimator, order):
         assert estimate.eta**2 == pytest.approx(estimate.indicators.sum(), rel=1e-10)
         ratio = estimate.eta / exact_errors(SCENE, sol).energy_error
         assert low < ratio < high, (refinements, ratio)
+
+
+def test_3d_face_jumps_do_not_depend_on_the_block_size(monkeypatch):
+    import estimators.residual_3d as residual_3d
+
+    sol = solve(get_formulation("vi")(SCENE, SCENE.mesh.refined(1), order=2), "active-set")
+    whole = residual_3d.interior_jumps_3d(sol)
+    monkeypatch.setattr(residual_3d, "FACE_CHUNK", 97)  # many blocks, the last one short
+    # the same sums in another order: equal to round-off
+    np.testing.assert_allclose(residual_3d.interior_jumps_3d(sol), whole, rtol=1e-12)
+    assert whole.min() > 0  # every tetrahedron has an interior face with a jump

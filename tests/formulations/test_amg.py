@@ -79,9 +79,10 @@ def test_a_solve_that_does_not_converge_raises_with_the_residual(monkeypatch):
 
 @pytest.mark.slow
 def test_cg_iterations_barely_grow_with_the_mesh():
-    """Rigid-body modes make the V-cycle mesh-independent: measured 14 / 20 / 25 / 30 CG
-    iterations to 1e-10 at 1 944 / 13 872 / 104 544 / 811 200 P1 DOFs on paper-3d; without
-    them 107 at 13 872 already. 1.5 x over one refinement allows for that slow growth."""
+    """Rigid-body modes make the V-cycle mesh-independent: measured 19 / 26 / 32 CG
+    iterations to 1e-10 at 1 944 / 13 872 / 104 544 P1 DOFs on paper-3d (38 at 545 832 in the
+    scaling table); without them 107 at 13 872 already. 1.5 x over one refinement allows for
+    that slow growth."""
     scene = get_scene("paper-3d")
     counts = []
     for refine in (2, 3):

@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from scipy import sparse
-from scipy.sparse.linalg import cg, gmres
+from scipy.sparse.linalg import LinearOperator, cg, gmres
 
 from formulations.solvers.backends.base import Backend, FactorisationError, register_backend
 
@@ -32,6 +32,16 @@ from formulations.solvers.backends.base import Backend, FactorisationError, regi
 RTOL = 1e-10
 MAX_ITERATIONS = 2000
 SYMMETRIC = 1e-12  # max |K - K'| / max |K| below which K is treated as symmetric (round-off)
+# the hierarchy and its V-cycle in single precision: the Krylov iteration stays in double and
+# corrects the preconditioner's round-off. vi P1 on paper-3d at 104 544 DOFs, CG to 1e-10:
+# 30 iterations in both precisions, 0.039 against 0.056 s per iteration (the V-cycle's sweeps
+# read half the bytes), and the hierarchy takes half the memory
+CYCLE_DTYPE = np.float32
+# one forward Gauss-Seidel sweep before the coarse correction and one backward after it (a
+# symmetric V-cycle, half the sweeps of PyAMG's default): the same contact solve at 104 544
+# DOFs took 124 V-cycles in 4.4 s against 102 in 4.8 s
+SMOOTHING = (("block_gauss_seidel", {"sweep": "forward"}),
+             ("block_gauss_seidel", {"sweep": "backward"}))
 
 
 @dataclass(eq=False)
@@ -82,12 +92,19 @@ def factorise(K: sparse.spmatrix, near_null: np.ndarray | None = None) -> Iterat
 
     K = sparse.csr_matrix(K)
     symmetric = is_symmetric(K)
-    modes = None if near_null is None else np.ascontiguousarray(near_null, dtype=float)
+    modes = None if near_null is None else np.ascontiguousarray(near_null, dtype=CYCLE_DTYPE)
     hierarchy = pyamg.smoothed_aggregation_solver(
-        K, B=modes, symmetry="symmetric" if symmetric else "nonsymmetric",
-        strength=("symmetric", {"theta": 0.0}), max_coarse=500, coarse_solver="splu")
-    return IterativeSolve(K, hierarchy.aspreconditioner(cycle="V"), symmetric)
+        K.astype(CYCLE_DTYPE), B=modes, symmetry="symmetric" if symmetric else "nonsymmetric",
+        strength=("symmetric", {"theta": 0.0}), max_coarse=500, coarse_solver="splu",
+        presmoother=SMOOTHING[0], postsmoother=SMOOTHING[1])
+    return IterativeSolve(K, in_double(hierarchy.aspreconditioner(cycle="V")), symmetric)
 
+
+def in_double(cycle) -> LinearOperator:
+    """The single-precision V-cycle as an operator on double vectors."""
+    return LinearOperator(cycle.shape, dtype=float,
+                          matvec=lambda r: cycle.matvec(np.asarray(r, dtype=CYCLE_DTYPE))
+                          .astype(float))
 
 register_backend(Backend(
     "amg", rank=3, factorise=factorise, condense=None,
