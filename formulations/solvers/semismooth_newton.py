@@ -24,6 +24,8 @@ Back-ends without a Schur complement (splu) run the same iteration on u with the
 Jacobian K + T' D_A T, factorised once per iteration; so does every back-end beyond
 SPARSE_NEWTON_FROM points when that Jacobian is SPD (a penalty; theta = 1), where the dense
 nq x nq block would cost O(nq^3) (``newton_route``); an iterative back-end (amg) always does.
+On a direct back-end a step whose active set differs from the last factorised one in a few
+points is solved by CG preconditioned by that factorisation (``reused_factorisation``).
 """
 
 from __future__ import annotations
@@ -49,6 +51,7 @@ from formulations.solvers.backends import (
 )
 from formulations.solvers.newton import Linearised, newton
 from formulations.solvers.registry import FAST_SOLVER, register_system_solver
+from formulations.solvers.reused_factorisation import ReusedFactorisation
 
 # relative nonlinear residual at which iterative refinement stops (one step reaches 1e-13 ..
 # 3e-12 from the ~1e-9 the partial factorisation leaves, measured to 5e5 DOFs)
@@ -148,6 +151,7 @@ def sparse_problem(system: SemismoothSystem, backend: str | None = None) -> Line
     every step are appended to ``krylov``."""
     T = system.T
     krylov: list[int] = []
+    direct = ReusedFactorisation(backend) if backend is not None else None
     rtol = [SEARCH_RTOL if iterative(backend) else 0.0]  # an iterative back-end's, per step
 
     def tighten() -> bool:
@@ -165,8 +169,8 @@ def sparse_problem(system: SemismoothSystem, backend: str | None = None) -> Line
             dx = solve(rhs, rtol=rtol[0])
             krylov.extend(solve.iterations)
             return dx, float("nan")
-        if backend is not None:
-            return factorise(J, backend)(rhs), float("nan")
+        if direct is not None:  # SPD: reuse an earlier factorisation (reused_factorisation)
+            return direct(J, active, rhs), float("nan")
         return splu(J.tocsc()).solve(rhs), float("nan")
 
     return Linearised(system.residual, lambda u: system.pressure_argument(T @ u), step,
