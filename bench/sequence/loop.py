@@ -54,10 +54,11 @@ class LoopSettings:
     theta: float = option(0.5, "marking parameter in (0, 1]", flag="theta", kind="theta",
                           section="how")
     backend: str | None = option(
-        None, "sparse direct back-end of the active-set solver: pardiso (MKL, installed with "
-        "the package on x86_64), cholmod (needs scikit-sparse) or splu (scipy)",
+        None, "sparse back-end of the active-set solver: pardiso (MKL, installed with the "
+        "package on x86_64), cholmod (needs scikit-sparse), splu (scipy) or amg (PyAMG's "
+        "multigrid with conjugate gradients, no factorisation)",
         flag="backend", kind="choice", section="how", choices=backend_names,
-        default_text="the first of these that is available")
+        default_text="the first of pardiso, cholmod, splu that is available")
     nested: bool = option(
         True, "solve every level from scratch instead of starting from the previous level's "
         "contact zone (nested iteration, the default)", flag="cold-start", kind="switch-off",

@@ -41,17 +41,19 @@ def test_cg_needs_at_most_k_plus_one_steps_for_k_changed_points(problem):
         np.testing.assert_allclose(J @ x, b, rtol=0, atol=1e-12 * np.linalg.norm(b))
 
 
-def test_a_step_refactorises_when_many_points_changed(problem, monkeypatch):
+def test_a_step_refactorises_when_cg_runs_out_of_its_budget(problem):
     K, T, b = problem
     direct = ReusedFactorisation(BACKEND)
     active = np.zeros(T.shape[0], dtype=bool)
-    for count, expected_factorisations in ((10, 1), (12, 1), (100, 2)):
+    for count, budget, factorisations in ((10, None, 1), (12, 1000, 1), (100, 2, 2)):
+        if budget is not None:  # set by the timing of the factorisation otherwise
+            direct.budget = budget
         active[:count] = True
         J = jacobian(K, T, active)
         x = direct(J, active, b)
-        assert direct.factorisations == expected_factorisations, count
+        assert direct.factorisations == factorisations, count
         np.testing.assert_allclose(J @ x, b, rtol=0, atol=1e-12 * np.linalg.norm(b))
-    assert len(direct.iterations) == 1  # the one reused step
+    assert len(direct.iterations) == 2 and direct.iterations[-1] == 2  # reused, then gave up
 
 
 def test_a_reused_step_that_stalls_is_solved_by_a_new_factorisation(problem, monkeypatch):
@@ -60,6 +62,7 @@ def test_a_reused_step_that_stalls_is_solved_by_a_new_factorisation(problem, mon
     direct = ReusedFactorisation(BACKEND)
     active = np.zeros(T.shape[0], dtype=bool)
     direct(jacobian(K, T, active), active, b)
+    direct.budget = 1000  # not the limit here
     active[:8] = True
     J = jacobian(K, T, active)
     x = direct(J, active, b)
