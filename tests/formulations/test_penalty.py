@@ -86,3 +86,25 @@ def test_the_fast_solve_is_the_penalised_equation_on_both_routes(monkeypatch, ba
     # against Clarabel on the slack QP (tolerance 1e-10): the 1e-7 / 1e-6 of the other checks
     energy, pressure = solution_difference(disc, condensed, reference)
     assert energy < 1e-7 and pressure < 1e-5
+
+
+@pytest.mark.parametrize("scene_name, refinements", [("hertz-3d", 0), ("paper", 2)])
+def test_a_higher_order_pressure_stays_within_its_samples(scene_name, refinements):
+    """P2: lambda_h between the quadrature points never exceeds the facet's largest value
+    there (a quadratic through interior points overshoots towards the corners where the
+    zone's edge crosses the facet; unbounded, hertz-3d's peak was 3.25 x Hertz's)."""
+    scene = get_scene(scene_name)
+    sol = solve(get_formulation("penalty")(scene, scene.mesh.refined(refinements), order=2),
+                "active-set")
+    trace = sol.trace
+    t, _ = trace.rule(4)  # the 6 points of the P2 penalty on triangles (p + 1 = 3 in 2D)
+    if scene.dim == 2:
+        t = gauss_legendre(3)[0]
+    samples = sol.pressure(t)
+    grid = (np.array(np.meshgrid(np.linspace(0, 1, 9), np.linspace(0, 1, 9))).reshape(2, -1)
+            if scene.dim == 3 else np.linspace(0.0, 1.0, 41))
+    if scene.dim == 3:
+        grid = grid[:, grid.sum(axis=0) <= 1.0]  # the reference triangle
+    # the clip itself: exact up to the round-off of evaluating the samples twice
+    assert (sol.pressure(grid).max(axis=1) <= samples.max(axis=1) * (1 + 1e-12)).all()
+    assert samples.max() > 0

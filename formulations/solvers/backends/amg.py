@@ -113,6 +113,6 @@ register_backend(Backend(
                 "near-null space; no factorisation (the projected active-set iteration)",
     iterative=True,
     # bench scaling --backend amg: peak of a whole level (assembly, solve, estimator) 0.46 /
-    # 2.73 GiB at 100 800 / 992 640 DOFs (2D, mixed) and 0.93 / 3.88 GiB at 104 544 / 545 832
+    # 2.73 GiB at 100 800 / 992 640 DOFs (2D, mixed) and 0.97 / 2.78 GiB at 104 544 / 545 832
     # DOFs (3D, vi; reports/amg/scaling-3d.md), the lines through them
-    memory_gib=(0.2034, 2.545e-6), memory_gib_3d=(0.2313, 6.685e-6)))
+    memory_gib=(0.2034, 2.545e-6), memory_gib_3d=(0.5395, 4.103e-6)))
