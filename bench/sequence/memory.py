@@ -27,7 +27,11 @@ Tetrahedra: a 3D factor fills faster than N (nested dissection: N^(4/3) nonzeros
 slope is DIM3_FACTOR times the 2D one at DIM3_AT DOFs and grows like N^(1/3) from there
 (bounded below by the factor itself). Measured on ``free-boundary-3d`` (vi, active-set,
 pardiso, one uniform level in a fresh process): peak 1.48 GiB at 104 544 P1 DOFs (5.1 x the
-2D slope) and 1.69 GiB at 104 544 P2 DOFs (4.2 x the 2D P2 slope).
+2D slope) and 1.69 GiB at 104 544 P2 DOFs (4.2 x the 2D P2 slope). With MKL 2026.2 the same
+PARDISO factorisations take more: ``bench scaling --dim 3`` (paper-3d, vi) peaks at 2.06 /
+16.19 GiB at 104 544 / 545 832 P1 DOFs (7.4 and 7.1 x the 2D slope, the latter after the
+N^(1/3) growth), against 1.31 / 9.12 GiB with the MKL of the first table; DIM3_FACTOR = 7.4
+bounds both.
 """
 
 from __future__ import annotations
@@ -54,7 +58,7 @@ class MemoryLine:
 REFERENCE_BOUND = "cholmod"  # the back-end whose measured line bounds the reference (docstring)
 ORDER_FACTOR = {1: 1.0, 2: 1.4, 3: 1.7}  # per-DOF memory of P_p relative to P1 (docstring)
 # 3D: per-DOF memory relative to 2D at DIM3_AT DOFs (docstring), then growing like N^(1/3)
-DIM3_FACTOR, DIM3_AT = 5.1, 1.05e5
+DIM3_FACTOR, DIM3_AT = 7.4, 1.05e5
 
 
 def memory_line(route_name: str) -> MemoryLine:
