@@ -63,7 +63,9 @@ def newton(problem: Linearised, x: np.ndarray, active: np.ndarray,
         if changes[-1] == 0:
             return NewtonResult(x, STATUS_OK, "", iteration, tuple(changes), False, "",
                                 condition)
-        if new.tobytes() in seen:
+        if new.tobytes() in seen and problem.tighten():  # inexact steps cycled: go on exactly
+            seen = {new.tobytes()}
+        elif new.tobytes() in seen:
             return damped(problem, best[1], iteration, tuple(changes), True,
                           "plain semismooth Newton revisited an active set")
         seen.add(new.tobytes())
@@ -74,7 +76,9 @@ def newton(problem: Linearised, x: np.ndarray, active: np.ndarray,
 
 def damped(problem: Linearised, x: np.ndarray, done: int, changes: tuple[int, ...],
            cycled: bool, why: str, max_iter: int = 200) -> NewtonResult:
-    """Newton with Armijo backtracking on |R|^2 from ``x``."""
+    """Newton with Armijo backtracking on |R|^2 from ``x``, its steps solved exactly (an
+    iterative back-end's inexact search steps cannot reach MERIT_TOLERANCE)."""
+    problem.tighten()
     r = problem.residual(x)
     condition = float("nan")
     for iteration in range(1, max_iter + 1):
