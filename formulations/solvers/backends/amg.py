@@ -106,6 +106,7 @@ def in_double(cycle) -> LinearOperator:
                           matvec=lambda r: cycle.matvec(np.asarray(r, dtype=CYCLE_DTYPE))
                           .astype(float))
 
+
 register_backend(Backend(
     "amg", rank=3, factorise=factorise, condense=None,
     missing="" if importlib.util.find_spec("pyamg") else "pyamg is not installed",
