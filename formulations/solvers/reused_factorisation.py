@@ -10,10 +10,11 @@ route takes sparse steps on a direct back-end (a penalty; theta = 1).
 
 In practice CG needs far fewer iterations than k, because the rank-one terms of one contact
 zone are alike: 8 .. 13 for k = 25 .. 56 and 24 .. 64 for k = 160 .. 270 on the adaptive
-hertz-3d levels of 5e3 .. 5.7e4 DOFs. So a step always tries CG, with a budget of as many
-iterations as cost BUDGET of a factorisation (timed on this machine, on the factorisation and
-its first back-substitution); it factorises its own Jacobian when CG has not reached RTOL within
-the budget (or within k + 1 + SLACK iterations). The answer is always a solve to RTOL, never an
+hertz-3d levels of 5e3 .. 5.7e4 DOFs (k / 6 .. k / 3). So a step tries CG, with a budget of as
+many iterations as cost BUDGET of a factorisation (timed on this machine, on the factorisation
+and its first back-substitution), when k is at most CHANGED_PER_ITERATION times that budget;
+it factorises its own Jacobian otherwise, or when CG has not reached RTOL within the budget (or
+within k + 1 + SLACK iterations). The answer is always a solve to RTOL, never an
 inexact one; which of the two routes gave it changes u by round-off only.
 """
 
@@ -34,6 +35,10 @@ BUDGET = 0.7
 # residual on these Jacobians is 1e-15 .. 1e-13
 RTOL = 1e-13
 SLACK = 10  # iterations beyond k + 1 that round-off may take
+# changed points per CG iteration below which a step tries CG: on the adaptive hertz-3d
+# penalty levels it converged where k was 1.8 .. 4.6 budgets and gave up from 5.7 budgets up
+# (each attempt that gives up costs BUDGET of a factorisation)
+CHANGED_PER_ITERATION = 5
 
 
 def preconditioned_cg(J: sparse.csr_matrix, b: np.ndarray, precondition: Callable,
@@ -70,8 +75,8 @@ class ReusedFactorisation:
     iterations: list[int] = field(default_factory=list)
 
     def __call__(self, J: sparse.csr_matrix, active: np.ndarray, b: np.ndarray) -> np.ndarray:
-        if self.solve_0 is not None:
-            changed = int((active != self.active_0).sum())
+        changed = 0 if self.active_0 is None else int((active != self.active_0).sum())
+        if self.solve_0 is not None and changed <= CHANGED_PER_ITERATION * self.budget:
             limit = min(changed + 1 + SLACK, self.budget)
             x, count = preconditioned_cg(J, b, self.solve_0, limit)
             self.iterations.append(count)

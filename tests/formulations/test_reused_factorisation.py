@@ -45,7 +45,7 @@ def test_a_step_refactorises_when_cg_runs_out_of_its_budget(problem):
     K, T, b = problem
     direct = ReusedFactorisation(BACKEND)
     active = np.zeros(T.shape[0], dtype=bool)
-    for count, budget, factorisations in ((10, None, 1), (12, 1000, 1), (100, 2, 2)):
+    for count, budget, factorisations in ((10, None, 1), (12, 1000, 1), (100, 20, 2)):
         if budget is not None:  # set by the timing of the factorisation otherwise
             direct.budget = budget
         active[:count] = True
@@ -53,7 +53,20 @@ def test_a_step_refactorises_when_cg_runs_out_of_its_budget(problem):
         x = direct(J, active, b)
         assert direct.factorisations == factorisations, count
         np.testing.assert_allclose(J @ x, b, rtol=0, atol=1e-12 * np.linalg.norm(b))
-    assert len(direct.iterations) == 2 and direct.iterations[-1] == 2  # reused, then gave up
+    assert len(direct.iterations) == 2 and direct.iterations[-1] == 20  # reused, then gave up
+
+
+def test_a_step_with_many_changed_points_for_its_budget_does_not_try_cg(problem):
+    K, T, b = problem
+    direct = ReusedFactorisation(BACKEND)
+    active = np.zeros(T.shape[0], dtype=bool)
+    direct(jacobian(K, T, active), active, b)
+    direct.budget = 4
+    active[:21] = True  # 21 > 5 x 4 changed points: a factorisation at once
+    J = jacobian(K, T, active)
+    x = direct(J, active, b)
+    assert direct.factorisations == 2 and direct.iterations == []
+    np.testing.assert_allclose(J @ x, b, rtol=0, atol=1e-12 * np.linalg.norm(b))
 
 
 def test_a_reused_step_that_stalls_is_solved_by_a_new_factorisation(problem, monkeypatch):
