@@ -24,8 +24,9 @@ Back-ends without a Schur complement (splu) run the same iteration on u with the
 Jacobian K + T' D_A T, factorised once per iteration; so does every back-end beyond
 SPARSE_NEWTON_FROM points when that Jacobian is SPD (a penalty; theta = 1), where the dense
 nq x nq block would cost O(nq^3) (``newton_route``); an iterative back-end (amg) always does.
-On a direct back-end every step first tries CG preconditioned by the last factorisation (the
-Jacobians differ in a rank-one term per changed point; ``reused_factorisation``).
+On a direct back-end a step whose active set changed in few points tries CG preconditioned by
+the last factorisation first (the Jacobians differ in a rank-one term per changed point;
+``reused_factorisation``).
 """
 
 from __future__ import annotations
