@@ -148,7 +148,8 @@ def reconstruct(interior: Interior, fluxes: list[Flux],
                          symmetry=interior.symmetry[:, :n_sym],
                          rhs=interior.rhs.reshape(-1, 2, n_rt).transpose(0, 2, 1),
                          data=data.transpose(0, 2, 1),
-                         skew=skew_data(interior, data, turning, clamped)[:, :n_sym], fixed=fixed)
+                         skew=(skew_data(interior, data, turning, clamped) if n_sym
+                               else np.zeros((patch.size, 0))), fixed=fixed)
     lay = layout(patch, dofs, status, rt.N, n_v)
     free_values = solve_patches(lay, pairs, clamped)
     sigma = np.zeros((2, rt.N))

@@ -16,6 +16,7 @@ from skfem.refdom import RefTri
 
 from estimators.averaging import element_areas
 from estimators.raviart_thomas import ElementTriRTk
+from estimators.rt_reference import element_matrices, patch_rhs, scalar_values
 from formulations.elasticity import ELEMENTS
 from formulations.load import body_load
 from formulations.p1_stiffness import barycentric_gradients
@@ -48,49 +49,18 @@ def interior_data(mesh, sigma_h, body_force, k: int, intorder: int) -> Interior:
     """``sigma_h(basis)`` returns sigma(u_h) (2, 2, n_el, nq) at the quadrature points of a
     basis; ``body_force`` f (2, ...) at points, or None; k the RT degree."""
     rt = Basis(mesh, ElementTriRTk(k), intorder=intorder)
-    mass, divergence, symmetry, dg = element_matrices(rt)
-    hats = np.array([np.asarray(b[0]) for b in Basis(mesh, ElementTriP1(),
-                                               quadrature=rt.quadrature).basis])
+    X, W = rt.quadrature
+    dg = scalar_values(ELEMENTS[k](), X)
+    mass, divergence, symmetry = element_matrices(mesh, k, X, W, dg,
+                                                  scalar_values(SCALARS[k - 1](), X))
     stress = sigma_h(rt)
-    rhs, data = patch_rhs(rt, dg, hats, stress, barycentric_gradients(mesh)[0])
+    rhs, data = patch_rhs(mesh, k, X, W, dg, stress, barycentric_gradients(mesh)[0])
     if body_force is not None:
         data = data - load_moments(mesh, body_force, k)
     total = np.array([np.bincount(mesh.t.T.ravel(), data[:, :, r].sum(axis=-1).ravel(),
                                   minlength=mesh.p.shape[1]) for r in (0, 1)]).T
     return Interior(rt=rt, sigma_h=stress, mass=mass, divergence=divergence,
                     symmetry=symmetry, rhs=rhs, data=data, total=total, k=k, intorder=intorder)
-
-
-def element_matrices(rt: Basis):
-    """Local RT_k mass matrices (n_el, n_rt, n_rt), divergence matrices (n_el, n_dg, n_rt)
-    against the discontinuous P_k basis, symmetry matrices (n_el, n_sym, 2, n_rt): row r's
-    share of (sigma_12 - sigma_21, gamma) for gamma in the discontinuous P_(k-1) basis, and the
-    P_k DG basis on the same quadrature."""
-    k = rt.elem.k
-    dg = Basis(rt.mesh, ElementDG(ELEMENTS[k]()), quadrature=rt.quadrature)
-    rotation = Basis(rt.mesh, ElementDG(SCALARS[k - 1]()), quadrature=rt.quadrature)
-    phi = np.array([np.asarray(b[0]) for b in rt.basis])          # (n_rt, 2, n_el, nq)
-    div = np.array([b[0].div for b in rt.basis])            # (n_rt, n_el, nq)
-    q = np.array([np.asarray(b[0]) for b in dg.basis])            # (n_dg, n_el, nq)
-    gamma = np.array([np.asarray(b[0]) for b in rotation.basis])  # (n_sym, n_el, nq)
-    mass = np.einsum("jiep,liep,ep->ejl", phi, phi, rt.dx)
-    divergence = np.einsum("lep,jep,ep->elj", q, div, rt.dx)
-    symmetry = np.stack([np.einsum("gep,jep,ep->egj", gamma, phi[:, 1], rt.dx),
-                         -np.einsum("gep,jep,ep->egj", gamma, phi[:, 0], rt.dx)], axis=2)
-    return mass, divergence, symmetry, dg
-
-
-def patch_rhs(rt: Basis, dg: Basis, hats: np.ndarray, sigma_h: np.ndarray,
-              hat_gradients: np.ndarray):
-    """r = (phi_j, psi_a sigma_h row) and c = (sigma_h grad psi_a, q_l) for every element,
-    local vertex a and row; sigma_h (2, 2, n_el, nq), hats (3, n_el, nq), hat_gradients
-    (3, 2, n_el). The load's part of c is ``load_moments``."""
-    phi = np.array([np.asarray(b[0]) for b in rt.basis])
-    q = np.array([np.asarray(b[0]) for b in dg.basis])
-    rhs = np.einsum("jkep,aep,rkep,ep->earj", phi, hats, sigma_h, rt.dx)
-    data = np.einsum("rkep,ake->arep", sigma_h, hat_gradients)
-    divergence = np.einsum("arep,lep,ep->earl", data, q, rt.dx)
-    return rhs, divergence
 
 
 def load_moments(mesh, body_force, k: int) -> np.ndarray:

@@ -10,12 +10,23 @@ the same system size are stacked and solved by one batched dense LU.
 
 from __future__ import annotations
 
+import os
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
 
 ZERO, FREE, FIXED = 0, 1, 2
 BATCH = 2000  # patches per stacked solve: bounds the memory of the dense systems
+
+
+def worker_count() -> int:
+    """Threads for the patch chunks: the cores this process may use, at most OMP_NUM_THREADS
+    when it is set (each chunk writes its own patches' unknowns, so the result does not depend
+    on the count)."""
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
+    limit = os.environ.get("OMP_NUM_THREADS", "")
+    return max(1, min(cores or 1, int(limit) if limit.isdigit() and int(limit) > 0 else 64))
 
 
 @dataclass(frozen=True, eq=False)
@@ -98,10 +109,12 @@ def solve_patches(lay: PatchLayout, pairs: PairMatrices, clamped: np.ndarray) ->
     blocks = 2 if n_sym else 1
     size = blocks * lay.n_free + lay.count * (blocks * n_dg + n_sym)
     out = np.zeros((lay.key_dof.size, 2))
-    for n in np.unique(size):
-        patches = np.flatnonzero(size == n)
-        for chunk in np.array_split(patches, max(1, -(-patches.size // BATCH))):
-            _solve_chunk(lay, chunk, int(n), pairs, (rhs, data, skew), clamped, out)
+    jobs = [(chunk, int(n)) for n in np.unique(size)
+            for chunk in np.array_split(np.flatnonzero(size == n),
+                                        max(1, -(-(size == n).sum() // BATCH)))]
+    with ThreadPoolExecutor(max_workers=worker_count()) as pool:
+        list(pool.map(lambda job: _solve_chunk(lay, job[0], job[1], pairs,
+                                               (rhs, data, skew), clamped, out), jobs))
     return out
 
 

@@ -1,0 +1,86 @@
+"""The element integrals of the vertex-patch problems from reference-element data
+(docs/theory.md, section 13.2).
+
+On an affine triangle T = F(T^), F(x^) = J x^ + b, the RT_k functions are the contravariant
+Piola maps phi_j = o_j J phi^_j / |det J| (o_j = +-1 the facet orientation, 1 inside), their
+divergences o_j div^ phi^_j / |det J|, and dx = |det J| dx^. Every integral of the patch
+problems is then a small reference tensor, computed once, contracted with J per element:
+
+    (phi_j, phi_l)_T         = o_j o_l / |det J| sum_cd (J'J)_cd  int^ phi^_jc phi^_ld,
+    (div phi_j, q_l)_T       = o_j int^ div^ phi^_j q^_l,
+    (phi_j . e_i, gamma_g)_T = o_j sum_c J_ic int^ phi^_jc gamma^_g,
+    (phi_j, psi_a sigma_r)_T = o_j sum_c int^ phi^_jc psi^_a (J' sigma_r)_c,
+
+with sigma_h sampled at the reference quadrature points, so that the last is one matrix
+product over all elements. No basis function is evaluated on the physical elements.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from skfem import ElementTriP1
+
+from estimators.raviart_thomas import ElementTriRTk
+
+
+def reference_rt(k: int, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """RT_k reference values (n_rt, 2, nq) and divergences (n_rt, nq) at the points X."""
+    element = ElementTriRTk(k)
+    pairs = [element.lbasis(X, j) for j in range(element.doflocs.shape[0])]
+    return np.array([p[0] for p in pairs]), np.array([p[1] for p in pairs])
+
+
+def scalar_values(element, X: np.ndarray) -> np.ndarray:
+    """The reference basis (n, nq) of a scalar Lagrange element at the points X."""
+    return np.array([element.lbasis(X, j)[0] for j in range(element.doflocs.shape[0])])
+
+
+def orientations(mesh, n_rt: int, k: int) -> np.ndarray:
+    """o_j per element (n_el, n_rt): -1 on a facet DOF whose facet's first element is another
+    one (scikit-fem's ``ElementHdiv.orient``), +1 otherwise."""
+    own = mesh.f2t[0, mesh.t2f] == np.arange(mesh.t.shape[1])[None, :]   # (3, n_el)
+    signs = np.ones((mesh.t.shape[1], n_rt))
+    signs[:, :3 * (k + 1)] = np.repeat(np.where(own, 1.0, -1.0).T, k + 1, axis=1)
+    return signs
+
+
+def element_matrices(mesh, k: int, X: np.ndarray, W: np.ndarray, dg: np.ndarray,
+                     rotation: np.ndarray):
+    """The RT_k mass (n_el, n_rt, n_rt), divergence (n_el, n_dg, n_rt) and symmetry
+    (n_el, n_sym, 2, n_rt) matrices (row r's share of (sigma_12 - sigma_21, gamma)) for the
+    reference bases ``dg`` (n_dg, nq) and ``rotation`` (n_sym, nq) at the rule (X, W)."""
+    mapping = mesh.mapping()
+    J, det = mapping.A, np.abs(mapping.detA)                           # (2, 2, n_el), (n_el,)
+    phi, div = reference_rt(k, X)
+    o = orientations(mesh, phi.shape[0], k)
+    gram = np.einsum("ice,ide->cde", J, J)                             # J'J
+    mass_ref = np.einsum("jcp,ldp,p->cdjl", phi, phi, W)
+    n_rt = phi.shape[0]
+    mass = (gram.reshape(4, -1).T @ mass_ref.reshape(4, -1)).reshape(-1, n_rt, n_rt)
+    mass /= det[:, None, None]
+    mass *= o[:, :, None] * o[:, None, :]
+    divergence = np.einsum("jp,lp,p->lj", div, dg, W)[None] * o[:, None, :]
+    moments = np.einsum("jcp,gp,p->gcj", phi, rotation, W)             # int^ phi^_jc gamma^_g
+    along = np.einsum("ice,gcj->eigj", J, moments) * o[:, None, None, :]   # component i
+    symmetry = np.stack([along[:, 1], -along[:, 0]], axis=2)
+    return mass, divergence, symmetry
+
+
+def patch_rhs(mesh, k: int, X: np.ndarray, W: np.ndarray, dg: np.ndarray,
+              sigma_h: np.ndarray, hat_gradients: np.ndarray):
+    """r = (phi_j, psi_a sigma_h row r) (n_el, 3, 2, n_rt) and c = (sigma_h grad psi_a, q_l)
+    (n_el, 3, 2, n_dg) for sigma_h (2, 2, n_el, nq) at the reference points X and the
+    barycentric gradients (3, 2, n_el)."""
+    mapping = mesh.mapping()
+    J, det = mapping.A, np.abs(mapping.detA)
+    phi, _ = reference_rt(k, X)
+    n_rt, n_el = phi.shape[0], mesh.t.shape[1]
+    hats = scalar_values(ElementTriP1(), X)                            # (3, nq)
+    o = orientations(mesh, n_rt, k)
+    pulled = np.einsum("kce,rkep->ercp", J, sigma_h).reshape(n_el * 2, -1)   # J' sigma row
+    weighted = np.einsum("jcp,ap,p->cpaj", phi, hats, W).reshape(pulled.shape[1], -1)
+    rhs = (pulled @ weighted).reshape(n_el, 2, 3, n_rt).transpose(0, 2, 1, 3) * o[:, None, None]
+    samples = sigma_h.transpose(2, 0, 1, 3).reshape(n_el * 4, -1)     # (e r k, p)
+    tested = (samples @ (dg * W).T).reshape(n_el, 2, 2, -1)           # e r k l
+    data = np.einsum("ake,erkl->earl", hat_gradients, tested) * det[:, None, None, None]
+    return rhs, data
