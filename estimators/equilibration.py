@@ -150,7 +150,7 @@ def reconstruct(interior: Interior, fluxes: list[Flux],
                          data=data.transpose(0, 2, 1),
                          skew=(skew_data(interior, data, turning, clamped) if n_sym
                                else np.zeros((patch.size, 0))), fixed=fixed)
-    lay = layout(patch, dofs, status, rt.N, n_v)
+    lay = layout(patch, dofs, status, facet_holders(mesh, rt.element_dofs, k), n_v)
     free_values = solve_patches(lay, pairs, clamped)
     sigma = np.zeros((2, rt.N))
     for r in (0, 1):
@@ -161,6 +161,25 @@ def reconstruct(interior: Interior, fluxes: list[Flux],
     scale = np.abs(interior.total).max() + np.abs(balance).max() + np.finfo(float).tiny
     return Reconstruction(basis=rt, dofs=sigma, values=values,
                           imbalance=float(np.abs(gap).max(initial=0.0) / scale))
+
+
+def facet_holders(mesh, element_dofs: np.ndarray, k: int) -> np.ndarray:
+    """For every (pair p = 3 e + i, RT slot j) the flat index p' n_rt + j' of the entry that
+    represents the same unknown of patch mesh.t[i, e]: for a DOF on a facet, the entry of the
+    facet's first element (scikit-fem's f2t[0]), which holds the same global DOF and vertex;
+    interior DOFs represent themselves."""
+    n_rt, n_el = element_dofs.shape
+    pair = np.arange(3 * n_el)
+    element, corner = pair // 3, pair % 3
+    holder = pair[:, None] * n_rt + np.arange(n_rt)[None, :]
+    for j in range(3 * (k + 1)):
+        first = mesh.f2t[0, mesh.t2f[j // (k + 1), element]]
+        moved = np.flatnonzero(first != element)
+        e0, vertex = first[moved], mesh.t[corner[moved], element[moved]]
+        i0 = (mesh.t[:, e0] == vertex[None, :]).argmax(axis=0)
+        j0 = (element_dofs[:, e0] == element_dofs[j, element[moved]][None, :]).argmax(axis=0)
+        holder[moved, j] = (3 * e0 + i0) * n_rt + j0
+    return holder
 
 
 def field_values(rt: Basis, dofs: np.ndarray) -> np.ndarray:

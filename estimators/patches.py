@@ -49,24 +49,33 @@ class PatchLayout:
     key_of: np.ndarray
 
 
-def layout(patch: np.ndarray, dofs: np.ndarray, status: np.ndarray, n_dofs: int,
+def layout(patch: np.ndarray, dofs: np.ndarray, status: np.ndarray, holder: np.ndarray,
            n_vertices: int) -> PatchLayout:
-    """``dofs`` (P, n_rt) global RT DOFs of each pair's element."""
+    """``dofs`` (P, n_rt) global RT DOFs of each pair's element; ``holder`` (P, n_rt) the flat
+    index (pair * n_rt + slot) of the entry that represents the same (patch, DOF) unknown (a
+    DOF on a facet at the patch's vertex is held by the facet's two elements; either may
+    represent it, the layout numbers the representatives patch by patch, without a sort of
+    the keys)."""
+    n_pairs, n_rt = status.shape
     free = status == FREE
-    keys = patch[:, None].astype(np.int64) * n_dofs + dofs
-    unique, inverse = np.unique(keys[free], return_inverse=True)
-    first = np.searchsorted(unique, np.arange(n_vertices, dtype=np.int64) * n_dofs)
-    key_of = np.full(status.shape, -1, dtype=np.int64)
-    key_of[free] = inverse
+    own = free & (holder == np.arange(n_pairs * n_rt).reshape(n_pairs, n_rt))
     order = np.argsort(patch, kind="stable")
     count = np.bincount(patch, minlength=n_vertices)
     starts = np.concatenate([[0], np.cumsum(count)[:-1]])
-    rank = np.empty(patch.size, dtype=np.int64)
-    rank[order] = np.arange(patch.size) - starts[patch[order]]
+    rank = np.empty(n_pairs, dtype=np.int64)
+    rank[order] = np.arange(n_pairs) - starts[patch[order]]
+    grouped = own[order].ravel()                     # entries patch by patch
+    number = np.cumsum(grouped) - 1
+    key = np.full(n_pairs * n_rt, -1, dtype=np.int64)
+    key[(order[:, None] * n_rt + np.arange(n_rt)).ravel()[grouped]] = number[grouped]
+    key_of = np.where(free, key[holder], -1)
+    n_free = np.bincount(np.repeat(patch, n_rt)[own.ravel()], minlength=n_vertices)
+    first = np.concatenate([[0], np.cumsum(n_free)[:-1]])
+    key_dof = np.empty(int(n_free.sum()), dtype=np.int64)
+    key_dof[key_of[own]] = dofs[own]
     return PatchLayout(patch=patch, status=status,
                        local=np.where(free, key_of - first[patch][:, None], -1),
-                       n_free=np.bincount(unique // n_dofs, minlength=n_vertices), rank=rank,
-                       count=count, key_dof=unique % n_dofs, key_of=key_of)
+                       n_free=n_free, rank=rank, count=count, key_dof=key_dof, key_of=key_of)
 
 
 @dataclass(frozen=True, eq=False)
