@@ -46,13 +46,13 @@ from formulations.solvers.backends import (
     FactorisationError,
     check_backend,
     condenses,
-    factorise,
     factorise_condensed,
     iterative,
 )
 from formulations.solvers.newton import Linearised, newton
 from formulations.solvers.registry import FAST_SOLVER, register_system_solver
 from formulations.solvers.reused_factorisation import ReusedFactorisation
+from formulations.solvers.reused_hierarchy import ReusedHierarchy
 
 # relative nonlinear residual at which iterative refinement stops (one step reaches 1e-13 ..
 # 3e-12 from the ~1e-9 the partial factorisation leaves, measured to 5e5 DOFs)
@@ -153,6 +153,7 @@ def sparse_problem(system: SemismoothSystem, backend: str | None = None) -> Line
     T = system.T
     krylov: list[int] = []
     direct = ReusedFactorisation(backend) if backend is not None else None
+    hierarchy = ReusedHierarchy(backend, system.near_null) if iterative(backend) else None
     rtol = [SEARCH_RTOL if iterative(backend) else 0.0]  # an iterative back-end's, per step
 
     def tighten() -> bool:
@@ -166,9 +167,9 @@ def sparse_problem(system: SemismoothSystem, backend: str | None = None) -> Line
         if backend is not None and iterative(backend):
             if not np.any(system.F - T.T @ system.phi_affine(active)[1]):
                 return -u, float("nan")  # no load, no contact: u = 0 exactly, not round-off
-            solve = factorise(J, backend, system.near_null)
-            dx = solve(rhs, rtol=rtol[0])
-            krylov.extend(solve.iterations)
+            done = len(hierarchy.iterations)
+            dx = hierarchy(J, rhs, rtol[0], active)
+            krylov.extend(hierarchy.iterations[done:])
             return dx, float("nan")
         if direct is not None:  # SPD: reuse an earlier factorisation (reused_factorisation)
             return direct(J, active, rhs), float("nan")

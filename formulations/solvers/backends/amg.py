@@ -52,6 +52,14 @@ class IterativeSolve:
     preconditioner: object
     symmetric: bool
     iterations: list[int] = field(default_factory=list)
+    max_iterations: int | None = None  # None: MAX_ITERATIONS
+
+    def for_matrix(self, K: sparse.spmatrix, max_iterations: int) -> IterativeSolve:
+        """A solve of another matrix K with this hierarchy as its preconditioner, that gives
+        up (``FactorisationError``) after ``max_iterations``."""
+        K = sparse.csr_matrix(K)
+        return IterativeSolve(K, self.preconditioner, is_symmetric(K),
+                              max_iterations=max_iterations)
 
     def __call__(self, b: np.ndarray, rtol: float | None = None) -> np.ndarray:
         """K^-1 b to the relative residual ``rtol`` (None: RTOL)."""
@@ -69,7 +77,8 @@ class IterativeSolve:
 
         method = cg if self.symmetric else gmres
         extra = {} if self.symmetric else {"restart": 60, "callback_type": "pr_norm"}
-        x, info = method(self.K, b, rtol=rtol, atol=0.0, maxiter=MAX_ITERATIONS,
+        limit = self.max_iterations or MAX_ITERATIONS
+        x, info = method(self.K, b, rtol=rtol, atol=0.0, maxiter=limit,
                          M=self.preconditioner, callback=tick, **extra)
         self.iterations.append(count[0])
         residual = np.linalg.norm(b - self.K @ x) / norm
