@@ -42,6 +42,7 @@ from estimators.guaranteed_contact import (
 from estimators.guaranteed_friction import balanced_shear, friction_bound, raw_shear, shear_at
 from estimators.patch_data import interior_data, rebalanced
 from estimators.residual import stress_tensor
+from estimators.rt_reference import displacement_gradient
 from formulations import DiscreteSolution
 from formulations.elasticity import ELEMENTS, element_diameters, stress_from_gradient
 
@@ -121,8 +122,9 @@ def equilibrate(scene, solution: DiscreteSolution):
     lam, mu = elasticity.lame
 
     def stress(basis):
-        grad = Basis(mesh, elasticity.basis.elem, quadrature=basis.quadrature).interpolate(
-            solution.u).grad
+        grad = displacement_gradient(mesh, elasticity.basis.elem.elem,
+                                     elasticity.basis.element_dofs, solution.u,
+                                     basis.quadrature[0])
         return stress_tensor(stress_from_gradient(grad, lam, mu))
 
     clamped = np.zeros(mesh.p.shape[1], dtype=bool)
