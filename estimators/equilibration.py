@@ -24,11 +24,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from skfem import Basis, ElementTriP1, FacetBasis
+from skfem import ElementTriP1, FacetBasis
 
 from estimators.patch_data import Interior, skew_data
 from estimators.patches import FIXED, FREE, ZERO, PairMatrices, layout, solve_patches
 from estimators.raviart_thomas import ElementTriRTk
+from estimators.rt_reference import ReferenceRT
 
 # local facets of scikit-fem's triangles: 0 = (v0, v1), 1 = (v1, v2), 2 = (v0, v2); the k + 1
 # RT_k DOFs of local facet f are (k + 1) f .. (k + 1) f + k, the interior ones follow.
@@ -40,11 +41,12 @@ WEAK_SYMMETRY_FROM = 2
 
 @dataclass(frozen=True, eq=False)
 class Reconstruction:
-    """sigma* row by row as RT DOF vectors on ``basis`` (shape (2, basis.N)), the element values
+    """sigma* row by row as RT DOF vectors on ``basis`` (an ``estimators.rt_reference.
+    ReferenceRT``; shape (2, basis.N)), the element values
     of sigma* (2, 2, n_elements, n_points) at the quadrature points of ``basis``, and how far
     the patch data were from balance (max over patches, relative to the largest patch datum)."""
 
-    basis: Basis
+    basis: ReferenceRT
     dofs: np.ndarray
     values: np.ndarray
     imbalance: float
@@ -156,7 +158,7 @@ def reconstruct(interior: Interior, fluxes: list[Flux],
     for r in (0, 1):
         np.add.at(sigma[r], lay.key_dof, free_values[:, r])
         np.add.at(sigma[r], dofs[status == FIXED], fixed[..., r][status == FIXED])
-    values = field_values(rt, sigma)
+    values = rt.values(sigma)
     gap = (interior.total - balance)[~clamped]
     scale = np.abs(interior.total).max() + np.abs(balance).max() + np.finfo(float).tiny
     return Reconstruction(basis=rt, dofs=sigma, values=values,
@@ -180,13 +182,3 @@ def facet_holders(mesh, element_dofs: np.ndarray, k: int) -> np.ndarray:
         j0 = (element_dofs[:, e0] == element_dofs[j, element[moved]][None, :]).argmax(axis=0)
         holder[moved, j] = (3 * e0 + i0) * n_rt + j0
     return holder
-
-
-def field_values(rt: Basis, dofs: np.ndarray) -> np.ndarray:
-    """The values (2, 2, n_el, nq) of the RT fields with DOFs ``dofs`` (2, rt.N) at the
-    quadrature points (row, component, element, point)."""
-    local = dofs[:, rt.element_dofs]                                    # (2, n_rt, n_el)
-    out = np.zeros((2, 2) + rt.dx.shape)
-    for j, phi in enumerate(rt.basis):
-        out += local[:, j][:, None, :, None] * np.asarray(phi[0])[None]
-    return out

@@ -15,8 +15,7 @@ from skfem.quadrature import get_quadrature
 from skfem.refdom import RefTri
 
 from estimators.averaging import element_areas
-from estimators.raviart_thomas import ElementTriRTk
-from estimators.rt_reference import element_matrices, patch_rhs, scalar_values
+from estimators.rt_reference import ReferenceRT, element_matrices, patch_rhs, scalar_values
 from formulations.elasticity import ELEMENTS
 from formulations.load import body_load
 from formulations.p1_stiffness import barycentric_gradients
@@ -33,7 +32,7 @@ class Interior:
     sum_T int_T (sigma_h grad psi_a - psi_a f) (n_vertices, 2), and the degree k and the
     quadrature order used."""
 
-    rt: Basis
+    rt: ReferenceRT
     sigma_h: np.ndarray
     mass: np.ndarray
     divergence: np.ndarray
@@ -48,7 +47,7 @@ class Interior:
 def interior_data(mesh, sigma_h, body_force, k: int, intorder: int) -> Interior:
     """``sigma_h(basis)`` returns sigma(u_h) (2, 2, n_el, nq) at the quadrature points of a
     basis; ``body_force`` f (2, ...) at points, or None; k the RT degree."""
-    rt = Basis(mesh, ElementTriRTk(k), intorder=intorder)
+    rt = ReferenceRT.build(mesh, k, intorder)
     X, W = rt.quadrature
     dg = scalar_values(ELEMENTS[k](), X)
     mass, divergence, symmetry = element_matrices(mesh, k, X, W, dg,

@@ -64,10 +64,9 @@ def layout(patch: np.ndarray, dofs: np.ndarray, status: np.ndarray, holder: np.n
     starts = np.concatenate([[0], np.cumsum(count)[:-1]])
     rank = np.empty(n_pairs, dtype=np.int64)
     rank[order] = np.arange(n_pairs) - starts[patch[order]]
-    grouped = own[order].ravel()                     # entries patch by patch
-    number = np.cumsum(grouped) - 1
+    grouped = np.flatnonzero(own[order].ravel())     # the keys, patch by patch
     key = np.full(n_pairs * n_rt, -1, dtype=np.int64)
-    key[(order[:, None] * n_rt + np.arange(n_rt)).ravel()[grouped]] = number[grouped]
+    key[order[grouped // n_rt] * n_rt + grouped % n_rt] = np.arange(grouped.size)
     key_of = np.where(free, key[holder], -1)
     n_free = np.bincount(np.repeat(patch, n_rt)[own.ravel()], minlength=n_vertices)
     first = np.concatenate([[0], np.cumsum(n_free)[:-1]])

@@ -17,10 +17,56 @@ product over all elements. No basis function is evaluated on the physical elemen
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
-from skfem import ElementTriP1
+from skfem import Basis, ElementTriP1
+from skfem.assembly import Dofs
+from skfem.quadrature import get_quadrature
+from skfem.refdom import RefTri
 
 from estimators.raviart_thomas import ElementTriRTk
+
+
+@dataclass(frozen=True, eq=False)
+class ReferenceRT:
+    """RT_k on a triangle mesh with a quadrature rule, without basis values on the elements:
+    its DOF numbering (scikit-fem's, ``element_dofs`` and ``N``), the rule (X, W), dx and the
+    points in physical coordinates. ``basis()`` builds scikit-fem's Basis when a caller needs
+    one (interpolation in tests)."""
+
+    mesh: object
+    elem: ElementTriRTk
+    quadrature: tuple[np.ndarray, np.ndarray]
+    element_dofs: np.ndarray
+    N: int
+
+    @classmethod
+    def build(cls, mesh, k: int, intorder: int) -> ReferenceRT:
+        elem = ElementTriRTk(k)
+        dofs = Dofs(mesh, elem)
+        return cls(mesh, elem, get_quadrature(RefTri, intorder), dofs.element_dofs, dofs.N)
+
+    @property
+    def dx(self) -> np.ndarray:
+        return np.abs(self.mesh.mapping().detA)[:, None] * self.quadrature[1][None, :]
+
+    def global_coordinates(self) -> np.ndarray:
+        return self.mesh.mapping().F(self.quadrature[0])
+
+    def basis(self) -> Basis:
+        return Basis(self.mesh, self.elem, quadrature=self.quadrature)
+
+    def values(self, dofs: np.ndarray) -> np.ndarray:
+        """The values (r, 2, n_el, nq) of fields with RT DOFs ``dofs`` (r, N) at the points:
+        o_j J phi^_j / |det J| summed with the element's DOF values."""
+        mapping, k = self.mesh.mapping(), self.elem.k
+        phi, _ = reference_rt(k, self.quadrature[0])
+        n_rt, n_el = self.element_dofs.shape
+        local = dofs[:, self.element_dofs] * orientations(self.mesh, n_rt, k).T[None]
+        reference = np.einsum("rje,jcp->rcep", local, phi, optimize=True)
+        return np.einsum("ice,rcep->riep", mapping.A, reference) / np.abs(
+            mapping.detA)[None, None, :, None]
 
 
 def reference_rt(k: int, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

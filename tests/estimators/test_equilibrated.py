@@ -67,7 +67,7 @@ def test_reconstruction_is_equilibrated(formulation, options):
     sol = solve(get_formulation(formulation)(scene, scene.mesh.refined(2), order=2, **options),
                 "active-set")
     rec, interior, *_ = equilibrate(scene, sol)
-    div = np.array([rec.basis.interpolate(s).div for s in rec.dofs])  # (2, n_el, nq)
+    div = np.array([rec.basis.basis().interpolate(s).div for s in rec.dofs])  # (2, n_el, nq)
     integral = (div * rec.basis.dx).sum(axis=-1)
     data = interior.data.sum(axis=-1)                                   # (n_el, 3, 2)
     expected = data.sum(axis=1).T      # the data of the three vertex patches of each element
