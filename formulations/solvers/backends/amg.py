@@ -122,10 +122,11 @@ register_backend(Backend(
     description="conjugate gradients with smoothed-aggregation AMG (PyAMG), rigid-body "
                 "near-null space; no factorisation (the projected active-set iteration)",
     iterative=True,
-    # bench scaling --backend amg: peak of a whole level (assembly, solve, estimator) 0.46 /
-    # 2.73 GiB at 100 800 / 992 640 DOFs (2D, mixed), the line through them. 3D: 0.97 GiB at
+    # bench scaling --backend amg: peak of a whole level (assembly, solve, estimator) 0.54 /
+    # 3.24 GiB at 100 800 / 992 640 DOFs (2D, mixed; with the float32 hierarchy, built from a
+    # float32 copy of K, against 0.46 / 2.73 before it), the line through them. 3D: 0.97 GiB at
     # 104 544 DOFs (one level, vi; reports/amg/scaling-3d.md) and 15.24 GiB, the peak of a whole
     # adaptive sequence to 2 736 186 DOFs (paper-3d, vi, residual; it holds the previous level
     # too, and its last refinement), the line through them (3.36 GiB at 545 832: the single
     # level measured 2.78)
-    memory_gib=(0.2034, 2.545e-6), memory_gib_3d=(0.4031, 5.422e-6)))
+    memory_gib=(0.2348, 3.027e-6), memory_gib_3d=(0.4031, 5.422e-6)))
