@@ -42,9 +42,9 @@ from estimators.guaranteed_contact import (
 from estimators.guaranteed_friction import balanced_shear, friction_bound, raw_shear, shear_at
 from estimators.patch_data import interior_data, rebalanced
 from estimators.residual import stress_tensor
-from estimators.rt_reference import displacement_gradient
 from formulations import DiscreteSolution
 from formulations.elasticity import ELEMENTS, element_diameters, stress_from_gradient
+from formulations.evaluation import gradients_at_reference
 
 # The bound needs the patch data to balance (docs/theory.md, 13.2); past this relative
 # imbalance (round-off is ~1e-12) the stress is not equilibrated and no bound is claimed.
@@ -122,9 +122,7 @@ def equilibrate(scene, solution: DiscreteSolution):
     lam, mu = elasticity.lame
 
     def stress(basis):
-        grad = displacement_gradient(mesh, elasticity.basis.elem.elem,
-                                     elasticity.basis.element_dofs, solution.u,
-                                     basis.quadrature[0])
+        grad = gradients_at_reference(elasticity.basis, solution.u, basis.quadrature[0])
         return stress_tensor(stress_from_gradient(grad, lam, mu))
 
     clamped = np.zeros(mesh.p.shape[1], dtype=bool)

@@ -72,9 +72,7 @@ def load_moments(mesh, body_force, k: int) -> np.ndarray:
     F = body_load(body_force, basis)[basis.element_dofs]                  # (2 n_fine, n_el)
     per_node = F.reshape(-1, 2, mesh.t.shape[1])                           # node m, row r
     nodes = fine.doflocs.T
-    hats = np.array([ElementTriP1().lbasis(nodes, a)[0] for a in range(3)])
-    coarse = ELEMENTS[k]()
-    q = np.array([coarse.lbasis(nodes, j)[0] for j in range(coarse.doflocs.shape[0])])
+    hats, q = scalar_values(ElementTriP1(), nodes), scalar_values(ELEMENTS[k](), nodes)
     return np.einsum("mre,am,lm->earl", per_node, hats, q)
 
 
@@ -98,9 +96,7 @@ def _hat_moments(k: int) -> np.ndarray:
     """int_T lambda_i q_l / |T| for the barycentric lambda_i and the P_k DG basis q_l, (3, n_dg)
     (the same on every triangle)."""
     X, W = get_quadrature(RefTri, k + 1)
-    element = ELEMENTS[k]()
-    q = np.array([element.lbasis(X, j)[0] for j in range(element.doflocs.shape[0])])
-    hats = np.array([ElementTriP1().lbasis(X, a)[0] for a in range(3)])
+    q, hats = scalar_values(ELEMENTS[k](), X), scalar_values(ElementTriP1(), X)
     return np.einsum("ap,lp,p->al", hats, q, W) / W.sum()
 
 
@@ -124,8 +120,6 @@ def skew_data(interior: Interior, data: np.ndarray, turning: np.ndarray,
     weight = np.bincount(mesh.t.ravel(), np.tile(area / 3, 3), minlength=n_v)
     share = np.repeat(area / 3, 3) / weight[mesh.t.T.ravel()]
     X, W = get_quadrature(RefTri, k)
-    scalar = SCALARS[k - 1]()
-    mean = np.array([(scalar.lbasis(X, g)[0] * W).sum() / W.sum()
-                     for g in range(scalar.doflocs.shape[0])])
+    mean = scalar_values(SCALARS[k - 1](), X) @ W / W.sum()
     return (rotation[mesh.t.T.ravel()] * share)[:, None] * mean[None, :]
 

@@ -131,14 +131,3 @@ def patch_rhs(mesh, k: int, X: np.ndarray, W: np.ndarray, dg: np.ndarray,
     data = np.einsum("ake,erkl->earl", hat_gradients, tested) * det[:, None, None, None]
     return rhs, data
 
-
-def displacement_gradient(mesh, scalar, element_dofs: np.ndarray, u: np.ndarray,
-                          X: np.ndarray) -> np.ndarray:
-    """grad u_h (2, 2, n_el, nq) at the reference points X for u_h in the vector Lagrange
-    space of the scalar element ``scalar`` (scikit-fem's ElementVector: local DOF 2 j + c is
-    component c at node j): grad u_c = J^-T sum_j u_jc grad^ phi^_j."""
-    n_el = mesh.t.shape[1]
-    dphi = np.array([scalar.lbasis(X, j)[1] for j in range(scalar.doflocs.shape[0])])
-    nodal = u[element_dofs].reshape(-1, 2, n_el).transpose(2, 1, 0)   # (e, c, j)
-    reference = (nodal @ dphi.reshape(dphi.shape[0], -1)).reshape(n_el, 2, 2, -1)  # e c m p
-    return np.einsum("mde,ecmp->cdep", mesh.mapping().invA, reference)

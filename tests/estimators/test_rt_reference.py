@@ -3,19 +3,14 @@ quadrature of the same integrals on the physical elements (docs/theory.md, 13.2)
 
 import numpy as np
 import pytest
-from skfem import Basis, ElementDG, ElementTriP1, ElementVector, MeshTri
+from skfem import Basis, ElementDG, ElementTriP1, MeshTri
 
 from estimators import patches
 from estimators.equilibrated import equilibrate
 from estimators.patch_data import SCALARS
 from estimators.patches import worker_count
 from estimators.raviart_thomas import ElementTriRTk
-from estimators.rt_reference import (
-    displacement_gradient,
-    element_matrices,
-    patch_rhs,
-    scalar_values,
-)
+from estimators.rt_reference import element_matrices, patch_rhs, scalar_values
 from formulations import get_formulation, solve
 from formulations.elasticity import ELEMENTS
 from formulations.p1_stiffness import barycentric_gradients
@@ -63,18 +58,6 @@ def test_reference_integrals_equal_physical_quadrature(k):
     for name, value in expected.items():
         # the same sums in another order: round-off of the entries' size (seen ~5e-16)
         assert np.abs(got[name] - value).max() <= 1e-12 * np.abs(value).max(), name
-
-
-@pytest.mark.parametrize("k", [1, 2, 3])
-def test_the_displacement_gradient_equals_scikit_fems(k):
-    mesh = skewed_mesh()
-    vector = Basis(mesh, ElementVector(ELEMENTS[k]()), intorder=2 * k + 2)
-    u = np.random.default_rng(k).standard_normal(vector.N)
-    expected = vector.interpolate(u).grad
-    got = displacement_gradient(mesh, ELEMENTS[k](), vector.element_dofs, u,
-                                vector.quadrature[0])
-    # the same sums in another order (seen ~3e-16)
-    assert np.abs(got - expected).max() <= 1e-12 * np.abs(expected).max()
 
 
 def test_worker_count_honours_omp_num_threads(monkeypatch):
