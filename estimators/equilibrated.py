@@ -42,6 +42,7 @@ from estimators.guaranteed_contact import (
 from estimators.guaranteed_friction import balanced_shear, friction_bound, raw_shear, shear_at
 from estimators.patch_data import interior_data, rebalanced
 from estimators.residual import stress_tensor
+from estimators.symmetrisation import symmetrised
 from formulations import DiscreteSolution
 from formulations.elasticity import ELEMENTS, element_diameters, stress_from_gradient
 from formulations.evaluation import gradients_at_reference
@@ -114,9 +115,10 @@ def estimate(scene, solution: DiscreteSolution) -> Estimate:
 
 
 def equilibrate(scene, solution: DiscreteSolution):
-    """sigma* (a ``Reconstruction``), the patch data, ||rho||_T^2, the contact terms of
-    lambda* (a ``ContactBound``), the Neumann data of the auxiliary problem, the clamped
-    vertices and sigma*_t (None without friction) (docs/theory.md, 13.2, 13.3 and 17.5)."""
+    """sigma* (a ``Reconstruction``, symmetrised by ``estimators.symmetrisation``), the patch
+    data, ||rho||_T^2, the contact terms of lambda* (a ``ContactBound``), the Neumann data of
+    the auxiliary problem, the clamped vertices and sigma*_t (None without friction)
+    (docs/theory.md, 13.2, 13.3 and 17.5)."""
     elasticity = solution.elasticity
     mesh, order = elasticity.mesh, elasticity.order
     lam, mu = elasticity.lame
@@ -132,28 +134,30 @@ def equilibrate(scene, solution: DiscreteSolution):
     n_v = mesh.p.shape[1]
     neumann = BoundaryData(scene.neumann_facets(mesh), scene.traction or (lambda x: 0.0 * x))
     neumann_flux = boundary_fluxes(interior, [neumann])
-    reaction = interior.total - boundary_balance(n_v, neumann_flux)[0]
+    reaction = interior.total - boundary_balance(n_v, neumann_flux)
     shear = None
     sheared = [] if solution.friction is None else [
         BoundaryData(trace.facets, lambda x: shear_at(trace, raw_shear(solution), x))]
     lam_star, bound = contact_traction(  # the normal balance net of sigma_t,h's own
         scene, solution, interior,
-        reaction - boundary_balance(n_v, boundary_fluxes(interior, sheared))[0], clamped)
+        reaction - boundary_balance(n_v, boundary_fluxes(interior, sheared)), clamped)
     normal = BoundaryData(trace.facets, lambda x: traction_at(trace, lam_star, x))
     contact = normal
     if sheared:  # sigma*_t balances what is left along the tangents (17.5)
         defect = reaction - boundary_balance(n_v, boundary_fluxes(interior,
-                                                                  [normal, *sheared]))[0]
+                                                                  [normal, *sheared]))
         shear = balanced_shear(solution, defect, clamped)
         contact = BoundaryData(trace.facets, lambda x: traction_at(trace, lam_star, x)
                                + shear_at(trace, shear, x))
     fluxes = neumann_flux + boundary_fluxes(interior, [contact])
-    interior, load = rebalanced(interior, interior.total - boundary_balance(n_v, fluxes)[0],
+    interior, load = rebalanced(interior, interior.total - boundary_balance(n_v, fluxes),
                                 clamped)
     rec = reconstruct(interior, fluxes, clamped)
     if rec.imbalance > BALANCE_TOLERANCE:
         raise NotEquilibrated(f"the patch data do not balance (relative imbalance "
                               f"{rec.imbalance:.1e} > {BALANCE_TOLERANCE:g}): no bound")
+    prescribed = np.concatenate([part.facets for part in (neumann, contact)])
+    rec = symmetrised(rec, interior, prescribed, (lam, mu), domain_constants(scene).korn)
     return rec, interior, load, bound, [neumann, contact], clamped, shear
 
 
@@ -169,7 +173,7 @@ def contact_traction(scene, solution, interior, reaction: np.ndarray,
     trace, order = solution.trace, solution.elasticity.order
     projected = projected_pressure(solution.pressure, order)
     raw = BoundaryData(trace.facets, lambda x: traction_at(trace, projected, x))
-    defect = reaction - boundary_balance(reaction.shape[0], boundary_fluxes(interior, [raw]))[0]
+    defect = reaction - boundary_balance(reaction.shape[0], boundary_fluxes(interior, [raw]))
     zero = FacetPolynomial(np.zeros((trace.facets.size, order + 1)))
     candidates = [balanced_traction(trace, projected, defect, clamped),
                   balanced_traction(trace, zero, reaction, clamped)]

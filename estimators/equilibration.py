@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 from skfem import ElementTriP1, FacetBasis
 
-from estimators.patch_data import Interior, skew_data
+from estimators.patch_data import Interior
 from estimators.patches import FIXED, FREE, ZERO, PairMatrices, layout, solve_patches
 from estimators.raviart_thomas import ElementTriRTk
 from estimators.rt_reference import ReferenceRT
@@ -34,9 +34,6 @@ from estimators.rt_reference import ReferenceRT
 # local facets of scikit-fem's triangles: 0 = (v0, v1), 1 = (v1, v2), 2 = (v0, v2); the k + 1
 # RT_k DOFs of local facet f are (k + 1) f .. (k + 1) f + k, the interior ones follow.
 _OPPOSITE_FACET = np.array([1, 2, 0])
-# weak symmetry only from k = 2, where V_h contains psi_a r_a and the rotation moments balance:
-# at k = 1 it made the bound larger on `paper` (docs/theory.md, 13.2)
-WEAK_SYMMETRY_FROM = 2
 
 
 @dataclass(frozen=True, eq=False)
@@ -64,13 +61,11 @@ class BoundaryData:
 @dataclass(frozen=True, eq=False)
 class Flux:
     """Pi_k (psi_a t) on boundary facets for both facet vertices a: the prescribed RT_k DOF
-    values (n_f, 2 vertices, 2 rows, k + 1 facet DOFs), the integrals of psi_a t (n_f, 2, 2)
-    and of psi_a t . r_a (n_f, 2) (r_a the rotation about a), the vertices (2, n_f), the
-    elements (n_f,) and their local facet (n_f,)."""
+    values (n_f, 2 vertices, 2 rows, k + 1 facet DOFs), the integrals of psi_a t (n_f, 2, 2),
+    the vertices (2, n_f), the elements (n_f,) and their local facet (n_f,)."""
 
     values: np.ndarray
     integrals: np.ndarray
-    turning: np.ndarray
     ends: np.ndarray
     elements: np.ndarray
     local: np.ndarray
@@ -95,11 +90,8 @@ def boundary_flux(interior: Interior, part: BoundaryData) -> Flux:
     psi = np.array([np.asarray(b[0]) for b in hats.basis])[vertex_local, rows[None, :]]
     moments = np.einsum("vfp,rfp,jfp,fp->fvrj", psi, t, trace, fb.dx)
     values = np.linalg.solve(gram[:, None, None], moments[..., None])[..., 0]
-    arm = x[None] - mesh.p[:, ends].transpose(1, 0, 2)[..., None]      # x - x_a, (2, 2, n_f, nq)
-    turn = t[1][None] * arm[:, 0] - t[0][None] * arm[:, 1]              # t . r_a
     return Flux(values=values, integrals=np.einsum("vfp,rfp,fp->fvr", psi, t, fb.dx),
-                turning=np.einsum("vfp,vfp,fp->fv", psi, turn, fb.dx), ends=ends,
-                elements=fb.tind, local=local)
+                ends=ends, elements=fb.tind, local=local)
 
 
 def _local_facet(mesh, facets: np.ndarray, elements: np.ndarray) -> np.ndarray:
@@ -111,14 +103,13 @@ def boundary_fluxes(interior: Interior, boundary: list[BoundaryData]) -> list[Fl
     return [boundary_flux(interior, part) for part in boundary if part.facets.size]
 
 
-def boundary_balance(n_vertices: int, fluxes: list[Flux]) -> tuple[np.ndarray, np.ndarray]:
-    """int psi_a t (n_vertices, 2) and int psi_a t . r_a (n_vertices,) over the boundary."""
-    balance, turning = np.zeros((n_vertices, 2)), np.zeros(n_vertices)
+def boundary_balance(n_vertices: int, fluxes: list[Flux]) -> np.ndarray:
+    """int psi_a t (n_vertices, 2) over the boundary."""
+    balance = np.zeros((n_vertices, 2))
     for flux in fluxes:
         for v in (0, 1):
             np.add.at(balance, flux.ends[v], flux.integrals[:, v])
-            np.add.at(turning, flux.ends[v], flux.turning[:, v])
-    return balance, turning
+    return balance
 
 
 def reconstruct(interior: Interior, fluxes: list[Flux],
@@ -143,15 +134,10 @@ def reconstruct(interior: Interior, fluxes: list[Flux],
             for j in range(k + 1):
                 status[p, (k + 1) * flux.local + j] = FIXED
                 fixed[p, (k + 1) * flux.local + j] = flux.values[:, v, :, j]
-    balance, turning = boundary_balance(n_v, fluxes)
-    data = interior.data.reshape(-1, 2, n_dg)
-    n_sym = interior.symmetry.shape[1] if k >= WEAK_SYMMETRY_FROM else 0
+    balance = boundary_balance(n_v, fluxes)
     pairs = PairMatrices(mass=interior.mass, divergence=interior.divergence,
-                         symmetry=interior.symmetry[:, :n_sym],
                          rhs=interior.rhs.reshape(-1, 2, n_rt).transpose(0, 2, 1),
-                         data=data.transpose(0, 2, 1),
-                         skew=(skew_data(interior, data, turning, clamped) if n_sym
-                               else np.zeros((patch.size, 0))), fixed=fixed)
+                         data=interior.data.reshape(-1, 2, n_dg).transpose(0, 2, 1), fixed=fixed)
     lay = layout(patch, dofs, status, facet_holders(mesh, rt.element_dofs, k), n_v)
     free_values = solve_patches(lay, pairs, clamped)
     sigma = np.zeros((2, rt.N))

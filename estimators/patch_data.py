@@ -1,8 +1,7 @@
 """The element data of the vertex-patch problems of the equilibrated stress (docs/theory.md,
 section 13.2): RT_k element matrices, the right-hand sides psi_a sigma_h and the divergence data
 sigma_h grad psi_a - psi_a f per (element, local vertex) pair, the load that balances patches
-the discrete solution does not balance exactly, and the rotation moments of the weak symmetry
-constraint.
+the discrete solution does not balance exactly.
 """
 
 from __future__ import annotations
@@ -10,7 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 import numpy as np
-from skfem import Basis, ElementDG, ElementTriP0, ElementTriP1, ElementTriP4, ElementVector
+from skfem import Basis, ElementDG, ElementTriP1, ElementTriP4, ElementVector
 from skfem.quadrature import get_quadrature
 from skfem.refdom import RefTri
 
@@ -20,8 +19,9 @@ from formulations.elasticity import ELEMENTS
 from formulations.load import body_load
 from formulations.p1_stiffness import barycentric_gradients
 
-# scalar Lagrange triangles by degree (P0 for the multipliers of weak symmetry at k = 1)
-SCALARS = {0: ElementTriP0, **ELEMENTS, 4: ElementTriP4}
+# scalar Lagrange triangles by degree, to P4: the load moments and the stream functions of
+# ``estimators.symmetrisation`` use P_(k+1)
+SCALARS = {**ELEMENTS, 4: ElementTriP4}
 
 
 @dataclass(frozen=True, eq=False)
@@ -36,7 +36,6 @@ class Interior:
     sigma_h: np.ndarray
     mass: np.ndarray
     divergence: np.ndarray
-    symmetry: np.ndarray
     rhs: np.ndarray
     data: np.ndarray
     total: np.ndarray
@@ -50,16 +49,15 @@ def interior_data(mesh, sigma_h, body_force, k: int, intorder: int) -> Interior:
     rt = ReferenceRT.build(mesh, k, intorder)
     X, W = rt.quadrature
     dg = scalar_values(ELEMENTS[k](), X)
-    mass, divergence, symmetry = element_matrices(mesh, k, X, W, dg,
-                                                  scalar_values(SCALARS[k - 1](), X))
+    mass, divergence = element_matrices(mesh, k, X, W, dg)
     stress = sigma_h(rt)
     rhs, data = patch_rhs(mesh, k, X, W, dg, stress, barycentric_gradients(mesh)[0])
     if body_force is not None:
         data = data - load_moments(mesh, body_force, k)
     total = np.array([np.bincount(mesh.t.T.ravel(), data[:, :, r].sum(axis=-1).ravel(),
                                   minlength=mesh.p.shape[1]) for r in (0, 1)]).T
-    return Interior(rt=rt, sigma_h=stress, mass=mass, divergence=divergence,
-                    symmetry=symmetry, rhs=rhs, data=data, total=total, k=k, intorder=intorder)
+    return Interior(rt=rt, sigma_h=stress, mass=mass, divergence=divergence, rhs=rhs,
+                    data=data, total=total, k=k, intorder=intorder)
 
 
 def load_moments(mesh, body_force, k: int) -> np.ndarray:
@@ -98,28 +96,3 @@ def _hat_moments(k: int) -> np.ndarray:
     X, W = get_quadrature(RefTri, k + 1)
     q, hats = scalar_values(ELEMENTS[k](), X), scalar_values(ElementTriP1(), X)
     return np.einsum("ap,lp,p->al", hats, q, W) / W.sum()
-
-
-def skew_data(interior: Interior, data: np.ndarray, turning: np.ndarray,
-              clamped: np.ndarray) -> np.ndarray:
-    """The right-hand side (P, n_sym) of the weak symmetry constraint: the rotation moment
-    R_a = (data, r_a) - int psi_a t . r_a of each patch off Gamma_D (r_a the rotation about a;
-    zero when u_h balances psi_a r_a, which V_h contains from k = 2), spread over the patch's
-    elements by their share of int psi_a (docs/theory.md, 13.2). Its integral over the patch is
-    then R_a, which makes the patch problem solvable."""
-    mesh, k = interior.rt.mesh, interior.k
-    n_v = mesh.p.shape[1]
-    bary = np.column_stack([1 - ELEMENTS[k]().doflocs.sum(axis=1), ELEMENTS[k]().doflocs])
-    nodes = np.einsum("li,cie->ecl", bary, mesh.p[:, mesh.t])          # (n_el, 2, n_dg)
-    vertex = mesh.p[:, mesh.t.T.ravel()].T                             # (P, 2)
-    arm = np.repeat(nodes, 3, axis=0) - vertex[:, :, None]             # (P, 2, n_dg)
-    moment = (data[:, 1] * arm[:, 0] - data[:, 0] * arm[:, 1]).sum(axis=-1)
-    rotation = np.bincount(mesh.t.T.ravel(), moment, minlength=n_v) - turning
-    rotation[clamped] = 0.0
-    area = element_areas(mesh)
-    weight = np.bincount(mesh.t.ravel(), np.tile(area / 3, 3), minlength=n_v)
-    share = np.repeat(area / 3, 3) / weight[mesh.t.T.ravel()]
-    X, W = get_quadrature(RefTri, k)
-    mean = scalar_values(SCALARS[k - 1](), X) @ W / W.sum()
-    return (rotation[mesh.t.T.ravel()] * share)[:, None] * mean[None, :]
-

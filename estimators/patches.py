@@ -1,11 +1,11 @@
 """Vertex-patch saddle-point problems solved in batches (docs/theory.md, section 13.2).
 
-Every (element, local vertex) pair contributes its element's RT mass, divergence and symmetry
-matrices to the patch of that vertex. A patch's unknowns are, for both rows of the stress, the
-RT DOFs of its elements that are neither on the facets opposite its vertex (zero flux) nor
-prescribed (Neumann and contact data); then per element the P_k DG multipliers of the two
-divergence constraints and the P_(k-1) multipliers of the weak symmetry constraint. Patches of
-the same system size are stacked and solved by one batched dense LU.
+Every (element, local vertex) pair contributes its element's RT mass and divergence matrices
+to the patch of that vertex. A patch's unknowns are the RT DOFs of its elements that are
+neither on the facets opposite its vertex (zero flux) nor prescribed (Neumann and contact
+data), then per element the P_k DG multipliers of the divergence constraint; the two rows of
+the stress share the matrix and are its two right-hand sides. Patches of the same system size
+are stacked and solved by one batched dense LU.
 """
 
 from __future__ import annotations
@@ -79,96 +79,72 @@ def layout(patch: np.ndarray, dofs: np.ndarray, status: np.ndarray, holder: np.n
 
 @dataclass(frozen=True, eq=False)
 class PairMatrices:
-    """Per element (pair p belongs to element p // 3): ``mass`` (n_el, n_rt, n_rt),
-    ``divergence`` (n_el, n_dg, n_rt), ``symmetry`` (n_el, n_sym, 2, n_rt) (row r's share of
-    (sigma_12 - sigma_21, gamma)); per pair: ``rhs`` (P, n_rt, 2), ``data`` (P, n_dg, 2),
-    ``skew`` (P, n_sym) and the prescribed values ``fixed`` (P, n_rt, 2) (zero where not
-    FIXED)."""
+    """Per element (pair p belongs to element p // 3): ``mass`` (n_el, n_rt, n_rt) and
+    ``divergence`` (n_el, n_dg, n_rt); per pair: ``rhs`` (P, n_rt, 2), ``data`` (P, n_dg, 2)
+    and the prescribed values ``fixed`` (P, n_rt, 2) (zero where not FIXED)."""
 
     mass: np.ndarray
     divergence: np.ndarray
-    symmetry: np.ndarray
     rhs: np.ndarray
     data: np.ndarray
-    skew: np.ndarray
     fixed: np.ndarray
 
 
 def solve_patches(lay: PatchLayout, pairs: PairMatrices, clamped: np.ndarray) -> np.ndarray:
     """The FREE unknowns (n_keys, 2) of every patch problem
 
-        [M  0  B' 0  S0'] [x0]   [rhs0 ]
-        [0  M  0  B' S1'] [x1]   [rhs1 ]
-        [B  0  0  0  0  ] [y0] = [data0]   (minus the prescribed DOFs' share)
-        [0  B  0  0  0  ] [y1]   [data1]
-        [S0 S1 0  0  0  ] [z ]   [skew ]
+        [M  B'] [x]   [rhs ]
+        [B  0 ] [y] = [data]   (minus the prescribed DOFs' share),
 
-    Without symmetry constraints (n_sym = 0) the rows decouple: one system per patch with the
-    two rows as right-hand sides. Off Gamma_D (``clamped`` False) the first multiplier of each
-    constraint is dropped: the data balance, so its equation follows from the others
-    (docs/theory.md, 13.2)."""
-    rhs, data, skew = pairs.rhs.copy(), pairs.data.copy(), pairs.skew.copy()
+    one system per patch with the two rows of the stress as right-hand sides. Off Gamma_D
+    (``clamped`` False) the first multiplier is dropped: the data balance, so its equation
+    follows from the others (docs/theory.md, 13.2)."""
+    rhs, data = pairs.rhs.copy(), pairs.data.copy()
     touched = np.flatnonzero((lay.status == FIXED).any(axis=1))  # pairs on Gamma_N, Gamma_C
     fixed, element = pairs.fixed[touched], touched // 3
     rhs[touched] -= np.matmul(pairs.mass[element], fixed)
     data[touched] -= np.matmul(pairs.divergence[element], fixed)
-    skew[touched] -= np.einsum("pgrl,plr->pg", pairs.symmetry[element], fixed)
-    n_dg, n_sym = pairs.divergence.shape[1], pairs.symmetry.shape[1]
-    blocks = 2 if n_sym else 1
-    size = blocks * lay.n_free + lay.count * (blocks * n_dg + n_sym)
+    size = lay.n_free + lay.count * pairs.divergence.shape[1]
     out = np.zeros((lay.key_dof.size, 2))
     jobs = [(chunk, int(n)) for n in np.unique(size)
             for chunk in np.array_split(np.flatnonzero(size == n),
                                         max(1, -(-(size == n).sum() // BATCH)))]
     with ThreadPoolExecutor(max_workers=worker_count()) as pool:
         list(pool.map(lambda job: _solve_chunk(lay, job[0], job[1], pairs,
-                                               (rhs, data, skew), clamped, out), jobs))
+                                               (rhs, data), clamped, out), jobs))
     return out
 
 
 def _solve_chunk(lay, chunk, n, pairs, right, clamped, out) -> None:
-    rhs, data, skew = right
+    rhs, data = right
     position = np.full(lay.n_free.size, -1)
     position[chunk] = np.arange(chunk.size)
     sel = np.flatnonzero(position[lay.patch] >= 0)
     g = position[lay.patch[sel]]
-    nf, count = lay.n_free[lay.patch[sel]], lay.count[lay.patch[sel]]
-    n_dg, n_sym = pairs.divergence.shape[1], pairs.symmetry.shape[1]
-    blocks, columns = (2, 1) if n_sym else (1, 2)
+    nf = lay.n_free[lay.patch[sel]]
+    n_dg = pairs.divergence.shape[1]
     free = lay.status[sel] == FREE
-    loc = [lay.local[sel] + r * nf[:, None] for r in range(blocks)]
-    div_at = [blocks * nf + r * count * n_dg + lay.rank[sel] * n_dg for r in range(blocks)]
-    sym_at = blocks * nf + blocks * count * n_dg + lay.rank[sel] * n_sym
-    entries = _Entries(chunk.size, n, columns)
-    both = free[:, :, None] & free[:, None, :]
+    loc = lay.local[sel]
+    div_at = nf + lay.rank[sel] * n_dg
+    entries = _Entries(chunk.size, n, 2)
     element = sel // 3
-    for r in range(blocks):
-        entries.matrix(g, loc[r][:, :, None], loc[r][:, None, :], pairs.mass[element], both)
-        _constraint(entries, g, div_at[r], loc[r], free, pairs.divergence[element])
-        if n_sym:
-            _constraint(entries, g, sym_at, loc[r], free, pairs.symmetry[element][:, :, r])
-    rows = [div_at[r][:, None] + np.arange(n_dg) for r in range(blocks)]
+    entries.matrix(g, loc[:, :, None], loc[:, None, :], pairs.mass[element],
+                   free[:, :, None] & free[:, None, :])
+    _constraint(entries, g, div_at, loc, free, pairs.divergence[element])
+    rows = div_at[:, None] + np.arange(n_dg)
     for r in (0, 1):
-        block, column = (r, 0) if n_sym else (0, r)
-        entries.vector(g, loc[block], rhs[sel][..., r], free, column)
-        entries.vector(g, rows[block], data[sel][..., r], np.ones(rows[block].shape, bool),
-                       column)
-    if n_sym:
-        sym_rows = sym_at[:, None] + np.arange(n_sym)
-        entries.vector(g, sym_rows, skew[sel], np.ones(sym_rows.shape, bool), 0)
+        entries.vector(g, loc, rhs[sel][..., r], free, r)
+        entries.vector(g, rows, data[sel][..., r], np.ones(rows.shape, bool), r)
     A, b = entries.assembled()
     neumann = (lay.rank[sel] == 0) & ~clamped[lay.patch[sel]]
-    for dropped in div_at + ([sym_at] if n_sym else []):
-        k, d = g[neumann], dropped[neumann]
-        A[k, d, :] = 0.0
-        A[k, :, d] = 0.0
-        A[k, d, d] = 1.0
-        b[k, d] = 0.0
+    k, d = g[neumann], div_at[neumann]
+    A[k, d, :] = 0.0
+    A[k, :, d] = 0.0
+    A[k, d, d] = 1.0
+    b[k, d] = 0.0
     x = np.linalg.solve(A, b)
-    keys = lay.key_of[sel][free]
     gf = np.broadcast_to(g[:, None], free.shape)[free]
-    out[keys] = (np.stack([x[gf, loc[0][free], 0], x[gf, loc[1][free], 0]], axis=1) if n_sym
-                 else x[gf, loc[0][free]])
+    out[lay.key_of[sel][free]] = x[gf, loc[free]]
 
 
 class _Entries:

@@ -8,7 +8,6 @@ problems is then a small reference tensor, computed once, contracted with J per 
 
     (phi_j, phi_l)_T         = o_j o_l / |det J| sum_cd (J'J)_cd  int^ phi^_jc phi^_ld,
     (div phi_j, q_l)_T       = o_j int^ div^ phi^_j q^_l,
-    (phi_j . e_i, gamma_g)_T = o_j sum_c J_ic int^ phi^_jc gamma^_g,
     (phi_j, psi_a sigma_r)_T = o_j sum_c int^ phi^_jc psi^_a (J' sigma_r)_c,
 
 with sigma_h sampled at the reference quadrature points, so that the last is one matrix
@@ -90,11 +89,9 @@ def orientations(mesh, n_rt: int, k: int) -> np.ndarray:
     return signs
 
 
-def element_matrices(mesh, k: int, X: np.ndarray, W: np.ndarray, dg: np.ndarray,
-                     rotation: np.ndarray):
-    """The RT_k mass (n_el, n_rt, n_rt), divergence (n_el, n_dg, n_rt) and symmetry
-    (n_el, n_sym, 2, n_rt) matrices (row r's share of (sigma_12 - sigma_21, gamma)) for the
-    reference bases ``dg`` (n_dg, nq) and ``rotation`` (n_sym, nq) at the rule (X, W)."""
+def element_matrices(mesh, k: int, X: np.ndarray, W: np.ndarray, dg: np.ndarray):
+    """The RT_k mass (n_el, n_rt, n_rt) and divergence (n_el, n_dg, n_rt) matrices for the
+    reference basis ``dg`` (n_dg, nq) at the rule (X, W)."""
     mapping = mesh.mapping()
     J, det = mapping.A, np.abs(mapping.detA)                           # (2, 2, n_el), (n_el,)
     phi, div = reference_rt(k, X)
@@ -106,10 +103,7 @@ def element_matrices(mesh, k: int, X: np.ndarray, W: np.ndarray, dg: np.ndarray,
     mass /= det[:, None, None]
     mass *= o[:, :, None] * o[:, None, :]
     divergence = np.einsum("jp,lp,p->lj", div, dg, W)[None] * o[:, None, :]
-    moments = np.einsum("jcp,gp,p->gcj", phi, rotation, W)             # int^ phi^_jc gamma^_g
-    along = np.einsum("ice,gcj->eigj", J, moments) * o[:, None, None, :]   # component i
-    symmetry = np.stack([along[:, 1], -along[:, 0]], axis=2)
-    return mass, divergence, symmetry
+    return mass, divergence
 
 
 def patch_rhs(mesh, k: int, X: np.ndarray, W: np.ndarray, dg: np.ndarray,
@@ -117,17 +111,26 @@ def patch_rhs(mesh, k: int, X: np.ndarray, W: np.ndarray, dg: np.ndarray,
     """r = (phi_j, psi_a sigma_h row r) (n_el, 3, 2, n_rt) and c = (sigma_h grad psi_a, q_l)
     (n_el, 3, 2, n_dg) for sigma_h (2, 2, n_el, nq) at the reference points X and the
     barycentric gradients (3, 2, n_el)."""
-    mapping = mesh.mapping()
-    J, det = mapping.A, np.abs(mapping.detA)
-    phi, _ = reference_rt(k, X)
-    n_rt, n_el = phi.shape[0], mesh.t.shape[1]
-    hats = scalar_values(ElementTriP1(), X)                            # (3, nq)
-    o = orientations(mesh, n_rt, k)
-    pulled = np.einsum("kce,rkep->ercp", J, sigma_h).reshape(n_el * 2, -1)   # J' sigma row
-    weighted = np.einsum("jcp,ap,p->cpaj", phi, hats, W).reshape(pulled.shape[1], -1)
-    rhs = (pulled @ weighted).reshape(n_el, 2, 3, n_rt).transpose(0, 2, 1, 3) * o[:, None, None]
+    n_el = mesh.t.shape[1]
+    rhs = rt_moments(mesh, k, X, W, sigma_h, scalar_values(ElementTriP1(), X))
     samples = sigma_h.transpose(2, 0, 1, 3).reshape(n_el * 4, -1)     # (e r k, p)
     tested = (samples @ (dg * W).T).reshape(n_el, 2, 2, -1)           # e r k l
+    det = np.abs(mesh.mapping().detA)
     data = np.einsum("ake,erkl->earl", hat_gradients, tested) * det[:, None, None, None]
     return rhs, data
+
+
+def rt_moments(mesh, k: int, X: np.ndarray, W: np.ndarray, fields: np.ndarray,
+               weights: np.ndarray) -> np.ndarray:
+    """(phi_j, w_a f_r)_T (n_el, n_w, 2, n_rt) for fields f (2, 2, n_el, nq), row r, at the
+    reference points X and reference weights w (n_w, nq): one matrix product of J' f_r with
+    a reference tensor."""
+    J = mesh.mapping().A
+    phi, _ = reference_rt(k, X)
+    n_rt, n_el, n_w = phi.shape[0], mesh.t.shape[1], weights.shape[0]
+    o = orientations(mesh, n_rt, k)
+    pulled = np.einsum("kce,rkep->ercp", J, fields).reshape(n_el * 2, -1)     # J' f row
+    weighted = np.einsum("jcp,ap,p->cpaj", phi, weights, W).reshape(pulled.shape[1], -1)
+    return ((pulled @ weighted).reshape(n_el, 2, n_w, n_rt).transpose(0, 2, 1, 3)
+            * o[:, None, None])
 
