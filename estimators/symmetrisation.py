@@ -33,8 +33,8 @@ from estimators.rt_reference import ReferenceRT, rt_moments
 # at P1, where S + C_K K is flat within 0.5 % for w / C_K^2 from 10 to 100.
 WEIGHT = 20.0
 # Every phi keeps the bound, so the minimisation need not be exact: at RTOL the objective is
-# within 0.5 % of its least value (measured on `paper`, P1, 1.3e5 .. 2.1e6 unknowns, 29 .. 40
-# iterations, independent of h; a direct solve of 2.1e6 took 16 s, these 3 s).
+# within 0.5 % of its least value (measured on `paper`, P1, 1.3e5 .. 2.1e6 unknowns, 21 .. 28
+# iterations, independent of h; a direct solve of 2.1e6 took 16 s, these about 3 s).
 RTOL = 1e-2
 MAX_ITERATIONS = 500
 _ROTATE = np.array([[0.0, 1.0], [-1.0, 0.0]])  # curl phi = _ROTATE grad phi
