@@ -37,6 +37,16 @@ def square_scene(gap, *, young_modulus=1000.0, poisson_ratio=0.0, divisions=4,
 
 
 @pytest.fixture
+def skewed_mesh() -> MeshTri:
+    """A locally refined, sheared mesh: every orientation and shape of element occurs."""
+    mesh = MeshTri.init_symmetric().refined(2)
+    mesh = mesh.refined(np.arange(5))
+    p = mesh.p.copy()
+    p[0] += 0.3 * p[1] ** 2
+    return MeshTri(p, mesh.t)
+
+
+@pytest.fixture
 def compression_scene():
     """A rigid flat pushes the bottom up by delta = 0.01 (g = -delta), nu = 0.
 
