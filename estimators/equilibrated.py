@@ -75,7 +75,8 @@ def friction_terms(friction, trace_constant: float) -> dict[str, float]:
 
 
 @register_estimator("equilibrated", "guaranteed upper bound: equilibrated RT stress on vertex "
-                                    "patches (Prager-Synge) plus Theorem 1's contact terms, "
+                                    "patches, symmetrised by the curl of a stream function "
+                                    "(Prager-Synge), plus Theorem 1's contact terms, "
                                     "every constant computed; Tresca friction's terms too",
                     guaranteed=True, applies=tresca_only, friction=True)
 def estimate(scene, solution: DiscreteSolution) -> Estimate:
