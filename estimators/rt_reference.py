@@ -133,4 +133,3 @@ def rt_moments(mesh, k: int, X: np.ndarray, W: np.ndarray, fields: np.ndarray,
     weighted = np.einsum("jcp,ap,p->cpaj", phi, weights, W).reshape(pulled.shape[1], -1)
     return ((pulled @ weighted).reshape(n_el, 2, n_w, n_rt).transpose(0, 2, 1, 3)
             * o[:, None, None])
-
