@@ -9,10 +9,11 @@ and Theorem 1 of the seed paper with every constant computed (docs/theory.md, se
 
 with u_0 the solution of the auxiliary problem (4) with contact traction lambda*, sigma* its
 equilibrated stress and rho the load that balances the patches u_h does not balance exactly
-(``estimators.equilibration``), d an extension of (g - u_hn)_- (``estimators.guaranteed_
-contact``), osc the data oscillation (Payne-Weinberger's 1/pi and a trace constant derived in
-13.3), C_G = (1/(2 mu) + C_K^2)^(1/2), and C_K, C_T, C_F the domain constants
-(``estimators.constants``). eta_0 reports A, eta_geometric D and eta_complementarity sqrt(B).
+(``estimators.equilibration``), d an extension of (g - u_hn)_- (``estimators.contact_
+extension``; of two, the one with the smaller eta), osc the data oscillation (Payne-
+Weinberger's 1/pi and a trace constant derived in 13.3), C_G = (1/(2 mu) + C_K^2)^(1/2), and
+C_K, C_T, C_F the domain constants (``estimators.constants``). eta_0 reports A, eta_geometric
+D and eta_complementarity sqrt(B).
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ from skfem import Basis, ElementDG, FacetBasis
 from estimators.averaging import compliance_energy, element_areas
 from estimators.base import BoundTerms, Estimate, planar_only, register_estimator
 from estimators.constants import domain_constants
+from estimators.contact_extension import EXTENSIONS
 from estimators.equilibration import (
     BoundaryData,
     boundary_balance,
@@ -35,11 +37,11 @@ from estimators.guaranteed_contact import (
     FacetPolynomial,
     balanced_traction,
     contact_bound,
-    extension,
     projected_pressure,
     traction_at,
 )
 from estimators.guaranteed_friction import balanced_shear, friction_bound, raw_shear, shear_at
+from estimators.nonnegative_traction import nonnegative_pressure
 from estimators.patch_data import interior_data, rebalanced
 from estimators.residual import stress_tensor
 from estimators.symmetrisation import symmetrised
@@ -80,9 +82,7 @@ def friction_terms(friction, trace_constant: float) -> dict[str, float]:
                                     "every constant computed; Tresca friction's terms too",
                     guaranteed=True, applies=tresca_only, friction=True)
 def estimate(scene, solution: DiscreteSolution) -> Estimate:
-    rec, interior, load, bound, boundary, clamped, shear = equilibrate(scene, solution)
-    friction = (None if shear is None else
-                friction_bound(scene, solution, shear, extension(scene, solution, clamped)))
+    rec, interior, load, bounds, boundary, _, shear = equilibrate(scene, solution)
     lam, mu = solution.elasticity.lame
     constants = domain_constants(scene)
     diff = rec.values - interior.sigma_h
@@ -91,11 +91,22 @@ def estimate(scene, solution: DiscreteSolution) -> Estimate:
     skew = ((rec.values[0, 1] - rec.values[1, 0]) ** 2 / 2 * rec.basis.dx).sum(axis=1)
     osc = oscillation(scene, rec.basis, boundary)
     grad_constant = np.sqrt(1 / (2 * mu) + constants.korn**2)
-    terms = BoundTerms(symmetric=np.sqrt(compliance.sum()),
-                       skew=constants.korn * np.sqrt(skew.sum()),
-                       oscillation=grad_constant * np.sqrt((osc**2).sum()),
-                       load=constants.friedrichs * np.sqrt(load.sum()),
-                       negative_traction=constants.trace * bound.negative,
+    volume = (np.sqrt(compliance) + constants.korn * np.sqrt(skew) + grad_constant * osc
+              + constants.friedrichs * np.sqrt(load)) ** 2
+    parts = dict(symmetric=np.sqrt(compliance.sum()), skew=constants.korn * np.sqrt(skew.sum()),
+                 oscillation=grad_constant * np.sqrt((osc**2).sum()),
+                 load=constants.friedrichs * np.sqrt(load.sum()))
+    # every extension d gives a bound (13.3): the smallest is kept
+    return min((_combined(scene, solution, parts, volume, bound, shear) for bound in bounds),
+               key=lambda est: est.eta)
+
+
+def _combined(scene, solution, parts: dict, volume: np.ndarray, bound, shear) -> Estimate:
+    """eta of 13.1 from the parts of A (``BoundTerms``' volume fields), the contact terms of
+    one extension (``bound``) and, under friction, those of sigma*_t (17.5)."""
+    constants = domain_constants(scene)
+    friction = None if shear is None else friction_bound(scene, solution, shear, bound.field)
+    terms = BoundTerms(**parts, negative_traction=constants.trace * bound.negative,
                        **friction_terms(friction, constants.trace))
     A = terms.symmetric + terms.skew + terms.oscillation + terms.load
     a = A + bound.extension + terms.negative_traction + terms.excess_shear
@@ -103,23 +114,34 @@ def estimate(scene, solution: DiscreteSolution) -> Estimate:
     b = max(A * bound.extension + bound.complementarity
             + (friction.complementarity if friction else 0.0), 0.0)
     eta = 0.5 * (a + np.sqrt(a * a + 4 * b))
-    local = (np.sqrt(compliance) + constants.korn * np.sqrt(skew) + grad_constant * osc
-             + constants.friedrichs * np.sqrt(load)) ** 2 + bound.per_element
-    if friction is not None:
-        local = local + friction.per_element
-    if local.sum() > 0:  # marking shares, scaled to sum to eta^2
-        local = local * eta**2 / local.sum()
+    local = marking_shares(eta, A, volume, terms, bound, friction)
     return Estimate(estimator="equilibrated", eta=float(eta), eta_0=float(A),
                     eta_geometric=bound.extension,
                     eta_complementarity=float(np.sqrt(bound.complementarity)), indicators=local,
                     guaranteed=True, bound=terms)
 
 
+def marking_shares(eta: float, A: float, volume: np.ndarray, terms: BoundTerms,
+                   bound: ContactBound, friction) -> np.ndarray:
+    """eta^2 per element for marking. With a and b as in 13.1, eta^2 = a eta + b splits into
+    A eta + D (eta + A) + N eta + B (+ N_t eta + B_t under friction); each part is spread over
+    the elements like its own square (``volume`` ~ A_T^2, a(d, d)_T, ||lambda*_-||^2 and the
+    slack of B on the element's contact facets), so a term weighs in marking as in eta."""
+    parts = [(A * eta, volume), (bound.extension * (eta + A), bound.energy),
+             (terms.negative_traction * eta, bound.negative_squares),
+             (bound.complementarity, bound.slack)]
+    if friction is not None:
+        parts.append((terms.excess_shear * eta + max(friction.complementarity, 0.0),
+                      friction.per_element))
+    local = sum(total * spread / spread.sum() for total, spread in parts if spread.sum() > 0)
+    return np.zeros_like(volume) + local
+
+
 def equilibrate(scene, solution: DiscreteSolution):
     """sigma* (a ``Reconstruction``, symmetrised by ``estimators.symmetrisation``), the patch
-    data, ||rho||_T^2, the contact terms of lambda* (a ``ContactBound``), the Neumann data of
-    the auxiliary problem, the clamped vertices and sigma*_t (None without friction)
-    (docs/theory.md, 13.2, 13.3 and 17.5)."""
+    data, ||rho||_T^2, the contact terms of lambda* (a ``ContactBound`` per extension), the
+    Neumann data of the auxiliary problem, the clamped vertices and sigma*_t (None without
+    friction) (docs/theory.md, 13.2, 13.3 and 17.5)."""
     elasticity = solution.elasticity
     mesh, order = elasticity.mesh, elasticity.order
     lam, mu = elasticity.lame
@@ -139,7 +161,7 @@ def equilibrate(scene, solution: DiscreteSolution):
     shear = None
     sheared = [] if solution.friction is None else [
         BoundaryData(trace.facets, lambda x: shear_at(trace, raw_shear(solution), x))]
-    lam_star, bound = contact_traction(  # the normal balance net of sigma_t,h's own
+    lam_star, bounds = contact_traction(  # the normal balance net of sigma_t,h's own
         scene, solution, interior,
         reaction - boundary_balance(n_v, boundary_fluxes(interior, sheared)), clamped)
     normal = BoundaryData(trace.facets, lambda x: traction_at(trace, lam_star, x))
@@ -159,30 +181,43 @@ def equilibrate(scene, solution: DiscreteSolution):
                               f"{rec.imbalance:.1e} > {BALANCE_TOLERANCE:g}): no bound")
     prescribed = np.concatenate([part.facets for part in (neumann, contact)])
     rec = symmetrised(rec, interior, prescribed, (lam, mu), domain_constants(scene).korn)
-    return rec, interior, load, bound, [neumann, contact], clamped, shear
+    return rec, interior, load, bounds, [neumann, contact], clamped, shear
 
 
-def contact_traction(scene, solution, interior, reaction: np.ndarray,
-                     clamped: np.ndarray) -> tuple[ContactTraction, ContactBound]:
-    """lambda* (docs/theory.md, 13.3): of two tractions that balance u_h on the contact
-    patches, the one with the smaller contact terms C_T ||lambda*_-|| + sqrt(B) (no patch
-    problem is solved for either). (i) lambda_h projected onto P_k per facet plus the P1
-    correction of what u_h does not balance (the mixed method balances lambda_h exactly);
-    (ii) the correction alone, the L2 representative of u_h's discrete reaction on Gamma_C
-    (for the penalty and Nitsche on coarse contact zones, whose pressure formula peaks between
-    the Gauss points that their own equations see). Returns it with its ``ContactBound``."""
+def contact_traction(scene, solution, interior, reaction: np.ndarray, clamped: np.ndarray
+                     ) -> tuple[ContactTraction, tuple[ContactBound, ...]]:
+    """lambda* (docs/theory.md, 13.3): of three tractions that balance u_h on the contact
+    patches, the one with the smallest terms 2 D + C_T ||lambda*_-|| + sqrt(B) (over the
+    extensions d of ``estimators.contact_extension``; no patch problem is solved for any).
+    Each is a pressure, projected onto P_k per facet, plus the P1 correction of what u_h does
+    not balance with it: (i) lambda_h (the mixed method balances it exactly); (ii) zero, so the
+    correction is the L2 representative of u_h's discrete reaction on Gamma_C (for the penalty
+    and Nitsche on coarse contact zones, whose pressure formula peaks between the Gauss points
+    that their own equations see); (iii) a non-negative traction with the reaction's moments
+    where one exists (``estimators.nonnegative_traction``; the correction takes the round-off
+    of its least squares, or what no non-negative traction balances). Returns it with its
+    ``ContactBound`` for every extension."""
     trace, order = solution.trace, solution.elasticity.order
-    projected = projected_pressure(solution.pressure, order)
-    raw = BoundaryData(trace.facets, lambda x: traction_at(trace, projected, x))
-    defect = reaction - boundary_balance(reaction.shape[0], boundary_fluxes(interior, [raw]))
-    zero = FacetPolynomial(np.zeros((trace.facets.size, order + 1)))
-    candidates = [balanced_traction(trace, projected, defect, clamped),
-                  balanced_traction(trace, zero, reaction, clamped)]
+    pressures = [projected_pressure(solution.pressure, order),
+                 FacetPolynomial(np.zeros((trace.facets.size, order + 1))),
+                 nonnegative_pressure(trace, reaction, clamped, order)]
+    candidates = [balanced_traction(trace, pressure,
+                                    reaction - _balance(interior, trace, pressure), clamped)
+                  for pressure in pressures]
     trace_constant = domain_constants(scene).trace
-    bounds = [contact_bound(scene, solution, traction, clamped) for traction in candidates]
-    terms = [trace_constant * b.negative + np.sqrt(b.complementarity) for b in bounds]
+    fields = [extend(scene, solution, clamped) for extend in EXTENSIONS]
+    bounds = [tuple(contact_bound(scene, solution, traction, d) for d in fields)
+              for traction in candidates]
+    terms = [min(2 * b.extension + trace_constant * b.negative + np.sqrt(b.complementarity)
+                 for b in options) for options in bounds]
     best = int(np.argmin(terms))
     return candidates[best], bounds[best]
+
+
+def _balance(interior, trace, pressure) -> np.ndarray:
+    """int psi_a (-pressure n) over Gamma_C per vertex, (n_vertices, 2)."""
+    part = BoundaryData(trace.facets, lambda x: traction_at(trace, pressure, x))
+    return boundary_balance(interior.total.shape[0], boundary_fluxes(interior, [part]))
 
 
 def oscillation(scene, rt: Basis, boundary: list[BoundaryData]) -> np.ndarray:

@@ -4,9 +4,9 @@
 lambda* is the formulation's pressure lambda_h plus a continuous piecewise linear correction
 delta on Gamma_C chosen so that u_h balances the hat functions psi_a e_i of every vertex off
 Gamma_D for the auxiliary problem with traction -lambda* n (exactly zero for the mixed method up
-to its solver's tolerance; the quadrature and nodal reactions of penalty and vi). The extension
-d = sum_a c_a psi_a nu_a of w = (g - u_hn)_- has d . n <= w on every contact facet, so its
-energy bounds the dual-type norm of Theorem 1 from above.
+to its solver's tolerance; the quadrature and nodal reactions of penalty and vi). With an
+extension d of w = (g - u_hn)_- (``estimators.contact_extension``), ``contact_bound`` gives
+the contact terms D, ||lambda*_-|| and B.
 """
 
 from __future__ import annotations
@@ -17,11 +17,9 @@ import numpy as np
 from scipy import sparse
 from scipy.sparse.linalg import spsolve
 
-from estimators.averaging import element_areas
+from estimators.contact_extension import Extension, discrete_gap, vertex_normals
 from formulations.contact import gauss_legendre
-from formulations.p1_stiffness import barycentric_gradients
 
-SAMPLES = 33        # points per contact facet at which w is sampled for min_e w (ends included)
 QUADRATURE = 10     # Gauss points per contact facet for the kinked integrands
 
 
@@ -108,74 +106,29 @@ def balanced_traction(trace, pressure, defect: np.ndarray, clamped: np.ndarray,
     return ContactTraction(pressure=pressure, delta=np.array([delta[start], delta[end]]))
 
 
-def vertex_normals(trace) -> np.ndarray:
-    """Length-weighted mean outer normals at the contact vertices, unit (2, n_vertices)."""
-    n_v = trace.mesh.p.shape[1]
-    nu = np.zeros((2, n_v))
-    for v in trace.vertices:
-        for i in (0, 1):
-            nu[i] += np.bincount(v, trace.normal[i] * trace.length, minlength=n_v)
-    norm = np.linalg.norm(nu, axis=0)
-    return nu / np.where(norm > 0, norm, 1.0)
-
-
 @dataclass(frozen=True)
 class ContactBound:
     extension: float        # D = ||d||, d . n <= w on Gamma_C
     negative: float         # ||lambda*_-||_{0,Gamma_C}
     complementarity: float  # (lambda*_+, g - u_hn - d . n)_{Gamma_C} >= 0
-    per_element: np.ndarray  # shares of D^2 + complementarity per element
+    energy: np.ndarray      # a(d, d) per element
+    negative_squares: np.ndarray  # ||lambda*_-||^2 over each element's contact facets
+    slack: np.ndarray       # |(lambda*_+, g - u_hn - d . n)| over each element's contact facets
+    field: Extension        # d itself
 
 
-def extension(scene, solution, clamped: np.ndarray) -> np.ndarray:
-    """d = sum_a c_a psi_a nu_a at the contact vertices, (2, n_vertices): the largest c_a <= 0
-    with d . n <= w = (g - u_hn)_- on every contact facet (module docstring)."""
+def contact_bound(scene, solution, traction: ContactTraction, d: Extension) -> ContactBound:
+    """D, ||lambda*_-|| and B of lambda* = ``traction`` with the extension ``d`` (13.1)."""
     trace = solution.trace
-    s = np.linspace(0.0, 1.0, SAMPLES)
-    x_gap = _gap_minus_displacement(scene, solution, s)                 # (n_f, SAMPLES)
-    w_min = np.minimum(x_gap, 0.0).min(axis=1)
-    nu = vertex_normals(trace)
-    c = np.zeros(trace.mesh.p.shape[1])
-    for v in trace.vertices:
-        ratio = w_min / np.einsum("if,if->f", nu[:, v], trace.normal)
-        np.minimum.at(c, v, ratio)
-    c[clamped] = 0.0
-    return c * nu
-
-
-def extension_along(trace, d: np.ndarray, direction: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """d . direction at local points t of every contact facet (direction (2, n_f)), linear
-    between the facet's vertices, (n_f, len(t))."""
-    start, end = (np.einsum("if,if->f", d[:, v], direction)[:, None] for v in trace.vertices)
-    return start * (1 - t) + end * t
-
-
-def contact_bound(scene, solution, traction: ContactTraction, clamped: np.ndarray) -> ContactBound:
-    trace = solution.trace
-    mesh = trace.mesh
-    d = extension(scene, solution, clamped)
-    energy = _p1_energy(mesh, d, solution.elasticity.lame)
+    energy = d.energy(trace, solution.elasticity.lame)
     t, w = gauss_legendre(QUADRATURE)
-    d_n = extension_along(trace, d, trace.normal, t)
+    d_n = d.along(trace, trace.normal, t)
     lam = traction(t)
-    slack = trace.integrate(np.maximum(lam, 0.0) * (_gap_minus_displacement(scene, solution, t)
-                                                    - d_n), w)
-    negative = float(np.sqrt(trace.integrate(np.minimum(lam, 0.0) ** 2, w).sum()))
-    per_element = energy + np.bincount(trace.element, np.abs(slack), mesh.t.shape[1])
-    return ContactBound(extension=float(np.sqrt(energy.sum())), negative=negative,
-                        complementarity=float(max(slack.sum(), 0.0)), per_element=per_element)
-
-
-def _gap_minus_displacement(scene, solution, t: np.ndarray) -> np.ndarray:
-    """g - u_hn at local points t of every contact facet, (n_f, len(t))."""
-    return scene.gap(solution.trace.points(t)) - solution.normal_displacement(t)
-
-
-def _p1_energy(mesh, nodal: np.ndarray, lame: tuple[float, float]) -> np.ndarray:
-    """a(d, d) per element for the P1 field with vertex values ``nodal`` (2, n_vertices)."""
-    lam, mu = lame
-    gradients = barycentric_gradients(mesh)[0]
-    grad = np.einsum("iae,ake->ike", nodal[:, mesh.t], gradients)  # du_i/dx_k
-    eps = 0.5 * (grad + grad.transpose(1, 0, 2))
-    density = 2 * mu * (eps**2).sum(axis=(0, 1)) + lam * (eps[0, 0] + eps[1, 1]) ** 2
-    return element_areas(mesh) * density
+    slack = trace.integrate(np.maximum(lam, 0.0) * (discrete_gap(scene, solution, t) - d_n), w)
+    negative = trace.integrate(np.minimum(lam, 0.0) ** 2, w)
+    n_el = trace.mesh.t.shape[1]
+    return ContactBound(extension=float(np.sqrt(energy.sum())),
+                        negative=float(np.sqrt(negative.sum())),
+                        complementarity=float(max(slack.sum(), 0.0)), energy=energy,
+                        negative_squares=np.bincount(trace.element, negative, n_el),
+                        slack=np.bincount(trace.element, np.abs(slack), n_el), field=d)

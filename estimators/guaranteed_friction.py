@@ -21,13 +21,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from estimators.contact_extension import Extension, vertex_normals
 from estimators.guaranteed_contact import (
     ContactTraction,
     balanced_traction,
-    extension_along,
     projected_pressure,
     traction_at,
-    vertex_normals,
 )
 from formulations.contact import gauss_legendre
 from formulations.evaluation import evaluate_on_trace
@@ -66,15 +65,15 @@ def shear_at(trace, shear: ContactTraction, x: np.ndarray) -> np.ndarray:
     return traction_at(trace, shear, x, direction=contact_tangent(trace))
 
 
-def friction_bound(scene, solution, shear: ContactTraction, d: np.ndarray) -> FrictionBound:
-    """N_t / C_T and B_t of the module docstring; ``d`` the extension's vertex vectors."""
+def friction_bound(scene, solution, shear: ContactTraction, d: Extension) -> FrictionBound:
+    """N_t / C_T and B_t of the module docstring; ``d`` the extension of the contact terms."""
     trace, law = solution.trace, scene.friction
     t, w = gauss_legendre(QUADRATURE)
     tangent = contact_tangent(trace)
     at = evaluate_on_trace(solution.elasticity.basis, trace, t)
     xi = (at.matrix(np.repeat(tangent, t.size, axis=1)) @ solution.u).reshape(
         trace.size, t.size) - law.slide
-    y = xi + extension_along(trace, d, tangent, t)
+    y = xi + d.along(trace, tangent, t)
     bound = law.slip_bound_at(trace.points(t)).reshape(trace.size, t.size)
     sigma = shear(t)
     excess = np.maximum(np.abs(sigma) - bound, 0.0)
