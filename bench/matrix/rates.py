@@ -5,6 +5,10 @@ The slope of log(y) against log(ndofs) is fitted by least squares (``np.polyfit`
 nothing touches on the first two). In 2D, O(h^1/2) is slope -1/4 and O(h) is slope -1/2.
 Effectivity statistics use the same levels and skip rows whose reference is too coarse;
 ``effectivity_all_min`` is the minimum over every level (for a guaranteed bound).
+``target_dofs_ratio`` prices ``--target-error`` against an oracle that knew the true error: for
+TOL = eta on each of those levels, the level's DOFs over the DOFs at which the error of the same
+sequence first falls to TOL (log-log interpolation between its judged levels); the largest
+(docs/guaranteed.md). Above 1 the bound asks for more DOFs than the error needs.
 """
 
 from __future__ import annotations
@@ -36,6 +40,26 @@ def judged_levels(rows: pd.DataFrame) -> pd.DataFrame:
     return ok[~ok["reference_too_coarse"].fillna(False).astype(bool)]
 
 
+def target_dofs_ratio(judged: pd.DataFrame, window: pd.DataFrame) -> float:
+    """The largest N_l / N_oracle(eta_l) over the levels l of ``window`` (module docstring);
+    NaN where the error of ``judged`` never falls to eta_l."""
+    judged = judged.sort_values("ndofs")
+    n, error = np.log(judged["ndofs"].to_numpy()), np.log(judged["energy_error"].to_numpy())
+    ratios = []
+    for _, level in window.iterrows():
+        below = np.flatnonzero(error <= np.log(level["eta"]))
+        if below.size == 0:
+            return float("nan")
+        first = below[0]
+        if first == 0:
+            crossing = n[0]
+        else:  # between the last level above TOL and the first one at or below it
+            share = (error[first - 1] - np.log(level["eta"])) / (error[first - 1] - error[first])
+            crossing = n[first - 1] + share * (n[first] - n[first - 1])
+        ratios.append(np.exp(np.log(level["ndofs"]) - crossing))
+    return float(max(ratios)) if ratios else float("nan")
+
+
 def rates_table(table: pd.DataFrame, levels: int = RATE_LEVELS) -> pd.DataFrame:
     rows = []
     table = with_labels(table[table["level"] >= 0])
@@ -62,6 +86,7 @@ def rates_table(table: pd.DataFrame, levels: int = RATE_LEVELS) -> pd.DataFrame:
             # over every judged level, not only the last ones: where a bound must hold
             "effectivity_all_min": float(judged["effectivity_index"].min()) if len(judged)
             else float("nan"),
+            "target_dofs_ratio": target_dofs_ratio(judged, usable),
             "too_coarse_rows": int(tail["reference_too_coarse"].astype(bool).sum()),
             "truth": str(group["truth"].iloc[-1]),
         })

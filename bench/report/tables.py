@@ -80,6 +80,10 @@ def effectivity_table(rates: pd.DataFrame) -> pd.DataFrame:
         "last": rates["effectivity_last"].map(_fmt), "min": rates["effectivity_min"].map(_fmt),
         "max": rates["effectivity_max"].map(_fmt),
         "max/min": rates["effectivity_variation"].map(_fmt),
+        # --target-error's DOFs over an oracle's (bench/matrix/rates.py); bounds only
+        "DOFs for eta vs error": [_fmt(r) if e in guaranteed_estimators() else "" for e, r in
+                                  zip(rates["estimator"], rates["target_dofs_ratio"],
+                                      strict=True)],
         "rows with too coarse reference": rates["too_coarse_rows"]}))
 
 
