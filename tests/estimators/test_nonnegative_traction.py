@@ -59,7 +59,7 @@ def test_the_bound_takes_it_where_the_reactions_representative_changes_sign(hert
     """hertz, vi, 16 770 DOFs: the L2 representative of the reactions had C_T ||lambda*_-||
     = 0.034 against A = 0.027; the non-negative traction leaves no negative part (round-off of
     its correction: relative 1e-5 allowed, 1.2e-6 measured) and a smaller bound (measured
-    0.0744 -> 0.0478)."""
+    0.0744 without this candidate, 0.0478 with it)."""
     scene, solution, _ = hertz_vi
     estimate = get_estimator("equilibrated")(scene, solution)
     assert estimate.bound.negative_traction <= 1e-5 * estimate.eta
