@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from estimators.averaging import element_areas
+from formulations.elasticity import stress_from_gradient
 from formulations.p1_stiffness import barycentric_gradients
 
 SAMPLES = 33  # points per contact facet at which d . n <= w is imposed (ends included)
@@ -61,10 +62,9 @@ class Extension:
 
 
 def _density(grad: np.ndarray, lame: tuple[float, float]) -> np.ndarray:
-    """2 mu |eps|^2 + lambda (tr eps)^2 for gradients (2, 2, ...)."""
-    lam, mu = lame
-    eps = 0.5 * (grad + grad.swapaxes(0, 1))
-    return 2 * mu * (eps**2).sum(axis=(0, 1)) + lam * (eps[0, 0] + eps[1, 1]) ** 2
+    """sigma : eps for gradients grad[i, j] = d d_i / d x_j, (2, 2, ...)."""
+    s11, s22, s12 = stress_from_gradient(grad, *lame)
+    return s11 * grad[0, 0] + s22 * grad[1, 1] + s12 * (grad[0, 1] + grad[1, 0])
 
 
 def discrete_gap(scene, solution, t: np.ndarray) -> np.ndarray:
