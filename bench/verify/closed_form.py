@@ -10,6 +10,7 @@ from bench.matrix.config import RunConfig
 from bench.matrix.config_files import run_fields
 from bench.matrix.spec import build_scene
 from bench.measure.contact import contact_zone
+from bench.measure.zone_edge import square_root_zone
 from bench.sequence.loop import run_sequence
 
 PEAK_SAMPLES = 8001  # points over +-4 half-widths where the computed peak pressure is sought
@@ -19,8 +20,9 @@ PEAK_GRID_3D = 201  # 3D: a grid of 201 x 201 points over +-2 contact radii
 def closed_form_table(run: dict) -> pd.DataFrame:
     """One row per sequence of ``run`` (the ``[closed_form]`` entry of expected.toml, a run
     file's keys: one per formulation and order): computed and predicted half-width (the contact
-    radius in 3D, that of the disc of the contact zone's area) and peak pressure, and their
-    relative errors, at the last level."""
+    radius in 3D, that of the disc of the contact zone's area), the same with the zone's edge
+    placed by the square-root law (``edge_half_width``, ``bench.measure.zone_edge``) and peak
+    pressure, and their relative errors, at the last level."""
     rows = []
     for spec in RunConfig(**run_fields(run, "[closed_form]")).specs():
         scene = build_scene(spec)
@@ -29,6 +31,8 @@ def closed_form_table(run: dict) -> pd.DataFrame:
         rows.append(_compare(scene, spec, result))
     table = pd.DataFrame(rows)
     table["half_width_error"] = table["half_width"] / table["predicted_half_width"] - 1
+    table["edge_half_width_error"] = (table["edge_half_width"] / table["predicted_half_width"]
+                                      - 1)
     table["peak_pressure_error"] = (table["peak_pressure"] / table["predicted_peak_pressure"]
                                     - 1)
     return table
@@ -40,6 +44,7 @@ def _compare(scene, spec, result) -> dict:
     force = sol.contact_force()
     predicted = scene.predict_contact(force)
     start, end = contact_zone(sol)
+    edge_start, edge_end = square_root_zone(sol)
     b = predicted.half_width
     s = np.linspace(predicted.centre - 4 * b, predicted.centre + 4 * b, PEAK_SAMPLES)
     if scene.dim == 3:  # a square grid over the disc's surroundings
@@ -48,5 +53,6 @@ def _compare(scene, spec, result) -> dict:
     return {"scene": scene.name, "formulation": spec.formulation, "order": spec.order,
             "dim": scene.dim, "ndofs": result.row.ndofs, "contact_force": force,
             "half_width": 0.5 * (end - start), "predicted_half_width": b,
+            "edge_half_width": 0.5 * (edge_end - edge_start),
             "peak_pressure": float(sol.pressure_at(s).max()),
             "predicted_peak_pressure": predicted.peak_pressure}
