@@ -41,6 +41,7 @@ from estimators.guaranteed_contact import (
     traction_at,
 )
 from estimators.guaranteed_friction import balanced_shear, friction_bound, raw_shear, shear_at
+from estimators.jump_equilibration import JumpOscillation, jump_oscillation
 from estimators.nonnegative_traction import nonnegative_pressure
 from estimators.patch_data import interior_data, rebalanced
 from estimators.residual import stress_tensor
@@ -89,12 +90,22 @@ def estimate(scene, solution: DiscreteSolution) -> Estimate:
     sym = np.array([diff[0, 0], diff[1, 1], 0.5 * (diff[0, 1] + diff[1, 0])])
     compliance = (compliance_energy(sym, lam, mu) * rec.basis.dx).sum(axis=1)
     skew = ((rec.values[0, 1] - rec.values[1, 0]) ** 2 / 2 * rec.basis.dx).sum(axis=1)
-    osc = oscillation(scene, rec.basis, boundary)
+    jump = jump_oscillation(rec.basis.mesh, scene.body_force, rec.basis.elem.k, (lam, mu),
+                            constants.korn)
+    osc = oscillation(scene, rec.basis, boundary, jump)
+    tau_sym, tau_skew = np.zeros_like(osc), np.zeros_like(osc)
+    if jump is not None:  # where f jumps: (r_2, v) through tau (13.2, "Where f jumps")
+        if jump.divergence_defect > BALANCE_TOLERANCE:
+            raise NotEquilibrated(f"div tau misses r_2 by {jump.divergence_defect:.1e} "
+                                  f"(relative) > {BALANCE_TOLERANCE:g}: no bound")
+        tau_sym[jump.elements] = np.sqrt(jump.symmetric)
+        tau_skew[jump.elements] = constants.korn * np.sqrt(jump.skew)
     grad_constant = np.sqrt(1 / (2 * mu) + constants.korn**2)
     volume = (np.sqrt(compliance) + constants.korn * np.sqrt(skew) + grad_constant * osc
-              + constants.friedrichs * np.sqrt(load)) ** 2
+              + tau_sym + tau_skew + constants.friedrichs * np.sqrt(load)) ** 2
     parts = dict(symmetric=np.sqrt(compliance.sum()), skew=constants.korn * np.sqrt(skew.sum()),
-                 oscillation=grad_constant * np.sqrt((osc**2).sum()),
+                 oscillation=(grad_constant * np.sqrt((osc**2).sum())
+                              + np.sqrt((tau_sym**2).sum()) + np.sqrt((tau_skew**2).sum())),
                  load=constants.friedrichs * np.sqrt(load.sum()))
     # every extension d gives a bound (13.3): the smallest is kept
     return min((_combined(scene, solution, parts, volume, bound, shear) for bound in bounds),
@@ -220,15 +231,19 @@ def _balance(interior, trace, pressure) -> np.ndarray:
     return boundary_balance(interior.total.shape[0], boundary_fluxes(interior, [part]))
 
 
-def oscillation(scene, rt: Basis, boundary: list[BoundaryData]) -> np.ndarray:
+def oscillation(scene, rt: Basis, boundary: list[BoundaryData],
+                jump: JumpOscillation | None = None) -> np.ndarray:
     """Per element, (h_T / pi) ||f - Pi_k f||_T + sum_e C_e ||t - Pi_k t||_e over its facets
-    with Neumann data, C_e^2 = |e| h_T^2 / |T| (1/pi^2 + 1/pi) (docs/theory.md, 13.3)."""
+    with Neumann data, C_e^2 = |e| h_T^2 / |T| (1/pi^2 + 1/pi) (docs/theory.md, 13.3); on the
+    elements of ``jump`` the sub-triangles' term of f instead (13.2, "Where f jumps")."""
     mesh, k = rt.mesh, rt.elem.k
     out = np.zeros(mesh.t.shape[1])
     if scene.body_force is not None:
         dg = Basis(mesh, ElementDG(ELEMENTS[k]()), quadrature=rt.quadrature)
         f = scene.body_force(np.asarray(rt.global_coordinates()))
         out += element_diameters(mesh) / np.pi * np.sqrt(_projection_error(dg, f))
+        if jump is not None:
+            out[jump.elements] = np.sqrt(jump.remainder)
     for part in boundary:
         if part.facets.size == 0:
             continue

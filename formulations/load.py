@@ -78,18 +78,21 @@ def physical(mapping, cells, X: np.ndarray) -> np.ndarray:
     return np.einsum("ijn,jnq->inq", A, X) + b[:, :, None]
 
 
-def refined_rule(body_force, basis: Basis):
+def refined_rule(body_force, basis: Basis, max_depth: int | None = None):
     """The rough elements, and the adaptive rule on them as a list of (cells, corners): the
     sub-triangles (corners in the reference coordinates of element ``cells[i]``) that keep the
-    element's rule (module docstring)."""
+    element's rule (module docstring), split at most ``max_depth`` times (default MAX_DEPTH,
+    MAX_DEPTH_3D on tetrahedra)."""
     mapping, rule = basis.mapping, basis.quadrature
     n, d = basis.mesh.t.shape[1], basis.mesh.dim()
+    if max_depth is None:
+        max_depth = MAX_DEPTH if d == 2 else MAX_DEPTH_3D
     k, volume = 2**d, 1.0 / (2 if d == 2 else 6)  # children per simplex; reference measure
     cells, corners = np.arange(n), np.broadcast_to(_REFERENCE[d], (n, d + 1, d))
     scale = np.abs(body_force(np.asarray(basis.global_coordinates()))).max()
     whole = integrals(body_force, mapping, cells, corners, rule)
     kept, rough = [], None
-    for depth in range((MAX_DEPTH if d == 2 else MAX_DEPTH_3D) + 1):
+    for depth in range(max_depth + 1):
         if cells.size == 0:
             break
         sub = children(corners)
@@ -99,7 +102,7 @@ def refined_rule(body_force, basis: Basis):
                  > ROUGH_TOLERANCE * scale * area)
         if depth == 0:
             rough = cells[split]
-        elif depth == (MAX_DEPTH if d == 2 else MAX_DEPTH_3D):
+        if depth == max_depth:
             split[:] = False
         kept.append((cells[~split], corners[~split]))
         cells = np.repeat(cells[split], k)
@@ -109,15 +112,16 @@ def refined_rule(body_force, basis: Basis):
     return rough, kept
 
 
-def body_load(body_force, basis: Basis) -> np.ndarray:
-    """(f, v) for every basis function, the rough elements on the refined rule."""
+def body_load(body_force, basis: Basis, max_depth: int | None = None) -> np.ndarray:
+    """(f, v) for every basis function, the rough elements on the refined rule (split at most
+    ``max_depth`` times, as in ``refined_rule``)."""
     @LinearForm
     def form(v, w):
         return dot(body_force(w.x), v)
 
     F = asm(form, basis)
-    rough, kept = refined_rule(body_force, basis)
-    if rough.size == 0:
+    rough, kept = refined_rule(body_force, basis, max_depth)
+    if rough.size == 0 or not kept:  # max_depth 0: every element keeps its own rule
         return F
     F -= asm(form, Basis(basis.mesh, basis.elem, quadrature=basis.quadrature, elements=rough))
     d = basis.mesh.dim()

@@ -19,9 +19,10 @@ def test_aligned_jump_lines_remove_the_oscillation_of_the_bound(align):
                             truth=truth_for(scene, None))
     row = last.row
     ratio = row.eta_oscillation / row.eta_symmetric
-    # measured at 1200 DOFs: 0.057 aligned (a smooth f's oscillation, falling like h^5), 7.98
-    # not aligned (the jump cuts a column of elements, whose f - Pi_3 f is O(1))
-    assert (ratio < 0.1) if align else (ratio > 1.0)
+    # measured at 1200 DOFs: 0.020 aligned (a smooth f's oscillation, falling like h^5), 1.14
+    # not aligned (the jump cuts a column of elements; equilibrated on their sub-triangles,
+    # 13.2, what is left is f - Pi_3 f on the sub-triangles it cuts; 7.98 before that)
+    assert (ratio < 0.1) if align else (ratio > 0.5)
     assert row.effectivity_index > 1.0
 
 

@@ -1,0 +1,209 @@
+"""The oscillation of a body force that jumps inside elements, equilibrated on sub-triangles
+(docs/theory.md, section 13.2, "Where f jumps").
+
+sigma* balances Pi_k f, the P_k projection of f per element, and the bound charges the rest,
+r = f - Pi_k f, through (r, v)_T <= (h_T / pi) ||r||_T ||grad v||_T. Where f jumps inside T,
+r is O(1) on all of T, and this Poincare bound is several times the true dual norm of r (r is
+orthogonal to P_k: it oscillates on T). On the elements where f is rough (those the load rule
+of ``formulations.load`` refines), each cut SUB_LEVELS times into 4^SUB_LEVELS sub-triangles S,
+
+    r = (f - Pi_S f) + (Pi_S f - Pi_k f) = r_1 + r_2,
+
+Pi_S the P_k projection per sub-triangle. r_2 is a piecewise polynomial with zero mean on
+every connected union of rough elements, so a tau in RT_k(S) with tau . n = 0 on the union's
+boundary and div tau = r_2 exists; of these the one of least L2 norm is computed (one sparse
+saddle-point solve, both rows at once). Then (r_2, v) = -(tau, grad v) <=
+||C^-1/2 sym tau|| a(v, v)^1/2 + ||skw tau|| ||skw grad v||, and r_1 is charged by the Poincare
+bound on the sub-triangles, (h_S / pi) ||r_1||_S: a jump now costs only on the sub-triangles
+it cuts, and at their size.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
+from scipy.sparse.linalg import splu
+from skfem import Basis, ElementDG, ElementVector, MeshTri
+from skfem.assembly import Dofs
+
+from estimators.averaging import compliance_energy
+from estimators.raviart_thomas import ElementTriRTk
+from estimators.rt_reference import (
+    ReferenceRT,
+    element_matrices,
+    orientations,
+    reference_rt,
+    scalar_values,
+)
+from formulations.elasticity import ELEMENTS, element_diameters
+from formulations.load import MAX_DEPTH, body_load, refined_rule
+
+SUB_LEVELS = 2  # each rough element in 16 sub-triangles
+SUB_ADAPTIVE = 0  # then refinements of the sub-triangles f is rough on
+# the load rule on the sub-triangles splits down to the size it reaches on the elements
+SUB_DEPTH = max(MAX_DEPTH - SUB_LEVELS - SUB_ADAPTIVE, 1)
+
+
+@dataclass(frozen=True, eq=False)
+class JumpOscillation:
+    """Per rough element (``elements``): ||C^-1/2 sym tau||_T^2, ||skw tau||_T^2 and the
+    sub-triangles' Poincare term sum_S ((h_S / pi) ||r_1||_S)^2; ``divergence_defect`` the
+    largest |div tau - r_2| moment relative to the largest r_2 moment (round-off)."""
+
+    elements: np.ndarray
+    symmetric: np.ndarray
+    skew: np.ndarray
+    remainder: np.ndarray
+    divergence_defect: float
+
+
+def rough_elements(mesh, body_force, k: int) -> np.ndarray:
+    """The elements on which the load rule refines (f jumps inside them)."""
+    if body_force is None:
+        return np.zeros(0, dtype=np.int64)
+    basis = Basis(mesh, ElementDG(ELEMENTS[k]()), intorder=2 * k)
+    return refined_rule(body_force, basis, max_depth=0)[0]
+
+
+def jump_oscillation(mesh, body_force, k: int, lame: tuple[float, float], korn: float
+                     ) -> JumpOscillation | None:
+    """The terms of the module docstring on the rough elements of ``mesh`` (None if f is
+    smooth on every element); ``korn`` C_K, the weight of the skew part."""
+    rough = rough_elements(mesh, body_force, k)
+    if rough.size == 0:
+        return None
+    sub, parent = sub_triangles(mesh, rough, body_force, k)
+    rt = ReferenceRT.build(sub, k, 2 * k + 2)
+    X, W = rt.quadrature
+    dg_ref = ELEMENTS[k]()
+    q = scalar_values(dg_ref, X)                             # (n_dg, nq)
+    _, divergence = element_matrices(sub, k, X, W, q)
+    r_2, sub_coefficients = _split_load(mesh, rough, sub, parent, body_force, k)
+    blocks = _energy_blocks(sub, k, X, W, stress_weight(lame, korn))
+    tau, defect = _least_tau(sub, rt, blocks, divergence, r_2)
+    values = rt.values(tau)                                  # (2, 2, n_sub, nq)
+    lam, mu = lame
+    sym = np.array([values[0, 0], values[1, 1], 0.5 * (values[0, 1] + values[1, 0])])
+    dx = rt.dx
+    per = [(compliance_energy(sym, lam, mu) * dx).sum(axis=1),
+           ((values[0, 1] - values[1, 0]) ** 2 / 2 * dx).sum(axis=1)]
+    f = body_force(np.asarray(rt.global_coordinates()))      # (2, n_sub, nq)
+    projected = np.einsum("sml,lp->msp", sub_coefficients, q)
+    r_1 = (((f - projected) ** 2).sum(axis=0) * dx).sum(axis=1)
+    per.append((element_diameters(sub) / np.pi) ** 2 * r_1)
+    symmetric, skew, remainder = (np.bincount(parent, p, rough.size) for p in per)
+    return JumpOscillation(elements=rough, symmetric=symmetric, skew=skew,
+                           remainder=remainder, divergence_defect=defect)
+
+
+def sub_triangles(mesh, rough: np.ndarray, body_force, k: int) -> tuple[MeshTri, np.ndarray]:
+    """The rough elements refined SUB_LEVELS times, then SUB_ADAPTIVE times where f is still
+    rough (a conforming mesh of their union), and the rough element (index into ``rough``)
+    that holds each sub-triangle."""
+    base = MeshTri(mesh.p, mesh.t[:, rough])
+    sub = base.refined(SUB_LEVELS)
+    for _ in range(SUB_ADAPTIVE):
+        cut = rough_elements(sub, body_force, k)
+        if cut.size == 0:
+            break
+        sub = sub.refined(cut)
+    centroids = sub.p[:, sub.t].mean(axis=1)
+    return sub, base.element_finder()(*centroids)
+
+
+def _split_load(mesh, rough, sub, parent, body_force, k):
+    """The moments (f - ... , q_l)_S of r_2 = Pi_S f - Pi_k f against the sub-triangles' P_k
+    DG functions (n_sub, 2, n_dg), and Pi_S f's nodal values (n_sub, 2, n_dg). Every integral
+    of f is the load rule's (refined where f is rough), so Pi_k f is the projection that
+    sigma* balances."""
+    dg_ref = ELEMENTS[k]()
+    basis = Basis(sub, ElementVector(ElementDG(dg_ref)), intorder=2 * k)
+    n_sub = sub.t.shape[1]
+    moments = body_load(body_force, basis, SUB_DEPTH)[basis.element_dofs].reshape(-1, 2, n_sub)
+    moments = moments.transpose(2, 1, 0)                               # (n_sub, 2, n_dg)
+    X, W = basis.quadrature
+    q = scalar_values(dg_ref, X)
+    reference_mass = np.einsum("lp,mp,p->lm", q, q, W)
+    det_sub = np.abs(sub.mapping().detA)
+    own = np.linalg.solve(reference_mass, moments.transpose(2, 1, 0).reshape(q.shape[0], -1))
+    own = own.reshape(q.shape[0], 2, n_sub).transpose(2, 1, 0) / det_sub[:, None, None]
+    # the parent's P_k functions at the sub-triangles' DG nodes: exact on each S (degree k)
+    nodes = sub.mapping().F(np.asarray(dg_ref.doflocs, dtype=float).T)  # (2, n_sub, n_dg)
+    local = mesh.mapping().invF(nodes, tind=rough[parent])
+    at_nodes = np.array([dg_ref.lbasis(local, j)[0] for j in range(q.shape[0])])  # l s m
+    parent_moments = np.zeros((rough.size, 2, q.shape[0]))
+    np.add.at(parent_moments, parent, np.einsum("lsm,srm->srl", at_nodes, moments))
+    det_parent = np.abs(mesh.mapping().detA)[rough]
+    coefficients = np.linalg.solve(reference_mass, parent_moments.transpose(2, 1, 0).reshape(
+        q.shape[0], -1)).reshape(q.shape[0], 2, rough.size).transpose(2, 1, 0)
+    coefficients /= det_parent[:, None, None]
+    projected = np.einsum("srl,lsm->srm", coefficients[parent], at_nodes)
+    r_2 = moments - np.einsum("lm,srm->srl", reference_mass, projected) * det_sub[:, None,
+                                                                                    None]
+    return r_2, own
+
+
+def stress_weight(lame: tuple[float, float], korn: float) -> np.ndarray:
+    """W (4, 4) with tau : W : tau = sym tau : C^-1 sym tau + C_K^2 |skw tau|^2, entries in
+    the order tau_00, tau_01, tau_10, tau_11 (row, component), in plane strain."""
+    lam, mu = lame
+    kappa = lam / (2 * (lam + mu))
+    W = np.zeros((4, 4))
+    W[0, 0] = W[3, 3] = (1 - kappa) / (2 * mu)
+    W[0, 3] = W[3, 0] = -kappa / (2 * mu)
+    W[1, 1] = W[2, 2] = 1 / (4 * mu) + korn**2 / 2
+    W[1, 2] = W[2, 1] = 1 / (4 * mu) - korn**2 / 2
+    return W
+
+
+def _energy_blocks(sub, k: int, X, W, weight: np.ndarray) -> np.ndarray:
+    """(tau, tau)_W per element on the two rows' RT_k functions, (n_sub, 2 n_rt, 2 n_rt): the
+    Piola components phi_j,c = o_j (J phi^_j)_c / |det J| against ``weight``."""
+    mapping = sub.mapping()
+    J, det = mapping.A, np.abs(mapping.detA)
+    phi, _ = reference_rt(k, X)
+    n_rt = phi.shape[0]
+    o = orientations(sub, n_rt, k)
+    reference = np.einsum("jap,lbp,p->abjl", phi, phi, W)
+    components = np.einsum("cae,dbe,abjl->cdejl", J, J, reference, optimize=True)
+    components *= (o[:, :, None] * o[:, None, :] / det[:, None, None])[None, None]
+    local = np.einsum("rcsd,cdejl->erjsl", weight.reshape(2, 2, 2, 2), components,
+                      optimize=True)
+    return local.reshape(-1, 2 * n_rt, 2 * n_rt)
+
+
+def _least_tau(sub, rt, blocks, divergence, data) -> tuple[np.ndarray, float]:
+    """tau (2, N) in RT_k(sub)^2, tau . n = 0 on the boundary, (div tau_r, q_l)_S = data
+    (n_sub, 2, n_dg), of least (tau, tau)_W (``blocks``): [E B'; B 0] with one multiplier per
+    row and connected component dropped (its equation follows from the data's zero mean)."""
+    n_sub, n_dg, n_rt = divergence.shape
+    dofs = np.concatenate([rt.element_dofs, rt.element_dofs + rt.N]).T   # (n_sub, 2 n_rt)
+    E = sp.csr_matrix((blocks.ravel(), (np.repeat(dofs, 2 * n_rt, axis=1).ravel(),
+                                        np.tile(dofs, (1, 2 * n_rt)).ravel())),
+                      shape=(2 * rt.N, 2 * rt.N))
+    div_rows = (np.arange(n_sub)[:, None] * n_dg + np.arange(n_dg)).repeat(n_rt, axis=1)
+    B = sp.csr_matrix((divergence.ravel(), (div_rows.ravel(),
+                                            np.tile(rt.element_dofs.T, (1, n_dg)).ravel())),
+                      shape=(n_sub * n_dg, rt.N))
+    boundary = Dofs(sub, ElementTriRTk(rt.elem.k)).get_facet_dofs(sub.boundary_facets())
+    free = np.setdiff1d(np.arange(rt.N), boundary.flatten())
+    inner = sub.f2t[1] >= 0
+    adjacency = sp.csr_matrix((np.ones(inner.sum()), (sub.f2t[0, inner], sub.f2t[1, inner])),
+                              shape=(n_sub, n_sub))
+    _, component = connected_components(adjacency, directed=False)
+    kept = np.setdiff1d(np.arange(n_sub * n_dg),
+                        np.unique(component, return_index=True)[1] * n_dg)
+    Bf = B[kept][:, free]
+    both = np.concatenate([free, free + rt.N])
+    K = sp.bmat([[E[both][:, both], sp.block_diag([Bf.T, Bf.T])],
+                 [sp.block_diag([Bf, Bf]), None]], format="csc")
+    flat = data.transpose(0, 2, 1).reshape(-1, 2)                      # (s l, r)
+    rhs = np.concatenate([np.zeros(both.size), flat[kept, 0], flat[kept, 1]])
+    x = splu(K).solve(rhs)
+    tau = np.zeros((2, rt.N))
+    tau[:, free] = x[:both.size].reshape(2, -1)
+    defect = np.abs(B @ tau.T - flat).max() / max(np.abs(flat).max(), np.finfo(float).tiny)
+    return tau, float(defect)
