@@ -11,7 +11,9 @@ with u_0 the solution of the auxiliary problem (4) with contact traction lambda*
 equilibrated stress and rho the load that balances the patches u_h does not balance exactly
 (``estimators.equilibration``), d an extension of (g - u_hn)_- (``estimators.contact_
 extension``; of two, the one with the smaller eta), osc the data oscillation (Payne-
-Weinberger's 1/pi and a trace constant derived in 13.3), C_G = (1/(2 mu) + C_K^2)^(1/2), and
+Weinberger's 1/pi and a trace constant derived in 13.3; where f jumps inside elements, most of
+it equilibrated on sub-triangles, ``estimators.jump_equilibration``), C_G = (1/(2 mu) +
+C_K^2)^(1/2), and
 C_K, C_T, C_F the domain constants (``estimators.constants``). eta_0 reports A, eta_geometric
 D and eta_complementarity sqrt(B).
 """

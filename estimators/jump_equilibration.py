@@ -11,9 +11,10 @@ of ``formulations.load`` refines), each cut SUB_LEVELS times into 4^SUB_LEVELS s
 
 Pi_S the P_k projection per sub-triangle. r_2 is a piecewise polynomial with zero mean on
 every connected union of rough elements, so a tau in RT_k(S) with tau . n = 0 on the union's
-boundary and div tau = r_2 exists; of these the one of least L2 norm is computed (one sparse
-saddle-point solve, both rows at once). Then (r_2, v) = -(tau, grad v) <=
-||C^-1/2 sym tau|| a(v, v)^1/2 + ||skw tau|| ||skw grad v||, and r_1 is charged by the Poincare
+boundary and div tau = r_2 exists; of these the one that minimises ||C^-1/2 sym tau||^2 +
+C_K^2 ||skw tau||^2 is computed (one sparse saddle-point solve, the two rows coupled). Then
+(r_2, v) = -(tau, grad v) <= ||C^-1/2 sym tau|| a(v, v)^1/2 + ||skw tau|| ||skw grad v|| <=
+(||C^-1/2 sym tau|| + C_K ||skw tau||) a(v, v)^1/2, and r_1 is charged by the Poincare
 bound on the sub-triangles, (h_S / pi) ||r_1||_S: a jump now costs only on the sub-triangles
 it cuts, and at their size.
 """
