@@ -19,13 +19,13 @@ takes this traction only where it gives the smaller contact terms.
 
 from __future__ import annotations
 
-import clarabel
 import numpy as np
 from scipy import sparse
 from scipy.special import comb
 
 from estimators.contact_extension import vertex_normals
 from estimators.guaranteed_contact import FacetPolynomial, projected_pressure
+from formulations.nonnegative_fit import bounded_least_squares
 
 EPSILON = 1e-4  # weight of ||lambda*|| against the balance (relative leftover ~1e-6, measured)
 
@@ -54,29 +54,12 @@ def nonnegative_pressure(trace, reaction: np.ndarray, clamped: np.ndarray, k: in
     row_scale = 1 / np.sqrt(2 * np.asarray(G.sum(axis=1)).ravel())  # int psi_a = l_a / 2
     # ||sum_j x_j B_j||^2 <= sum_j x_j^2 |e| / (k + 1) (Bernstein: a partition of unity)
     norm = np.repeat(np.sqrt(trace.length / (k + 1)), k + 1)
-    x = _bounded_least_squares(sparse.diags(row_scale) @ G, row_scale * R, EPSILON * norm)
-    x = x.reshape(trace.size, k + 1)
+    x = bounded_least_squares(sparse.diags(row_scale) @ G, row_scale * R, EPSILON * norm)
+    # unsolved: lambda* is candidate (ii) of 13.3 again, still a bound
+    x = (np.zeros(norm.size) if x is None else x).reshape(trace.size, k + 1)
 
     def pressure(t):
         bernstein = np.array([comb(k, j) * t**j * (1 - t) ** (k - j) for j in range(k + 1)])
         return x @ bernstein
 
     return projected_pressure(pressure, k)
-
-
-def _bounded_least_squares(A: sparse.csr_matrix, b: np.ndarray, weights: np.ndarray
-                           ) -> np.ndarray:
-    """argmin over x >= 0 of ||A x - b||^2 + ||weights * x||^2, by Clarabel's interior point
-    method on the banded normal equations (a chain along Gamma_C: milliseconds where scipy's
-    bounded least squares took seconds at 1e3 unknowns)."""
-    n = A.shape[1]
-    P = sparse.triu(2 * (A.T @ A + sparse.diags(weights**2))).tocsc()
-    settings = clarabel.DefaultSettings()
-    settings.verbose = False
-    settings.tol_gap_abs = settings.tol_gap_rel = settings.tol_feas = 1e-12  # a small problem
-    solver = clarabel.DefaultSolver(P, -2 * (A.T @ b), -sparse.eye(n, format="csc"),
-                                    np.zeros(n), [clarabel.NonnegativeConeT(n)], settings)
-    solution = solver.solve()
-    if solution.status not in (clarabel.SolverStatus.Solved, clarabel.SolverStatus.AlmostSolved):
-        return np.zeros(n)  # then lambda* is candidate (ii) of 13.3 again: still a bound
-    return np.maximum(np.asarray(solution.x), 0.0)

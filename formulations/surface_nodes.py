@@ -8,32 +8,46 @@ no lumping is consistent: the integral of a vertex's basis function over a trian
 smooth pressure has vertex reactions near 0 and any positive lumped weight there (the
 sub-triangle lumping A / 12, A / 4) turns them into vertex pressures near 0 -- lambda_h then
 oscillates and its error stalls (measured on free-boundary-3d: 1.44e-3 from 1e5 to 2.5e5 DOFs).
-So P2 solves the consistent boundary mass system M lambda = r (M_ij = int phi_i phi_j over
-Gamma_C), which reproduces any P2 pressure, and keeps lambda only on the contact triangles with
-a node whose reaction pushes (above ACTIVE_FRACTION of the largest), clipped at 0: M^-1 is dense,
-so the solve leaves small values of either sign at every node of Gamma_C, and positive ones far
-outside the contact zone made its measured radius twice the true one (free-boundary-3d: zone end
-0.84, 0.88, 0.77 against 0.4 on three uniform levels; 0.70, 0.55, 0.46 with the cut, which
-leaves the zone overshooting by up to a triangle as P1's does, and the pressure error as it
-was). Cutting node by node instead puts 0 at the vertices inside the zone whose reaction is 0
-(a vertex function of a P2 triangle integrates to 0) and makes lambda_h oscillate: 4 x the
-pressure error on an adaptive sequence. lambda_h is the P2 interpolant of the kept values,
-clipped at 0. The lumped weights still weigh the nodal normals.
+So P2 fits the reactions: lambda_h on the contact triangles with a node whose reaction
+pushes (above ACTIVE_FRACTION of the largest) is the quadratic with non-negative Bernstein
+coefficients (so lambda_h >= 0 everywhere, no clipping) whose moments int lambda_h phi_i
+match the reactions r_i best in the least-squares sense, each row weighted by 1/sqrt of its
+lumped mass (``formulations.nonnegative_fit``). Its integral, the contact force, is then the
+sum of the reactions up to what no non-negative quadratic matches (docs/theory.md, 14.1).
+Before it, the consistent boundary mass system M lambda = r (exact for any P2 pressure, but M^-1
+is dense: it left values of either sign at every node, which had to be cut to the pushing
+triangles and clipped at 0) gave a contact force 21 % above the reactions' on free-boundary-3d
+at 1944 DOFs and a zone 20 % too wide on hertz-3d at 2.8e4 adaptive DOFs. The lumped weights
+still weigh the nodal normals.
 """
 
 from __future__ import annotations
 
 import numpy as np
 from scipy import sparse
-from scipy.sparse.linalg import spsolve
 
 from formulations.contact import TraceNodes
 from formulations.contact_surface import triangle_lagrange, triangle_rule
 from formulations.kkt import ACTIVE_FRACTION
+from formulations.nonnegative_fit import bounded_least_squares
 
 # lumped mass per unit facet area, local nodes in scikit-fem's ElementTriP2 order
 # (vertices 0, 1, 2; midpoints of edges 01, 12, 02)
 LUMPED = {1: np.full(3, 1 / 3), 2: np.array([1, 1, 1, 3, 3, 3]) / 12}
+EPSILON = 1e-4  # weight of ||lambda_h|| against the moments: picks one of many fits
+
+
+def _bernstein_moments() -> np.ndarray:
+    """int phi_i B_j per unit area (6, 6): phi_i the P2 Lagrange functions, B_j the P2
+    Bernstein polynomials (vertex j: l_j^2; edge ab: 2 l_a l_b), in the same node order."""
+    t, w = triangle_rule(4)  # exact for the products of two quadratics
+    bary = np.array([1 - t[0] - t[1], t[0], t[1]])
+    bernstein = np.array([bary[0] ** 2, bary[1] ** 2, bary[2] ** 2, 2 * bary[0] * bary[1],
+                          2 * bary[1] * bary[2], 2 * bary[0] * bary[2]])
+    return np.einsum("iq,jq,q->ij", triangle_lagrange(2)[1](t), bernstein, w)
+
+
+BERNSTEIN_MOMENTS = _bernstein_moments()
 
 
 def surface_nodes(mesh, trace, order: int) -> TraceNodes:
@@ -76,25 +90,44 @@ def surface_rows(elasticity, nodes: TraceNodes,
 
 
 def nodal_pressures(trace, nodes: TraceNodes, reaction: np.ndarray) -> np.ndarray:
-    """lambda at the nodes from the reactions (module docstring): lumped for P1, the consistent
-    boundary mass system for P2, kept where a reaction pushes and clipped at 0."""
+    """lambda at the nodes from the reactions (module docstring): lumped for P1; for P2 the
+    quadratic with non-negative Bernstein coefficients whose moments match the reactions."""
     if nodes.facet_rows.shape[1] == 3:
         return reaction / nodes.weight
-    points, basis = triangle_lagrange(2)
-    t, w = triangle_rule(4)  # exact for products of two quadratics
-    phi = basis(t)  # (6, nq)
-    local = np.einsum("iq,jq,q->ij", phi, phi, w)  # per unit area
-    rows = np.repeat(nodes.facet_rows, 6, axis=1).ravel()
-    cols = np.tile(nodes.facet_rows, 6).ravel()
-    values = (local.ravel()[None, :] * trace.measure[:, None]).ravel()
-    m = nodes.weight.size
-    mass = sparse.csc_matrix((values, (rows, cols)), shape=(m, m))
     # an interior-point solver leaves reactions of ~1e-9 relative everywhere: not contact
     pushes = reaction > ACTIVE_FRACTION * reaction.max(initial=0.0)
-    pressed = pushes[nodes.facet_rows].any(axis=1)  # facets with a node that pushes
-    kept = np.zeros(m, dtype=bool)
-    kept[nodes.facet_rows[pressed].ravel()] = True
-    return np.where(kept, np.maximum(spsolve(mass, reaction), 0.0), 0.0)
+    pressed = np.flatnonzero(pushes[nodes.facet_rows].any(axis=1))
+    m = nodes.weight.size
+    if pressed.size == 0:
+        return np.zeros(m)
+    rows = nodes.facet_rows[pressed]                        # (n_pressed, 6)
+    area = trace.measure[pressed]
+    moments = sparse.csr_matrix((
+        (BERNSTEIN_MOMENTS.ravel()[None, :] * area[:, None]).ravel(),
+        (np.repeat(rows, 6, axis=1).ravel(), np.tile(rows, 6).ravel())), shape=(m, m))
+    control = np.unique(rows)                               # the unknown coefficients
+    tested = np.unique(rows)                                # where a moment is matched
+    scale = 1 / np.sqrt(nodes.weight[tested])
+    # ||sum_j x_j B_j||^2 <= sum_j x_j^2 int B_j (Bernstein: a partition of unity, >= 0)
+    norm = np.sqrt(np.bincount(rows.ravel(), np.repeat(area / 6, 6), m)[control])
+    A = sparse.diags(scale) @ moments[tested][:, control]
+    x = bounded_least_squares(A, scale * reaction[tested], EPSILON * norm)
+    if x is None:
+        return np.zeros(m)
+    coefficients = np.zeros(m)
+    coefficients[control] = x
+    return lagrange_values(nodes.facet_rows, coefficients)
+
+
+def lagrange_values(facet_rows: np.ndarray, coefficients: np.ndarray) -> np.ndarray:
+    """The values at the P2 nodes of the quadratic with Bernstein ``coefficients`` (at a vertex
+    its own; at the midpoint of edge ab, (b_a + b_b) / 4 + b_ab / 2)."""
+    values = coefficients.copy()
+    for edge, (a, b) in enumerate(((0, 1), (1, 2), (0, 2))):
+        mid = facet_rows[:, 3 + edge]
+        values[mid] = (coefficients[facet_rows[:, a]] + coefficients[facet_rows[:, b]]) / 4 \
+            + coefficients[mid] / 2
+    return values
 
 
 def surface_pressure(values: np.ndarray, t: np.ndarray) -> np.ndarray:
