@@ -105,17 +105,16 @@ def nodal_pressures(trace, nodes: TraceNodes, reaction: np.ndarray) -> np.ndarra
     moments = sparse.csr_matrix((
         (BERNSTEIN_MOMENTS.ravel()[None, :] * area[:, None]).ravel(),
         (np.repeat(rows, 6, axis=1).ravel(), np.tile(rows, 6).ravel())), shape=(m, m))
-    control = np.unique(rows)                               # the unknown coefficients
-    tested = np.unique(rows)                                # where a moment is matched
-    scale = 1 / np.sqrt(nodes.weight[tested])
+    on = np.unique(rows)  # the unknown coefficients, and the nodes whose moments are matched
+    scale = 1 / np.sqrt(nodes.weight[on])
     # ||sum_j x_j B_j||^2 <= sum_j x_j^2 int B_j (Bernstein: a partition of unity, >= 0)
-    norm = np.sqrt(np.bincount(rows.ravel(), np.repeat(area / 6, 6), m)[control])
-    A = sparse.diags(scale) @ moments[tested][:, control]
-    x = bounded_least_squares(A, scale * reaction[tested], EPSILON * norm)
-    if x is None:
-        return np.zeros(m)
+    norm = np.sqrt(np.bincount(rows.ravel(), np.repeat(area / 6, 6), m)[on])
+    A = sparse.diags(scale) @ moments[on][:, on]
+    x = bounded_least_squares(A, scale * reaction[on], EPSILON * norm)
+    if x is None:  # Clarabel failed: the sub-triangle lumping (module docstring), not zero
+        return reaction / nodes.weight
     coefficients = np.zeros(m)
-    coefficients[control] = x
+    coefficients[on] = x
     return lagrange_values(nodes.facet_rows, coefficients)
 
 
