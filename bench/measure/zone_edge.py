@@ -47,8 +47,7 @@ def square_root_zone(solution: DiscreteSolution) -> tuple[float, float]:
         start, end = _interval_ends(corners[0], values)
         return max(start, support[0]), min(end, support[1])
     fraction = _positive_fraction(values)
-    e1, e2 = corners[:, :, 1] - corners[:, :, 0], corners[:, :, 2] - corners[:, :, 0]
-    area = 0.5 * np.abs(e1[0] * e2[1] - e1[1] * e2[0])
+    area = 0.5 * np.abs(np.linalg.det((corners[:, :, 1:] - corners[:, :, :1]).transpose(1, 2, 0)))
     zone = (fraction * area).sum()
     if zone <= 0:
         return float("nan"), float("nan")
@@ -111,13 +110,11 @@ def _extrapolated(nodes, simplices, squared, pressed) -> np.ndarray:
 
 def _gradients(corners: np.ndarray, values: np.ndarray) -> np.ndarray:
     """The constant gradient (m, n) of the linear interpolant of ``values`` (n, m + 1) on
-    simplices with ``corners`` (m, n, m + 1), m = 1 or 2."""
-    if corners.shape[0] == 1:
-        return ((values[:, 1] - values[:, 0]) / (corners[0, :, 1] - corners[0, :, 0]))[None]
-    e1, e2 = corners[:, :, 1] - corners[:, :, 0], corners[:, :, 2] - corners[:, :, 0]
-    d1, d2 = values[:, 1] - values[:, 0], values[:, 2] - values[:, 0]
-    det = e1[0] * e2[1] - e1[1] * e2[0]
-    return np.array([(d1 * e2[1] - d2 * e1[1]) / det, (e1[0] * d2 - e2[0] * d1) / det])
+    simplices with ``corners`` (m, n, m + 1): E' g = d with E the edges from the first corner
+    and d the value differences along them, in any dimension m."""
+    edges = (corners[:, :, 1:] - corners[:, :, :1]).transpose(1, 2, 0)   # (n, m, m): edge, x
+    rise = values[:, 1:] - values[:, :1]                                 # (n, m)
+    return np.linalg.solve(edges, rise[..., None])[..., 0].T
 
 
 def _interval_ends(corners: np.ndarray, values: np.ndarray) -> tuple[float, float]:
