@@ -21,9 +21,8 @@ D and eta_complementarity sqrt(B).
 from __future__ import annotations
 
 import numpy as np
-from skfem import Basis, ElementDG, FacetBasis
 
-from estimators.averaging import compliance_energy, element_areas
+from estimators.averaging import compliance_energy
 from estimators.base import BoundTerms, Estimate, planar_only, register_estimator
 from estimators.constants import domain_constants
 from estimators.contact_extension import EXTENSIONS
@@ -43,13 +42,14 @@ from estimators.guaranteed_contact import (
     traction_at,
 )
 from estimators.guaranteed_friction import balanced_shear, friction_bound, raw_shear, shear_at
-from estimators.jump_equilibration import JumpOscillation, jump_oscillation
+from estimators.jump_equilibration import jump_oscillation
 from estimators.nonnegative_traction import nonnegative_pressure
+from estimators.oscillation import oscillation
 from estimators.patch_data import interior_data, rebalanced
 from estimators.residual import stress_tensor
 from estimators.symmetrisation import symmetrised
 from formulations import DiscreteSolution
-from formulations.elasticity import ELEMENTS, element_diameters, stress_from_gradient
+from formulations.elasticity import stress_from_gradient
 from formulations.evaluation import gradients_at_reference
 
 # The bound needs the patch data to balance (docs/theory.md, 13.2); past this relative
@@ -61,14 +61,20 @@ class NotEquilibrated(RuntimeError):
     """The discrete solution does not balance the auxiliary problem's hat functions."""
 
 
-def tresca_only(scene=None, **context) -> str | None:
-    """Coulomb is refused (not a minimisation: no bound, docs/theory.md 17.5); 3D too."""
-    if scene is not None and scene.friction.kind == "coulomb":
-        return (f"estimator 'equilibrated' bounds the error under Tresca friction only "
-                f"(the scene's law is {scene.friction.label}: Coulomb's is not a "
-                "minimisation)")
-    return planar_only("equilibrated", "the Raviart-Thomas patch equilibration is built on "
-                                       "triangles")(scene=scene, **context)
+def tresca_only_for(name: str):
+    """The ``applies`` check of estimator ``name``: Coulomb is refused (not a minimisation: no
+    bound, docs/theory.md 17.5); 3D too."""
+    def check(scene=None, **context) -> str | None:
+        if scene is not None and scene.friction.kind == "coulomb":
+            return (f"estimator '{name}' bounds the error under Tresca friction only "
+                    f"(the scene's law is {scene.friction.label}: Coulomb's is not a "
+                    "minimisation)")
+        return planar_only(name, "the Raviart-Thomas patch equilibration is built on "
+                                 "triangles")(scene=scene, **context)
+    return check
+
+
+tresca_only = tresca_only_for("equilibrated")
 
 
 def friction_terms(friction, trace_constant: float) -> dict[str, float]:
@@ -88,9 +94,7 @@ def estimate(scene, solution: DiscreteSolution) -> Estimate:
     rec, interior, load, bounds, boundary, _, shear = equilibrate(scene, solution)
     lam, mu = solution.elasticity.lame
     constants = domain_constants(scene)
-    diff = rec.values - interior.sigma_h
-    sym = np.array([diff[0, 0], diff[1, 1], 0.5 * (diff[0, 1] + diff[1, 0])])
-    compliance = (compliance_energy(sym, lam, mu) * rec.basis.dx).sum(axis=1)
+    compliance = compliance_squares(rec, interior, (lam, mu))
     skew = ((rec.values[0, 1] - rec.values[1, 0]) ** 2 / 2 * rec.basis.dx).sum(axis=1)
     jump = jump_oscillation(rec.basis.mesh, scene.body_force, rec.basis.elem.k, (lam, mu),
                             constants.korn)
@@ -109,12 +113,25 @@ def estimate(scene, solution: DiscreteSolution) -> Estimate:
                  oscillation=(grad_constant * np.sqrt((osc**2).sum())
                               + np.sqrt((tau_sym**2).sum()) + np.sqrt((tau_skew**2).sum())),
                  load=constants.friedrichs * np.sqrt(load.sum()))
-    # every extension d gives a bound (13.3): the smallest is kept
-    return min((_combined(scene, solution, parts, volume, bound, shear) for bound in bounds),
-               key=lambda est: est.eta)
+    return smallest(scene, solution, parts, volume, bounds, shear, "equilibrated")
 
 
-def _combined(scene, solution, parts: dict, volume: np.ndarray, bound, shear) -> Estimate:
+def compliance_squares(rec, interior, lame: tuple[float, float]) -> np.ndarray:
+    """||C^{-1/2}(sym sigma* - sigma_h)||_T^2 per element."""
+    diff = rec.values - interior.sigma_h
+    sym = np.array([diff[0, 0], diff[1, 1], 0.5 * (diff[0, 1] + diff[1, 0])])
+    return (compliance_energy(sym, *lame) * rec.basis.dx).sum(axis=1)
+
+
+def smallest(scene, solution, parts: dict, volume: np.ndarray, bounds, shear, name: str
+             ) -> Estimate:
+    """Every extension d gives a bound (13.3): the smallest, as estimator ``name``."""
+    return min((_combined(scene, solution, parts, volume, bound, shear, name)
+                for bound in bounds), key=lambda est: est.eta)
+
+
+def _combined(scene, solution, parts: dict, volume: np.ndarray, bound, shear, name: str
+              ) -> Estimate:
     """eta of 13.1 from the parts of A (``BoundTerms``' volume fields), the contact terms of
     one extension (``bound``) and, under friction, those of sigma*_t (17.5)."""
     constants = domain_constants(scene)
@@ -128,7 +145,7 @@ def _combined(scene, solution, parts: dict, volume: np.ndarray, bound, shear) ->
             + (friction.complementarity if friction else 0.0), 0.0)
     eta = 0.5 * (a + np.sqrt(a * a + 4 * b))
     local = marking_shares(eta, A, volume, terms, bound, friction)
-    return Estimate(estimator="equilibrated", eta=float(eta), eta_0=float(A),
+    return Estimate(estimator=name, eta=float(eta), eta_0=float(A),
                     eta_geometric=bound.extension,
                     eta_complementarity=float(np.sqrt(bound.complementarity)), indicators=local,
                     guaranteed=True, bound=terms)
@@ -150,11 +167,12 @@ def marking_shares(eta: float, A: float, volume: np.ndarray, terms: BoundTerms,
     return np.zeros_like(volume) + local
 
 
-def equilibrate(scene, solution: DiscreteSolution):
-    """sigma* (a ``Reconstruction``, symmetrised by ``estimators.symmetrisation``), the patch
-    data, ||rho||_T^2, the contact terms of lambda* (a ``ContactBound`` per extension), the
-    Neumann data of the auxiliary problem, the clamped vertices and sigma*_t (None without
-    friction) (docs/theory.md, 13.2, 13.3 and 17.5)."""
+def equilibrate(scene, solution: DiscreteSolution, symmetrise=None):
+    """sigma* (a ``Reconstruction``, symmetrised by ``estimators.symmetrisation``, or by
+    ``symmetrise(rec, interior, prescribed, lame)`` if given), the patch data, ||rho||_T^2,
+    the contact terms of lambda* (a ``ContactBound`` per extension), the Neumann data of the
+    auxiliary problem, the clamped vertices and sigma*_t (None without friction)
+    (docs/theory.md, 13.2, 13.3 and 17.5)."""
     elasticity = solution.elasticity
     mesh, order = elasticity.mesh, elasticity.order
     lam, mu = elasticity.lame
@@ -193,6 +211,9 @@ def equilibrate(scene, solution: DiscreteSolution):
         raise NotEquilibrated(f"the patch data do not balance (relative imbalance "
                               f"{rec.imbalance:.1e} > {BALANCE_TOLERANCE:g}): no bound")
     prescribed = np.concatenate([part.facets for part in (neumann, contact)])
+    if symmetrise is not None:
+        return (symmetrise(rec, interior, prescribed, (lam, mu)), interior, load, bounds,
+                [neumann, contact], clamped, shear)
     rec = symmetrised(rec, interior, prescribed, (lam, mu), domain_constants(scene).korn)
     return rec, interior, load, bounds, [neumann, contact], clamped, shear
 
@@ -231,43 +252,3 @@ def _balance(interior, trace, pressure) -> np.ndarray:
     """int psi_a (-pressure n) over Gamma_C per vertex, (n_vertices, 2)."""
     part = BoundaryData(trace.facets, lambda x: traction_at(trace, pressure, x))
     return boundary_balance(interior.total.shape[0], boundary_fluxes(interior, [part]))
-
-
-def oscillation(scene, rt: Basis, boundary: list[BoundaryData],
-                jump: JumpOscillation | None = None) -> np.ndarray:
-    """Per element, (h_T / pi) ||f - Pi_k f||_T + sum_e C_e ||t - Pi_k t||_e over its facets
-    with Neumann data, C_e^2 = |e| h_T^2 / |T| (1/pi^2 + 1/pi) (docs/theory.md, 13.3); on the
-    elements of ``jump`` the sub-triangles' term of f instead (13.2, "Where f jumps")."""
-    mesh, k = rt.mesh, rt.elem.k
-    out = np.zeros(mesh.t.shape[1])
-    if scene.body_force is not None:
-        dg = Basis(mesh, ElementDG(ELEMENTS[k]()), quadrature=rt.quadrature)
-        f = scene.body_force(np.asarray(rt.global_coordinates()))
-        out += element_diameters(mesh) / np.pi * np.sqrt(_projection_error(dg, f))
-        if jump is not None:
-            out[jump.elements] = np.sqrt(jump.remainder)
-    for part in boundary:
-        if part.facets.size == 0:
-            continue
-        fb = FacetBasis(mesh, ELEMENTS[k](), facets=part.facets, intorder=8)
-        t = part.traction(np.asarray(fb.global_coordinates()))
-        err = _projection_error(fb, t)
-        length = np.linalg.norm(mesh.p[:, mesh.facets[0, part.facets]]
-                                - mesh.p[:, mesh.facets[1, part.facets]], axis=0)
-        element = fb.tind
-        c_e = np.sqrt(length * element_diameters(mesh)[element] ** 2
-                      / element_areas(mesh)[element] * (1 / np.pi**2 + 1 / np.pi))
-        out += np.bincount(element, c_e * np.sqrt(err), mesh.t.shape[1])
-    return out
-
-
-def _projection_error(basis, values: np.ndarray) -> np.ndarray:
-    """||v - Pi v||^2 per element or facet of ``basis`` for v (2, n, nq), Pi the L2 projection
-    onto the span of the basis's local functions (on a facet the P_k functions of the triangle
-    span P_k(e) with repetitions: the pseudo-inverse of their Gram matrix)."""
-    phi = np.array([np.asarray(b[0]) for b in basis.basis])           # (m, n, nq)
-    gram = np.einsum("jnp,lnp,np->njl", phi, phi, basis.dx)
-    moments = np.einsum("jnp,rnp,np->nrj", phi, values, basis.dx)
-    coef = np.einsum("njl,nrl->nrj", np.linalg.pinv(gram, rcond=1e-10), moments)
-    projected = np.einsum("nrj,jnp->rnp", coef, phi)
-    return (((values - projected) ** 2).sum(axis=0) * basis.dx).sum(axis=1)

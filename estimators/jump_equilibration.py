@@ -69,10 +69,13 @@ def rough_elements(mesh, body_force, k: int) -> np.ndarray:
     return refined_rule(body_force, basis, max_depth=0)[0]
 
 
-def jump_oscillation(mesh, body_force, k: int, lame: tuple[float, float], korn: float
-                     ) -> JumpOscillation | None:
+def jump_oscillation(mesh, body_force, k: int, lame: tuple[float, float], korn: float,
+                     element_korn: np.ndarray | None = None) -> JumpOscillation | None:
     """The terms of the module docstring on the rough elements of ``mesh`` (None if f is
-    smooth on every element); ``korn`` C_K, the weight of the skew part."""
+    smooth on every element); ``korn`` C_K, the weight of the skew part. With
+    ``element_korn`` (K_T per element of ``mesh``, ``estimators.local_korn``) the skew part
+    of tau has zero mean on every rough element and weighs (K_T - 1) / (2 mu) there instead
+    (docs/theory.md 13.4, "Local Korn constants")."""
     rough = rough_elements(mesh, body_force, k)
     if rough.size == 0:
         return None
@@ -83,8 +86,15 @@ def jump_oscillation(mesh, body_force, k: int, lame: tuple[float, float], korn: 
     q = scalar_values(dg_ref, X)                             # (n_dg, nq)
     _, divergence = element_matrices(sub, k, X, W, q)
     r_2, sub_coefficients = _split_load(mesh, rough, sub, parent, body_force, k)
-    blocks = _energy_blocks(sub, k, X, W, stress_weight(lame, korn))
-    tau, defect = _least_tau(sub, rt, blocks, divergence, r_2)
+    if element_korn is None:
+        weights, means = np.full(sub.t.shape[1], korn**2), None
+    else:
+        weights = ((element_korn[rough] - 1) / (2 * lame[1]))[parent]
+        means = (_skew_means(sub, rt, parent, rough.size), parent)
+    symmetric = _energy_blocks(sub, k, X, W, stress_weight(lame, 0.0))
+    skew_only = _energy_blocks(sub, k, X, W, stress_weight(lame, 1.0)) - symmetric
+    blocks = symmetric + weights[:, None, None] * skew_only
+    tau, defect = _least_tau(sub, rt, blocks, divergence, r_2, means)
     values = rt.values(tau)                                  # (2, 2, n_sub, nq)
     lam, mu = lame
     sym = np.array([values[0, 0], values[1, 1], 0.5 * (values[0, 1] + values[1, 0])])
@@ -176,10 +186,29 @@ def _energy_blocks(sub, k: int, X, W, weight: np.ndarray) -> np.ndarray:
     return local.reshape(-1, 2 * n_rt, 2 * n_rt)
 
 
-def _least_tau(sub, rt, blocks, divergence, data) -> tuple[np.ndarray, float]:
+def _skew_means(sub, rt, parent: np.ndarray, n_parents: int) -> sp.csr_matrix:
+    """M (n_parents, 2 N): int_T s(tau) = int_T (tau_01 - tau_10) / 2 per rough element T
+    for tau's two rows' RT DOFs, from int_S phi_j = o_j J int^ phi^_j (Piola)."""
+    X, W = rt.quadrature
+    phi, _ = reference_rt(rt.elem.k, X)
+    integrals = np.einsum("cae,ja->ejc", sub.mapping().A, phi @ W)    # (n_sub, n_rt, c)
+    integrals *= orientations(sub, phi.shape[0], rt.elem.k)[:, :, None]
+    rows = np.repeat(parent, rt.element_dofs.shape[0])
+    cols = rt.element_dofs.T.ravel()
+    first = sp.csr_matrix((0.5 * integrals[:, :, 1].ravel(), (rows, cols)),
+                          shape=(n_parents, rt.N))
+    second = sp.csr_matrix((-0.5 * integrals[:, :, 0].ravel(), (rows, cols)),
+                           shape=(n_parents, rt.N))
+    return sp.hstack([first, second]).tocsr()
+
+
+def _least_tau(sub, rt, blocks, divergence, data, means=None) -> tuple[np.ndarray, float]:
     """tau (2, N) in RT_k(sub)^2, tau . n = 0 on the boundary, (div tau_r, q_l)_S = data
     (n_sub, 2, n_dg), of least (tau, tau)_W (``blocks``): [E B'; B 0] with one multiplier per
-    row and connected component dropped (its equation follows from the data's zero mean)."""
+    row and connected component dropped (its equation follows from the data's zero mean).
+    ``means`` (rows int_T s(tau) per parent T, ``_skew_means``): these vanish too, one per
+    component dropped (their sum is the torque of the data, which is zero: r_2 is
+    orthogonal to the rigid motions on every T)."""
     n_sub, n_dg, n_rt = divergence.shape
     dofs = np.concatenate([rt.element_dofs, rt.element_dofs + rt.N]).T   # (n_sub, 2 n_rt)
     E = sp.csr_matrix((blocks.ravel(), (np.repeat(dofs, 2 * n_rt, axis=1).ravel(),
@@ -199,10 +228,17 @@ def _least_tau(sub, rt, blocks, divergence, data) -> tuple[np.ndarray, float]:
                         np.unique(component, return_index=True)[1] * n_dg)
     Bf = B[kept][:, free]
     both = np.concatenate([free, free + rt.N])
-    K = sp.bmat([[E[both][:, both], sp.block_diag([Bf.T, Bf.T])],
-                 [sp.block_diag([Bf, Bf]), None]], format="csc")
+    constraints = sp.block_diag([Bf, Bf])
+    if means is not None:
+        matrix, parent = means
+        owner = np.zeros(matrix.shape[0], dtype=np.int64)
+        owner[parent] = component
+        held = np.setdiff1d(np.arange(matrix.shape[0]), np.unique(owner, return_index=True)[1])
+        constraints = sp.vstack([constraints, matrix[held][:, both]])
+    K = sp.bmat([[E[both][:, both], constraints.T], [constraints, None]], format="csc")
     flat = data.transpose(0, 2, 1).reshape(-1, 2)                      # (s l, r)
-    rhs = np.concatenate([np.zeros(both.size), flat[kept, 0], flat[kept, 1]])
+    rhs = np.concatenate([np.zeros(both.size), flat[kept, 0], flat[kept, 1],
+                          np.zeros(constraints.shape[0] - 2 * kept.size)])
     x = splu(K).solve(rhs)
     tau = np.zeros((2, rt.N))
     tau[:, free] = x[:both.size].reshape(2, -1)

@@ -134,7 +134,7 @@ def test_target_error_stops_the_sequence():
 
 
 def test_target_error_needs_a_guaranteed_estimator():
-    assert guaranteed_estimators() == ["equilibrated"]
+    assert "equilibrated" in guaranteed_estimators()
     with pytest.raises(ValueError, match="target_error=0.1 needs estimators"):
         RunConfig(estimators=("residual",), target_error=0.1)
 

@@ -6,7 +6,6 @@ import pytest
 from skfem import Basis, ElementDG, MeshTri
 
 from estimators.constants import domain_constants
-from estimators.equilibrated import _projection_error
 from estimators.jump_equilibration import (
     _energy_blocks,
     _least_tau,
@@ -16,6 +15,7 @@ from estimators.jump_equilibration import (
     stress_weight,
     sub_triangles,
 )
+from estimators.oscillation import projection_error
 from estimators.rt_reference import ReferenceRT, element_matrices, scalar_values
 from formulations.elasticity import ELEMENTS, element_diameters
 from scenes import get_scene
@@ -104,7 +104,7 @@ def test_the_jump_costs_less_than_the_poincare_bound_on_free_boundary():
                + grad_constant * np.sqrt(jump.remainder.sum()))
         dg = Basis(mesh, ElementDG(ELEMENTS[k]()), intorder=2 * k + 6)
         f = scene.body_force(np.asarray(dg.global_coordinates()))
-        poincare = element_diameters(mesh) / np.pi * np.sqrt(_projection_error(dg, f))
+        poincare = element_diameters(mesh) / np.pi * np.sqrt(projection_error(dg, f))
         old = grad_constant * np.sqrt((poincare[jump.elements] ** 2).sum())
         # the dual norm of a step minus its P_k projection is 0.2 .. 0.4 of the Poincare
         # bound (k >= 1, a 1D computation), and the sub-triangles' remainder about 2^-3 of it;

@@ -1,0 +1,98 @@
+"""``equilibrated-local``: the bound of ``equilibrated`` with the Korn-type constant C_K, a
+discrete eigenvalue computed from below, replaced by local constants proved from the geometry
+(docs/theory.md, section 13.4, "Local Korn constants").
+
+* sigma* is weakly symmetric: its skew part is orthogonal to the continuous piecewise linear
+  functions (``estimators.weak_symmetry``). Then, for v in H^1_D, with the vertex patches'
+  constants K_z of ``estimators.local_korn`` and the hat functions psi_z,
+
+      (skw sigma*, skw grad v) = sum_z (psi_z skw sigma*, skw grad v - c_z)
+          <= sum_z ||psi_z^(1/2) skw sigma*|| (K_z - 1)^(1/2) ||eps(v)||_(omega_z)
+          <= ((d + 1) / (2 mu) sum_z (K_z - 1) ||psi_z^(1/2) skw sigma*||^2)^(1/2) ||v||
+
+  (every element lies in d + 1 patches; a(v, v) >= 2 mu ||eps(v)||^2 as lambda >= 0).
+* The data oscillation is orthogonal to P_k, which holds the rigid motions, so on an element
+  (f - Pi_k f, v)_T = (f - Pi_k f, v - r)_T with r the rigid motion that gives v - r zero
+  mean and zero mean rotation: ||v - r||_T <= (h_T / pi) K_T^(1/2) ||eps(v)||_T, and the same
+  factor (K_T / (2 mu))^(1/2) on the facet terms. The sub-triangles of an element f jumps in
+  are similar to it (uniform refinement), so they share its K_T.
+* Where f jumps, tau's skew part has zero mean on every such element and is charged with
+  ((K_T - 1) / (2 mu))^(1/2) (``estimators.jump_equilibration``).
+
+C_T and C_F (the negative traction and the balancing load) remain the computed constants of
+``estimators.constants``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from skfem import Basis, ElementTriP1
+
+from estimators.base import register_estimator
+from estimators.constants import domain_constants
+from estimators.equilibrated import (
+    BALANCE_TOLERANCE,
+    NotEquilibrated,
+    compliance_squares,
+    equilibrate,
+    smallest,
+    tresca_only_for,
+)
+from estimators.jump_equilibration import jump_oscillation
+from estimators.local_korn import element_korn, vertex_korn
+from estimators.oscillation import oscillation
+from estimators.weak_symmetry import weakly_symmetrised
+from formulations import DiscreteSolution
+
+NAME = "equilibrated-local"
+
+
+def skew_squares(rec, korn: np.ndarray, mu: float) -> np.ndarray:
+    """(d + 1) / (2 mu) sum_z (K_z - 1) ||psi_z^(1/2) skw sigma*||_T^2 per element, with
+    |skw sigma|^2 = (sigma_12 - sigma_21)^2 / 2 (Frobenius)."""
+    rt, t = rec.basis, rec.basis.mesh.t
+    hats = Basis(rt.mesh, ElementTriP1(), quadrature=rt.quadrature)
+    density = (rec.values[0, 1] - rec.values[1, 0]) ** 2 / 2 * rt.dx        # (n_el, nq)
+    weighted = sum((korn[t[i]] - 1)[:, None] * np.asarray(hats.basis[i][0]) * density
+                   for i in range(3))
+    return (t.shape[0]) / (2 * mu) * weighted.sum(axis=1)
+
+
+@register_estimator(NAME, "equilibrated with local Korn constants proved from the patches' "
+                          "angles (weakly symmetric stress) instead of the computed C_K",
+                    guaranteed=True, applies=tresca_only_for(NAME), friction=True)
+def estimate(scene, solution: DiscreteSolution):
+    mesh = solution.elasticity.mesh
+    lam, mu = solution.elasticity.lame
+    vertex, element = vertex_korn(mesh), element_korn(mesh)
+    # the skew weight of the minimisation, as C_K^2 is in ``equilibrated``'s
+    weight = float(np.sqrt(mesh.t.shape[0] * np.median(vertex - 1) / (2 * mu)))
+
+    def weak(rec, interior, prescribed, lame):
+        symmetric, defect = weakly_symmetrised(rec, interior, prescribed, lame, weight)
+        if defect > BALANCE_TOLERANCE:
+            raise NotEquilibrated(f"the skew part misses orthogonality to P1 by {defect:.1e} "
+                                  f"(relative) > {BALANCE_TOLERANCE:g}: no bound")
+        return symmetric
+
+    rec, interior, load, bounds, boundary, _, shear = equilibrate(scene, solution, weak)
+    compliance = compliance_squares(rec, interior, (lam, mu))
+    skew = skew_squares(rec, vertex, mu)
+    jump = jump_oscillation(mesh, scene.body_force, rec.basis.elem.k, (lam, mu), 0.0,
+                            element_korn=element)
+    osc = np.sqrt(element / (2 * mu)) * oscillation(scene, rec.basis, boundary, jump)
+    tau_sym, tau_skew = np.zeros_like(osc), np.zeros_like(osc)
+    if jump is not None:
+        if jump.divergence_defect > BALANCE_TOLERANCE:
+            raise NotEquilibrated(f"div tau misses r_2 by {jump.divergence_defect:.1e} "
+                                  f"(relative) > {BALANCE_TOLERANCE:g}: no bound")
+        tau_sym[jump.elements] = np.sqrt(jump.symmetric)
+        tau_skew[jump.elements] = np.sqrt((element[jump.elements] - 1) / (2 * mu) * jump.skew)
+    friedrichs = domain_constants(scene).friedrichs
+    volume = (np.sqrt(compliance) + np.sqrt(skew) + osc + tau_sym + tau_skew
+              + friedrichs * np.sqrt(load)) ** 2
+    parts = dict(symmetric=np.sqrt(compliance.sum()), skew=np.sqrt(skew.sum()),
+                 oscillation=(np.sqrt((osc**2).sum()) + np.sqrt((tau_sym**2).sum())
+                              + np.sqrt((tau_skew**2).sum())),
+                 load=friedrichs * np.sqrt(load.sum()))
+    return smallest(scene, solution, parts, volume, bounds, shear, NAME)
