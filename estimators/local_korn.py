@@ -16,9 +16,9 @@ skew part then deviates from its mean by at most (K - 1)^(1/2) ||eps(v)||_w.
 On a polygon, the angle between a ray from c and an edge [a, b] is smallest at an end: it is
 min(alpha_a, alpha_b), the angles of the triangle (c, a, b) at a and b, and c sees the whole
 polygon when it lies strictly on the inner side of every edge. A triangle's best c is its
-incentre (theta = half its smallest angle); a vertex patch's is taken as the best of its
-vertex, its triangles' centroids and incentres and the midpoints of its edges through the
-vertex (needed where the vertex lies on the boundary, where it sees its own facets at 0).
+incentre (theta = half its smallest angle). An interior vertex's patch is seen from the
+vertex; a boundary vertex sees its own facets at 0, and its patch from the best of its
+triangles' centroids, incentres, edge midpoints and a barycentric lattice (LATTICE).
 """
 
 from __future__ import annotations
@@ -89,16 +89,15 @@ def _patch_pieces(mesh):
     lengths = np.array([np.linalg.norm(x[:, (i + 1) % 3] - x[:, (i + 2) % 3], axis=0)
                         for i in range(3)])
     incentre = (x * lengths[None]).sum(axis=1) / lengths.sum(axis=0)
-    centres = [(np.arange(p.shape[1]), p)]
-    centres += [(t[i], x.mean(axis=1)) for i in range(3)]
-    centres += [(t[i], incentre) for i in range(3)]
-    centres += [(t[i], 0.5 * (x[:, i] + x[:, j])) for i in range(3) for j in range(3) if i != j]
+    centres = [(np.arange(p.shape[1]), p)]  # an interior vertex sees its patch itself
     on_boundary = np.zeros(p.shape[1], dtype=bool)
     on_boundary[mesh.facets[:, boundary]] = True
-    for i in range(3):  # where the vertex sees its own facets at 0: a lattice in its triangles
+    for i in range(3):  # a boundary vertex sees its own facets at 0: other centres
         near = np.flatnonzero(on_boundary[t[i]])
-        for weights in LATTICE:
-            centres.append((t[i, near], np.einsum("j,cjn->cn", weights, x[:, :, near])))
+        points = [x.mean(axis=1), incentre, 0.5 * (x[:, i] + x[:, (i + 1) % 3]),
+                  0.5 * (x[:, i] + x[:, (i + 2) % 3])]
+        points += [np.einsum("j,cjn->cn", weights, x) for weights in LATTICE]
+        centres += [(t[i, near], point[:, near]) for point in points]
     return edges, (np.concatenate([c[0] for c in centres]), np.hstack([c[1] for c in centres]))
 
 

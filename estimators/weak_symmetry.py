@@ -15,7 +15,7 @@ local Korn constants of ``estimators.local_korn`` bound without a global constan
 The constrained minimiser is computed by projected conjugate gradients (Gould, Hribar and
 Nocedal's constraint preconditioner, with the inverse node blocks D^-1 of the unconstrained
 system): every iterate satisfies B phi = g to the round-off of one sparse factorisation of
-S = B D^-1 B', so the objective can stop early (RTOL, as there) while the constraints hold.
+S = B D^-1 B' (the default direct back-end), so the objective can stop early (RTOL, as there) while the constraints hold.
 """
 
 from __future__ import annotations
@@ -24,7 +24,7 @@ from dataclasses import replace
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.sparse.linalg import aslinearoperator, cg, splu
+from scipy.sparse.linalg import aslinearoperator, cg
 from skfem import Basis, BilinearForm, ElementTriP1, LinearForm, asm
 
 from estimators.equilibration import Reconstruction
@@ -36,6 +36,7 @@ from estimators.symmetrisation import (
     rt_dofs,
     stream_system,
 )
+from formulations.solvers.backends import factorise
 
 
 @BilinearForm
@@ -76,14 +77,14 @@ def constrained_stream_function(rt, residual: np.ndarray, values: np.ndarray,
     B = constraint_matrix(rt) @ sp.diags(system.free.astype(float))
     g = -skew_moments(rt, values)
     D = system.blocks
-    factor = splu((B @ D @ B.T).tocsc())
+    solve_s = factorise((B @ D @ B.T).tocsc())  # the default direct back-end
 
     def onto(x: np.ndarray) -> np.ndarray:  # the D-nearest phi with B phi = g
-        return x + D @ (B.T @ factor.solve(g - B @ x))
+        return x + D @ (B.T @ solve_s(g - B @ x))
 
     def reduced(r: np.ndarray) -> np.ndarray:  # D^-1 r with its B-part removed: B z = 0
         z = D @ r
-        return z - D @ (B.T @ factor.solve(B @ z))
+        return z - D @ (B.T @ solve_s(B @ z))
 
     start, _ = cg(system.operator, system.rhs, rtol=RTOL, maxiter=MAX_ITERATIONS,
                   M=aslinearoperator(D))
