@@ -15,7 +15,8 @@ local Korn constants of ``estimators.local_korn`` bound without a global constan
 The constrained minimiser is computed by projected conjugate gradients (Gould, Hribar and
 Nocedal's constraint preconditioner, with the inverse node blocks D^-1 of the unconstrained
 system): every iterate satisfies B phi = g to the round-off of one sparse factorisation of
-S = B D^-1 B' (the default direct back-end), so the objective can stop early (RTOL, as there) while the constraints hold.
+S = B D^-1 B' (the default direct back-end), so the objective can stop early (RTOL, as
+there) while the constraints hold.
 """
 
 from __future__ import annotations
