@@ -7,10 +7,11 @@ int_w skw grad v = 0 satisfies
 
     ||grad v||_w^2 <= K ||eps(v)||_w^2,   K = 2 / sin^2(theta / 2)
 
-(Kim's bound, as used by Bertrand, Kober, Moldenhauer and Starke for weakly symmetric stress
-equilibration: Horgan and Payne's K = 2 (1 + Gamma) = 2 / beta^2 with Costabel and Dauge's
-lower bound beta >= sin(theta / 2) of the inf-sup constant of the divergence). Sharp on a
-disc (theta = pi / 2, K = 4). As |grad v|^2 = |eps(v)|^2 + |skw grad v|^2 pointwise, the
+(Kim, 2011, as used by Bertrand, Kober, Moldenhauer and Starke for weakly symmetric stress
+equilibration; it rests on Horgan and Payne's K = 2 (1 + Gamma) = 2 / beta^2 and a lower
+bound of the inf-sup constant beta of the divergence by the angle, whose proofs Costabel and
+Dauge revisited for star-shaped domains). Sharp on a disc (theta = pi / 2, K = 4); checked
+against discrete Korn constants in tests/estimators/test_local_korn.py. As |grad v|^2 = |eps(v)|^2 + |skw grad v|^2 pointwise, the
 skew part then deviates from its mean by at most (K - 1)^(1/2) ||eps(v)||_w.
 
 On a polygon, the angle between a ray from c and an edge [a, b] is smallest at an end: it is
