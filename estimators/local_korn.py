@@ -11,8 +11,9 @@ int_w skw grad v = 0 satisfies
 equilibration; it rests on Horgan and Payne's K = 2 (1 + Gamma) = 2 / beta^2 and a lower
 bound of the inf-sup constant beta of the divergence by the angle, whose proofs Costabel and
 Dauge revisited for star-shaped domains). Sharp on a disc (theta = pi / 2, K = 4); checked
-against discrete Korn constants in tests/estimators/test_local_korn.py. As |grad v|^2 = |eps(v)|^2 + |skw grad v|^2 pointwise, the
-skew part then deviates from its mean by at most (K - 1)^(1/2) ||eps(v)||_w.
+against discrete Korn constants in tests/estimators/test_local_korn.py. As |grad v|^2 =
+|eps(v)|^2 + |skw grad v|^2 pointwise, the skew part then deviates from its mean by at most
+(K - 1)^(1/2) ||eps(v)||_w.
 
 On a polygon, the angle between a ray from c and an edge [a, b] is smallest at an end: it is
 min(alpha_a, alpha_b), the angles of the triangle (c, a, b) at a and b, and c sees the whole

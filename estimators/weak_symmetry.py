@@ -69,10 +69,15 @@ def constraint_matrix(rt) -> sp.csr_matrix:
                       asm(_skew_of_curl_second, stream, hats)]).tocsr()
 
 
+def hat_moments(rt, density: np.ndarray) -> np.ndarray:
+    """(density, psi_z) per vertex for values (n_el, nq) at the points of ``rt``."""
+    return asm(_against_hats, Basis(rt.mesh, ElementTriP1(), quadrature=rt.quadrature),
+               s=density)
+
+
 def skew_moments(rt, values: np.ndarray) -> np.ndarray:
     """(s(tau), psi_z) per vertex for a field tau (2, 2, n_el, nq) at the points of ``rt``."""
-    hats = Basis(rt.mesh, ElementTriP1(), quadrature=rt.quadrature)
-    return asm(_against_hats, hats, s=0.5 * (values[0, 1] - values[1, 0]))
+    return hat_moments(rt, 0.5 * (values[0, 1] - values[1, 0]))
 
 
 def constrained_stream_function(rt, residual: np.ndarray, values: np.ndarray,
@@ -121,8 +126,7 @@ def weakly_symmetrised(rec: Reconstruction, interior: Interior, prescribed: np.n
                                       prescribed, lame, korn)
     correction = curl_values(rt, phi)
     values = rec.values + correction
-    scale = asm(_against_hats, Basis(rt.mesh, ElementTriP1(), quadrature=rt.quadrature),
-                s=0.5 * (np.abs(values[0, 1]) + np.abs(values[1, 0])))
+    scale = hat_moments(rt, 0.5 * (np.abs(values[0, 1]) + np.abs(values[1, 0])))
     defect = np.abs(skew_moments(rt, values)).max() / max(scale.max(), np.finfo(float).tiny)
     return replace(rec, dofs=rec.dofs + rt_dofs(rt, interior.mass, correction),
                    values=values), float(defect)
