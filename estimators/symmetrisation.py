@@ -87,6 +87,26 @@ def element_system(rt: ReferenceRT, Q: np.ndarray, residual: np.ndarray):
 
 
 @dataclass(frozen=True, eq=False)
+class StreamElements:
+    """The minimisation of the module docstring, element by element: ``matrices`` (n_el, m,
+    m) and ``vectors`` (n_el, m) for the unknowns ``index`` (n_el, m; row r's values at r n +
+    node), and ``free``, the values not pinned."""
+
+    matrices: np.ndarray
+    vectors: np.ndarray
+    index: np.ndarray
+    free: np.ndarray
+
+    def assembled(self, local: np.ndarray) -> np.ndarray:
+        """The global vector of element vectors (n_el, m), 0 on pinned values."""
+        return np.bincount(self.index.ravel(), local.ravel(), minlength=self.free.size) * self.free
+
+    @property
+    def rhs(self) -> np.ndarray:
+        return self.assembled(self.vectors)
+
+
+@dataclass(frozen=True, eq=False)
 class StreamSystem:
     """The minimisation of the module docstring for phi (row r's values at r n + node):
     ``operator`` its matrix on the free values (element matrices, float32 products), ``rhs``,
@@ -98,11 +118,11 @@ class StreamSystem:
     free: np.ndarray
 
 
-def stream_system(rt: ReferenceRT, residual: np.ndarray, prescribed: np.ndarray,
-                  lame: tuple[float, float], korn: float) -> StreamSystem:
-    """The system of the module docstring for the residual sigma* - sigma_h (2, 2, n_el, nq)
-    at the points of ``rt``, phi = 0 on the ``prescribed`` facets (one value pinned per row if
-    there are none: curl ignores constants)."""
+def stream_elements(rt: ReferenceRT, residual: np.ndarray, prescribed: np.ndarray,
+                    lame: tuple[float, float], korn: float) -> StreamElements:
+    """The element data of the module docstring for the residual sigma* - sigma_h (2, 2, n_el,
+    nq) at the points of ``rt``, phi = 0 on the ``prescribed`` facets (one value pinned per
+    row if there are none: curl ignores constants)."""
     dofs = Dofs(rt.mesh, SCALARS[rt.elem.k + 1]())
     n = dofs.N
     matrices, vectors = element_system(rt, density(*lame, WEIGHT * korn**2), residual)
@@ -111,24 +131,28 @@ def stream_system(rt: ReferenceRT, residual: np.ndarray, prescribed: np.ndarray,
               else np.zeros(1, dtype=np.int64))
     free = np.ones(2 * n, dtype=bool)
     free[np.concatenate([pinned, pinned + n])] = False
-    single = matrices.astype(np.float32)  # any phi keeps the bound: float32 products suffice
+    return StreamElements(matrices, vectors, index, free)
 
-    def assemble(local: np.ndarray) -> np.ndarray:
-        return np.bincount(index.ravel(), local.ravel(), minlength=2 * n) * free
+
+def stream_system(elements: StreamElements) -> StreamSystem:
+    """The matrix-free system of ``elements``."""
+    single = elements.matrices.astype(np.float32)  # any phi keeps the bound: float32 suffices
+    index, free = elements.index, elements.free
 
     def apply(x: np.ndarray) -> np.ndarray:
         local = (x * free).astype(np.float32)[index][..., None]
-        return assemble(np.matmul(single, local)[..., 0])
+        return elements.assembled(np.matmul(single, local)[..., 0])
 
-    operator = LinearOperator((2 * n, 2 * n), matvec=apply, dtype=float)
-    return StreamSystem(operator, assemble(vectors), node_blocks(matrices, index, free), free)
+    operator = LinearOperator((free.size, free.size), matvec=apply, dtype=float)
+    return StreamSystem(operator, elements.rhs, node_blocks(elements.matrices, index, free),
+                        free)
 
 
 def stream_function(rt: ReferenceRT, residual: np.ndarray, prescribed: np.ndarray,
                     lame: tuple[float, float], korn: float) -> np.ndarray:
-    """phi (2, dim P_(k+1)) of the module docstring (``stream_system``'s arguments), by
+    """phi (2, dim P_(k+1)) of the module docstring (``stream_elements``' arguments), by
     conjugate gradients preconditioned by the node blocks, to RTOL."""
-    system = stream_system(rt, residual, prescribed, lame, korn)
+    system = stream_system(stream_elements(rt, residual, prescribed, lame, korn))
     phi, _ = cg(system.operator, system.rhs, rtol=RTOL, maxiter=MAX_ITERATIONS,
                 M=aslinearoperator(system.blocks))
     return (phi * system.free).reshape(2, -1)

@@ -12,11 +12,15 @@ Then (skw sigma, skw grad v) = sum_z (psi_z skw sigma, skw grad v - c_z) for any
 skew matrices c_z (their sum sum_z psi_z c_z is continuous and piecewise linear), which the
 local Korn constants of ``estimators.local_korn`` bound without a global constant (13.4).
 
-The constrained minimiser is computed by projected conjugate gradients (Gould, Hribar and
-Nocedal's constraint preconditioner, with the inverse node blocks D^-1 of the unconstrained
-system): every iterate satisfies B phi = g to the round-off of one sparse factorisation of
-S = B D^-1 B' (the default direct back-end), so the objective can stop early
-(PROJECTED_RTOL) while the constraints hold.
+The constrained minimiser solves the saddle-point system [A B'; B 0] (A the minimisation's
+matrix, y the multipliers): with A factorised once by the default direct back-end, conjugate
+gradients on B A^-1 B' y = B A^-1 b - g, which is spectrally like a P1 mass matrix and needs
+about ten iterations whatever h (preconditioned by its diagonal with diag(A) for A). Above
+DIRECT_UNKNOWNS, where that factorisation would take more memory than the contact solve,
+projected conjugate gradients (Gould, Hribar and Nocedal's constraint preconditioner, with
+the inverse node blocks D^-1 of the unconstrained system) keep every iterate on B phi = g by
+one sparse factorisation of S = B D^-1 B' and stop at PROJECTED_RTOL. Either way the last
+step projects onto B phi = g with S, to round-off.
 """
 
 from __future__ import annotations
@@ -25,7 +29,7 @@ from dataclasses import replace
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.sparse.linalg import aslinearoperator, cg
+from scipy.sparse.linalg import LinearOperator, aslinearoperator, cg
 from skfem import Basis, BilinearForm, ElementTriP1, LinearForm, asm
 
 from estimators.equilibration import Reconstruction
@@ -33,12 +37,22 @@ from estimators.patch_data import SCALARS, Interior
 from estimators.symmetrisation import (
     MAX_ITERATIONS,
     RTOL,
+    StreamElements,
     curl_values,
+    node_blocks,
     rt_dofs,
+    stream_elements,
     stream_system,
 )
 from formulations.solvers.backends import factorise
 
+# Above this many unknowns (2 dim P_(k+1)) the projected iterations replace the factorisation
+# of A: at 2.1e6 (`paper`, mixed, P1, 526 338 DOFs) the direct route took 54 s (factorisation
+# 19 s) and 7.0 GiB at peak for the whole estimate, the projected iterations 83 s.
+DIRECT_UNKNOWNS = 2_500_000
+# CG on the multipliers: at 1e-3 (11 iterations) eta agrees with 1e-6 (20) to 1e-7 relative
+# (`paper`, mixed, P1, 33 282 DOFs), the last projection mending the constraints.
+SCHUR_RTOL = 1e-3
 # The projected iterations start from the projection of the unconstrained minimiser, which
 # the constraints move far from the constrained one: stopped at RTOL they left eta 10 % above
 # equilibrated's on `paper`, mixed, P1, 132 098 DOFs (0.5388 against 0.4880; the symmetric
@@ -80,26 +94,38 @@ def skew_moments(rt, values: np.ndarray) -> np.ndarray:
     return hat_moments(rt, 0.5 * (values[0, 1] - values[1, 0]))
 
 
-def constrained_stream_function(rt, residual: np.ndarray, values: np.ndarray,
-                                prescribed: np.ndarray, lame: tuple[float, float],
-                                korn: float) -> np.ndarray:
-    """phi (2, dim P_(k+1)) minimising ``estimators.symmetrisation``'s objective subject to
-    B phi = -(s(sigma*), psi_z) (module docstring); ``values`` sigma* at the points."""
-    system = stream_system(rt, residual, prescribed, lame, korn)
-    B = constraint_matrix(rt) @ sp.diags(system.free.astype(float))
-    g = -skew_moments(rt, values)
-    D = system.blocks
-    solve_s = factorise((B @ D @ B.T).tocsc())  # the default direct back-end
+def stream_matrix(elements: StreamElements) -> sp.csr_matrix:
+    """A assembled, with the identity on the pinned values' rows and columns."""
+    index, free = elements.index, elements.free
+    kept = free[index].astype(float)
+    local = elements.matrices * kept[:, :, None] * kept[:, None, :]
+    m = index.shape[1]
+    rows, cols = np.repeat(index, m, axis=1), np.tile(index, (1, m))
+    return (sp.csr_matrix((local.ravel(), (rows.ravel(), cols.ravel())),
+                          shape=(free.size, free.size))
+            + sp.diags((~free).astype(float))).tocsr()
 
-    def onto(x: np.ndarray) -> np.ndarray:  # the D-nearest phi with B phi = g
-        return x + D @ (B.T @ solve_s(g - B @ x))
 
-    def reduced(r: np.ndarray) -> np.ndarray:  # D^-1 r with its B-part removed: B z = 0
-        z = D @ r
-        return z - D @ (B.T @ solve_s(B @ z))
+def multiplier_iterations(elements: StreamElements, B: sp.csr_matrix,
+                          g: np.ndarray) -> np.ndarray:
+    """The minimiser subject to B phi = g by CG on the multipliers (module docstring)."""
+    A = stream_matrix(elements)
+    solve_a = factorise(A.tocsc())  # the default direct back-end
+    unconstrained = solve_a(elements.rhs)
+    scale = abs(B).power(2) @ (1.0 / A.diagonal())
+    schur = LinearOperator((B.shape[0],) * 2, matvec=lambda y: B @ solve_a(B.T @ y),
+                           dtype=float)
+    y, _ = cg(schur, B @ unconstrained - g, rtol=SCHUR_RTOL, maxiter=MAX_ITERATIONS,
+              M=sp.diags(1.0 / np.where(scale > 0, scale, 1.0)))
+    return unconstrained - solve_a(B.T @ y)
 
+
+def projected_iterations(elements: StreamElements, onto, reduced) -> np.ndarray:
+    """The minimiser subject to B phi = g by projected CG (module docstring): ``onto`` the
+    D-nearest point on the constraints, ``reduced`` D^-1 r with its B-part removed."""
+    system = stream_system(elements)
     start, _ = cg(system.operator, system.rhs, rtol=RTOL, maxiter=MAX_ITERATIONS,
-                  M=aslinearoperator(D))
+                  M=aslinearoperator(system.blocks))
     x = onto(start * system.free)
     r = system.operator @ x - system.rhs
     z = reduced(r)
@@ -114,7 +140,32 @@ def constrained_stream_function(rt, residual: np.ndarray, values: np.ndarray,
         z = reduced(r)
         rz, previous = r @ z, rz
         p = -z + rz / previous * p
-    return (onto(x) * system.free).reshape(2, -1)
+    return x
+
+
+def constrained_stream_function(rt, residual: np.ndarray, values: np.ndarray,
+                                prescribed: np.ndarray, lame: tuple[float, float],
+                                korn: float) -> np.ndarray:
+    """phi (2, dim P_(k+1)) minimising ``estimators.symmetrisation``'s objective subject to
+    B phi = -(s(sigma*), psi_z) (module docstring); ``values`` sigma* at the points."""
+    elements = stream_elements(rt, residual, prescribed, lame, korn)
+    B = (constraint_matrix(rt) @ sp.diags(elements.free.astype(float))).tocsr()
+    g = -skew_moments(rt, values)
+    D = node_blocks(elements.matrices, elements.index, elements.free)
+    solve_s = factorise((B @ D @ B.T).tocsc())  # the default direct back-end
+
+    def onto(x: np.ndarray) -> np.ndarray:  # the D-nearest phi with B phi = g
+        return x + D @ (B.T @ solve_s(g - B @ x))
+
+    def reduced(r: np.ndarray) -> np.ndarray:  # D^-1 r with its B-part removed: B z = 0
+        z = D @ r
+        return z - D @ (B.T @ solve_s(B @ z))
+
+    if elements.free.size <= DIRECT_UNKNOWNS:
+        x = multiplier_iterations(elements, B, g)
+    else:
+        x = projected_iterations(elements, onto, reduced)
+    return (onto(x) * elements.free).reshape(2, -1)
 
 
 def weakly_symmetrised(rec: Reconstruction, interior: Interior, prescribed: np.ndarray,
