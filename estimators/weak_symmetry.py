@@ -16,11 +16,11 @@ The constrained minimiser solves the saddle-point system [A B'; B 0] (A the mini
 matrix, y the multipliers): with A factorised once by the default direct back-end, conjugate
 gradients on B A^-1 B' y = B A^-1 b - g, which is spectrally like a P1 mass matrix and needs
 about ten iterations whatever h (preconditioned by its diagonal with diag(A) for A). Above
-DIRECT_UNKNOWNS, where that factorisation would take more memory than the contact solve,
-projected conjugate gradients (Gould, Hribar and Nocedal's constraint preconditioner, with
-the inverse node blocks D^-1 of the unconstrained system) keep every iterate on B phi = g by
-one sparse factorisation of S = B D^-1 B' and stop at PROJECTED_RTOL. Either way the last
-step projects onto B phi = g with S, to round-off.
+DIRECT_UNKNOWNS, which bounds that factorisation's memory, projected conjugate gradients
+(Gould, Hribar and Nocedal's constraint preconditioner, with the inverse node blocks D^-1 of
+the unconstrained system) keep every iterate on B phi = g by one sparse factorisation of
+S = B D^-1 B' and stop at PROJECTED_RTOL. Either way the last step projects onto B phi = g
+with S, to round-off.
 """
 
 from __future__ import annotations
