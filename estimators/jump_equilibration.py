@@ -38,6 +38,7 @@ from estimators.rt_reference import (
     orientations,
     reference_rt,
     scalar_values,
+    summed_matrix,
 )
 from formulations.elasticity import ELEMENTS, element_diameters
 from formulations.load import MAX_DEPTH, body_load, refined_rule
@@ -211,9 +212,7 @@ def _least_tau(sub, rt, blocks, divergence, data, means=None) -> tuple[np.ndarra
     orthogonal to the rigid motions on every T)."""
     n_sub, n_dg, n_rt = divergence.shape
     dofs = np.concatenate([rt.element_dofs, rt.element_dofs + rt.N]).T   # (n_sub, 2 n_rt)
-    E = sp.csr_matrix((blocks.ravel(), (np.repeat(dofs, 2 * n_rt, axis=1).ravel(),
-                                        np.tile(dofs, (1, 2 * n_rt)).ravel())),
-                      shape=(2 * rt.N, 2 * rt.N))
+    E = summed_matrix(blocks, dofs, 2 * rt.N)
     div_rows = (np.arange(n_sub)[:, None] * n_dg + np.arange(n_dg)).repeat(n_rt, axis=1)
     B = sp.csr_matrix((divergence.ravel(), (div_rows.ravel(),
                                             np.tile(rt.element_dofs.T, (1, n_dg)).ravel())),

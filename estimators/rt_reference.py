@@ -19,6 +19,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.sparse as sp
 from skfem import Basis, ElementTriP1
 from skfem.assembly import Dofs
 from skfem.quadrature import get_quadrature
@@ -133,3 +134,11 @@ def rt_moments(mesh, k: int, X: np.ndarray, W: np.ndarray, fields: np.ndarray,
     weighted = np.einsum("jcp,ap,p->cpaj", phi, weights, W).reshape(pulled.shape[1], -1)
     return ((pulled @ weighted).reshape(n_el, 2, n_w, n_rt).transpose(0, 2, 1, 3)
             * o[:, None, None])
+
+
+def summed_matrix(blocks: np.ndarray, index: np.ndarray, size: int) -> sp.csr_matrix:
+    """The size x size sparse sum of element matrices ``blocks`` (n_el, m, m) on the global
+    unknowns ``index`` (n_el, m)."""
+    m = index.shape[1]
+    rows, cols = np.repeat(index, m, axis=1), np.tile(index, (1, m))
+    return sp.csr_matrix((blocks.ravel(), (rows.ravel(), cols.ravel())), shape=(size, size))

@@ -34,6 +34,7 @@ from skfem import Basis, BilinearForm, ElementTriP1, LinearForm, asm
 
 from estimators.equilibration import Reconstruction
 from estimators.patch_data import SCALARS, Interior
+from estimators.rt_reference import summed_matrix
 from estimators.symmetrisation import (
     MAX_ITERATIONS,
     RTOL,
@@ -99,11 +100,7 @@ def stream_matrix(elements: StreamElements) -> sp.csr_matrix:
     index, free = elements.index, elements.free
     kept = free[index].astype(float)
     local = elements.matrices * kept[:, :, None] * kept[:, None, :]
-    m = index.shape[1]
-    rows, cols = np.repeat(index, m, axis=1), np.tile(index, (1, m))
-    return (sp.csr_matrix((local.ravel(), (rows.ravel(), cols.ravel())),
-                          shape=(free.size, free.size))
-            + sp.diags((~free).astype(float))).tocsr()
+    return (summed_matrix(local, index, free.size) + sp.diags((~free).astype(float))).tocsr()
 
 
 def multiplier_iterations(elements: StreamElements, B: sp.csr_matrix,
