@@ -60,7 +60,8 @@ def nitsche_friction_qp(scene, system: SemismoothSystem, elasticity, trace,
                              tangential_rows(elasticity, trace, t)
                              - sparse.diags(np.repeat(1.0 / system.gamma, block)) @ shear,
                              system.gap, system.weight * system.gamma, system.weight,
-                             trace.points(t), contact_tangents(trace))
+                             trace.points(t), contact_tangents(trace),
+                             near_null=elasticity.rigid_modes)
 
 
 def shear_function(scene, elasticity, trace, gamma_facet: np.ndarray, u_free: np.ndarray,

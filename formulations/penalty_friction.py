@@ -39,7 +39,8 @@ def penalty_friction_qp(scene, elasticity, P: sparse.csr_matrix, gap: np.ndarray
     (both weighted by ``weights``, D); P the normal rows at the points."""
     return slack_friction_qp(scene, elasticity.K_free, elasticity.F_free, P,
                              tangential_rows(elasticity, trace, t), gap, weights, row_length,
-                             trace.points(t), contact_tangents(trace))
+                             trace.points(t), contact_tangents(trace),
+                             near_null=elasticity.rigid_modes)
 
 
 def penalty_friction_state(qp: ContactQP, x: np.ndarray, normal: np.ndarray,

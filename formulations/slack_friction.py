@@ -56,10 +56,12 @@ def shear_vectors(values: np.ndarray, tangents: list[np.ndarray]) -> np.ndarray:
 def slack_friction_qp(scene, K: sparse.spmatrix, F: np.ndarray, P: sparse.spmatrix,
                       R: sparse.spmatrix, gap: np.ndarray, weights: np.ndarray,
                       row_length: np.ndarray, points: np.ndarray,
-                      tangents: list[np.ndarray]) -> ContactQP:
+                      tangents: list[np.ndarray],
+                      near_null: np.ndarray | None = None) -> ContactQP:
     """The QP of the module docstring: unknowns u, the normal slacks, the tangential slacks;
     ``row_length`` the points' shares w_q |e| of Gamma_C, ``points`` their positions,
-    ``tangents`` the facets' (``contact_tangents``)."""
+    ``tangents`` the facets' (``contact_tangents``), ``near_null`` the rigid-body modes of
+    K (the first unknowns; the slacks' block is diagonal)."""
     law, ns = scene.friction, row_length.size
     block = R.shape[0] // ns  # tangential directions per point: d - 1
     eye, eye_t = sparse.identity(ns, format="csr"), sparse.identity(block * ns, format="csr")
@@ -79,4 +81,5 @@ def slack_friction_qp(scene, K: sparse.spmatrix, F: np.ndarray, P: sparse.spmatr
                      B=sparse.hstack([P, -eye, sparse.csr_matrix((ns, block * ns))],
                                      format="csr"), G=gap,
                      row_scale=np.ones(ns),
-                     objective_scale=float(scene.material.young_modulus), friction=friction)
+                     objective_scale=float(scene.material.young_modulus),
+                     near_null=near_null, friction=friction)

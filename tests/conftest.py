@@ -15,6 +15,13 @@ from scenes import Material, Scene
 TOL = 1e-10
 
 
+def energy_difference(discretisation, a, b) -> float:
+    """||a.u - b.u||_K / ||b.u||_K: how far two solves of one discretisation differ."""
+    K = discretisation.elasticity.K
+    e = a.u - b.u
+    return float(np.sqrt(e @ (K @ e) / (b.u @ (K @ b.u))))
+
+
 def interruptible_bench(*args, cwd=None) -> subprocess.Popen:
     """``python -m bench ARGS`` as a child that Ctrl-C (SIGINT) reaches: a shell without job
     control starts background commands with SIGINT ignored, children inherit that, and Python

@@ -43,6 +43,7 @@ from formulations.solvers.box import (
 )
 from formulations.solvers.coulomb import coulomb_fixed_point
 from formulations.solvers.disc import disc_ssn
+from formulations.solvers.projected_friction import solve_projected_tresca, split_preconditioner
 from formulations.solvers.registry import FAST_SOLVER
 
 # the exact active-set steps leave round-off; the fixed point stops when the bound has settled
@@ -63,10 +64,7 @@ def condensed_system(qp: ContactQP, backend: str):
         solve, S, phases = factor.solve, factor.condensed(C), list(factor.phases)
     else:
         solve = factorise(qp.K, backend, qp.near_null)
-        columns = C.T.toarray()
-        X = (np.column_stack([solve(column) for column in columns.T]) if iterative(backend)
-             else solve(columns))
-        S, phases = np.asarray(C @ X), []
+        S, phases = np.asarray(C @ solve(C.T.toarray())), []
     u0 = solve(qp.F)
     shift = qp.friction.shift
     r = C @ u0 - np.concatenate([qp.G, np.zeros(qp.friction.T.shape[0]) if shift is None
@@ -125,6 +123,8 @@ def solve_frictional(qp: ContactQP, warm_start: np.ndarray | None = None, max_it
                             "node: only 1 (2D, a box) and 2 (3D, a disc) are solved")
     start = time.perf_counter()
     backend = check_backend(backend)
+    if iterative(backend):
+        return solve_without_factorisation(qp, warm_start, max_iter, backend)
     solve, C, S, r, phases = condensed_system(qp, backend)
 
     def tresca(step_qp: ContactQP, previous: QPSolution | None) -> QPSolution:
@@ -150,3 +150,23 @@ def solve_frictional(qp: ContactQP, warm_start: np.ndarray | None = None, max_it
     return replace(answer, solve_time=time.perf_counter() - start,
                    diagnostics=replace(answer.diagnostics, phases=tuple(phases)))
 
+
+def solve_without_factorisation(qp: ContactQP, warm_start: np.ndarray | None, max_iter: int,
+                                backend: str) -> QPSolution:
+    """Tresca or Coulomb on an iterative back-end (``projected_friction``): one multigrid
+    hierarchy of K for every step of every Tresca problem."""
+    start = time.perf_counter()
+    precondition = split_preconditioner(qp, backend)
+    phases, counts = [("hierarchy", time.perf_counter() - start)], []
+
+    def tresca(step_qp: ContactQP, previous: QPSolution | None) -> QPSolution:
+        step = solve_projected_tresca(step_qp, precondition, previous, warm_start, max_iter)
+        counts.extend(step.diagnostics.krylov_iterations)
+        return step
+
+    answer = (coulomb_fixed_point(qp, tresca, COULOMB_RTOL) if qp.friction.coulomb
+              else tresca(qp, None))
+    phases.append(("iterate", answer.solve_time))
+    return replace(answer, solve_time=time.perf_counter() - start, backend=backend,
+                   diagnostics=replace(answer.diagnostics, phases=tuple(phases),
+                                       krylov_iterations=tuple(counts)))

@@ -78,13 +78,18 @@ def projected_cg(K, precondition, project, F: np.ndarray, u: np.ndarray, rtol: f
 
 def next_active_set(qp: ContactQP, active: np.ndarray, u: np.ndarray, K, multipliers):
     """(lambda, the next active set) from u solved on ``active`` (module docstring)."""
-    rows = np.flatnonzero(active)
     lam = np.zeros(qp.m)
-    lam[rows] = multipliers(qp.F - K @ u)
+    lam[np.flatnonzero(active)] = multipliers(qp.F - K @ u)
+    return lam, next_rows(qp, active, u, lam)
+
+
+def next_rows(qp: ContactQP, active: np.ndarray, u: np.ndarray, lam: np.ndarray) -> np.ndarray:
+    """The augmented update: keep the active rows whose multiplier is not negative (to the
+    solve's accuracy), add the inactive rows that u violates."""
     slack = qp.G - qp.B @ u
     scale = max(np.abs(u).max(initial=0.0), qp.gap_scale, np.finfo(float).tiny)
     zero = WEAKLY_ACTIVE * np.abs(lam).max(initial=0.0)
-    return lam, np.where(active, lam > -zero, slack < -VIOLATION_TOLERANCE * scale)
+    return np.where(active, lam > -zero, slack < -VIOLATION_TOLERANCE * scale)
 
 
 def solve_projected(qp: ContactQP, active: np.ndarray, max_iter: int, backend: str):

@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 from skfem import Basis, MeshTet, MeshTri
 
+from conftest import energy_difference
 from formulations import get_formulation
 from formulations.discretisation import solve
 from formulations.elasticity import rigid_body_modes, vector_element
@@ -18,12 +19,6 @@ DIRECT = "pardiso" if "pardiso" in backends.available_backends() else "splu"
 # the agreement the back-end promises, 1e-8 relative in energy: CG stops at a relative
 # residual of 1e-10 (amg.RTOL), measured to leave 4e-11 or less on such problems
 ENERGY_AGREEMENT = 1e-8
-
-
-def energy_difference(discretisation, a, b) -> float:
-    K = discretisation.elasticity.K
-    e = a.u - b.u
-    return float(np.sqrt(e @ (K @ e) / (b.u @ (K @ b.u))))
 
 
 @pytest.mark.parametrize("scene,refine,order,formulation", [
