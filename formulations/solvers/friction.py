@@ -14,7 +14,9 @@ K is factorised once and S comes from the same factorisation, as in the friction
 ``active_set``; Coulomb's fixed point (``coulomb``) reuses both for every step, so a Coulomb
 level costs one factorisation too. Two tangential directions per node (3D) make the bound a
 disc, not a box: the same condensed problem is then solved by semismooth Newton
-(``disc.disc_ssn``), warm-started by the previous Coulomb step.
+(``disc.disc_ssn``), warm-started by the previous Coulomb step. An iterative back-end, which
+would form S one Krylov solve per row of C, runs the iteration on the primal side instead
+(``projected_friction``).
 """
 
 from __future__ import annotations
