@@ -58,7 +58,7 @@ class FrictionError(ValueError):
 
 def condensed_system(qp: ContactQP, backend: str):
     """(solve, S, r, phases): a factorisation of K, the condensed C K^-1 C' and its right-hand
-    side, on any back-end (an iterative one solves for each row of C in turn)."""
+    side, on a direct back-end (an iterative one takes ``solve_without_factorisation``)."""
     C = sparse.vstack([qp.B, qp.friction.T], format="csr")
     clock = time.perf_counter()
     if condenses(backend):

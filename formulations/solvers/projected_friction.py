@@ -74,7 +74,7 @@ def first_sets(qp: ContactQP, previous: QPSolution | None,
     if previous is not None and previous.tangential is not None:
         tangential = previous.tangential.reshape(nodes, block)
         size = np.linalg.norm(tangential, axis=1)
-        slips = size >= qp.friction.bound * (1 - 1e-8)
+        slips = size >= qp.friction.bound * (1 - WEAKLY_ACTIVE)
         return FrictionSets(previous.multipliers > 0, ~slips,
                             tangential / np.where(size > 0, size, 1.0)[:, None])
     normal = np.asarray(warm_start) > 0 if warm_start is not None else -qp.G > 0
@@ -101,7 +101,8 @@ def step_rows(qp: ContactQP, sets: FrictionSets):
     force = (friction.bound[:, None] * sets.direction * ~sets.stick[:, None]).ravel()
     kappa = np.zeros(nodes) if sets.stiffness is None else sets.stiffness * ~sets.stick
     across = (np.eye(block)[None] - np.einsum("ni,nj->nij", sets.direction, sets.direction))
-    springs = sparse.block_diag(kappa[:, None, None] * across, format="csr")
+    springs = sparse.bsr_matrix((kappa[:, None, None] * across, np.arange(nodes),
+                                 np.arange(nodes + 1)), shape=(nodes * block,) * 2).tocsr()
     force = force - springs @ shift
     C_A = sparse.vstack([qp.B[np.flatnonzero(sets.normal)], friction.T[stick_rows]],
                         format="csr")
