@@ -1,7 +1,7 @@
 """CI gates: every entry of bench/expected.toml must pass (rates, effectivity, Hertz).
 
-The gate runs take about four minutes on 2 cores, so they are in the slow group that CI runs in
-its second stage (the paper scene's overkill reference is built once and cached under
+The gate runs take about 35 minutes on 2 cores beside the rest of the slow group, which CI runs
+in its second stage (the paper scene's overkill reference is built once and cached under
 .cache/references, or $SIGNORINI_BENCH_CACHE)."""
 
 import pytest
@@ -23,7 +23,7 @@ def verdicts(tmp_path_factory):
     return verdicts
 
 
-@pytest.mark.slow  # the gate runs take about four minutes on 2 cores
+@pytest.mark.slow  # the gate runs: about 35 minutes on 2 cores
 @pytest.mark.parametrize("gate", GATES)
 def test_gate(verdicts, gate):
     mine = [v for v in verdicts if v.gate == gate]
