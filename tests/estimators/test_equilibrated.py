@@ -76,7 +76,7 @@ def test_reconstruction_is_equilibrated(formulation, options):
     assert rec.imbalance <= 1e-10  # the balanced patches: round-off only
 
 
-@pytest.mark.parametrize("order", [1, 2, 3])
+@pytest.mark.parametrize("order", [1, 2, pytest.param(3, marks=pytest.mark.slow)])  # P3: ~6 s
 @pytest.mark.parametrize("formulation, options", [("mixed", {}), ("vi", {}), ("penalty", {}),
                                                   ("nitsche", {"theta": 1.0}),
                                                   ("nitsche", {"theta": 0.0})])

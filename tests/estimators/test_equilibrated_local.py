@@ -25,7 +25,7 @@ from scenes import get_scene
 LAME = (0.5769, 0.3846)  # E = 1, nu = 0.3
 
 
-@pytest.mark.parametrize("order", [1, 3])
+@pytest.mark.parametrize("order", [1, pytest.param(3, marks=pytest.mark.slow)])  # P3: ~12 s
 @pytest.mark.parametrize("formulation, options", [("mixed", {}), ("vi", {}),
                                                   ("nitsche", {"theta": 1.0})])
 def test_bound_is_above_the_exact_error(formulation, options, order):

@@ -63,6 +63,7 @@ def _interpolate(sol, points):
     return np.einsum("kn,ikn->in", weights, nodal[:, mesh.t[:, element]])
 
 
+@pytest.mark.slow  # builds a reference: about 15 s
 def test_reference_error_agrees_with_exact_error_on_non_nested_meshes(tmp_path, monkeypatch):
     # an adaptive reference (not nested with a uniform u_h) measures the same error as the exact
     # solution, up to the reference's own error

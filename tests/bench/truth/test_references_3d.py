@@ -29,6 +29,7 @@ def test_tetrahedral_scenes_get_p2_recipes():
     assert recipes_for(get_scene("paper")) == ("mixed-p3", "mixed-p2")
 
 
+@pytest.mark.slow  # the 45 000-DOF reference: about 40 s to build, once per module
 def test_the_error_bar_is_of_the_size_of_the_true_error(reference):
     scene, ref = reference
     assert isinstance(ref.mesh, MeshTet) and ref.recipe == "vi-p2" and ref.order == 2
@@ -42,6 +43,7 @@ def test_the_error_bar_is_of_the_size_of_the_true_error(reference):
     assert 0.5 < ref.estimated_error / true_error < 2.0, (ref.estimated_error, true_error)
 
 
+@pytest.mark.slow  # the 45 000-DOF reference: about 40 s to build, once per module
 def test_a_cached_reference_loads_as_it_was_built(reference):
     scene, ref = reference
     again = cache.load_or_build(scene, BUDGET)
@@ -49,6 +51,7 @@ def test_a_cached_reference_loads_as_it_was_built(reference):
     assert again.pressure_s.shape == ref.pressure_s.shape and again.zone == ref.zone
 
 
+@pytest.mark.slow  # the 45 000-DOF reference: about 40 s to build, once per module
 def test_reference_errors_agree_with_exact_errors(reference):
     scene, ref = reference
     sol = solve(get_formulation("vi")(scene, scene.mesh.refined(1)), "active-set")
@@ -62,6 +65,7 @@ def test_reference_errors_agree_with_exact_errors(reference):
     assert measured.pressure_error == pytest.approx(exact.pressure_error, rel=1.0)
 
 
+@pytest.mark.slow  # the 45 000-DOF reference: about 40 s to build, once per module
 def test_the_pressure_is_interpolated_over_the_contact_plane(reference):
     scene, ref = reference
     x = np.array([[0.0, 0.1, 0.3, 0.9], [0.0, 0.2, 0.1, 0.0]])
