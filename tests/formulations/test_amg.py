@@ -101,3 +101,26 @@ def test_a_problem_whose_solution_is_zero_gets_exactly_zero(formulation):
     answer = solve(discretisation, "active-set", backend="amg", warm_start=np.ones(m))
     assert answer.status == "ok", answer.reason
     assert not np.any(answer.u)
+
+
+@pytest.mark.parametrize("scene,refine", [("paper", 3), ("paper-3d", 1)])
+def test_the_v_cycle_is_pyamgs_own_in_single_precision(scene, refine):
+    """The back-end's V-cycle against PyAMG's ``aspreconditioner`` on the same single-precision
+    hierarchy (a cycle of its ``solve``, which also computes residuals around it): the same
+    operations in float32, so they agree to a few float32 roundings (eps 6e-8; 1e-5 leaves room
+    for the coarse LU and the sweeps' accumulation), and the cycle is symmetric to that
+    accuracy (CG needs it)."""
+    scene = get_scene(scene)
+    qp = get_formulation("vi")(scene, scene.mesh.refined(refine)).qp
+    solve_k = backends.factorise(qp.K, "amg", qp.near_null)
+    cycle = solve_k.preconditioner
+    assert isinstance(cycle, amg.VCycle)
+    pyamg_cycle = cycle.hierarchy.aspreconditioner(cycle="V")
+    assert len(cycle.levels) >= 2  # a coarse correction was exercised
+    rng = np.random.default_rng(1)
+    x, y = rng.standard_normal((2, qp.n))
+    ours = cycle @ x
+    theirs = pyamg_cycle @ x.astype(amg.CYCLE_DTYPE)
+    assert np.linalg.norm(ours - theirs) <= 1e-5 * np.linalg.norm(theirs)
+    # a one-sided cycle (forward sweeps both times) leaves about |y||Mx| / sqrt(n) here
+    assert abs(y @ ours - x @ (cycle @ y)) <= 1e-5 * np.linalg.norm(y) * np.linalg.norm(ours)

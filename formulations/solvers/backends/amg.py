@@ -106,14 +106,54 @@ def factorise(K: sparse.spmatrix, near_null: np.ndarray | None = None) -> Iterat
         K.astype(CYCLE_DTYPE), B=modes, symmetry="symmetric" if symmetric else "nonsymmetric",
         strength=("symmetric", {"theta": 0.0}), max_coarse=500, coarse_solver="splu",
         presmoother=SMOOTHING[0], postsmoother=SMOOTHING[1])
-    return IterativeSolve(K, in_double(hierarchy.aspreconditioner(cycle="V")), symmetric)
+    in_single(hierarchy)
+    return IterativeSolve(K, VCycle(hierarchy), symmetric)
 
 
-def in_double(cycle) -> LinearOperator:
-    """The single-precision V-cycle as an operator on double vectors."""
-    return LinearOperator(cycle.shape, dtype=float,
-                          matvec=lambda r: cycle.matvec(np.asarray(r, dtype=CYCLE_DTYPE))
-                          .astype(float))
+def in_single(hierarchy) -> None:
+    """Every level's operator and transfer in CYCLE_DTYPE."""
+    from pyamg.relaxation.smoothing import change_smoothers
+
+    for level in hierarchy.levels:
+        for name in ("A", "P", "R"):
+            if hasattr(level, name):
+                setattr(level, name, single(getattr(level, name)))
+    change_smoothers(hierarchy, SMOOTHING[0], SMOOTHING[1])
+
+
+def single(M: sparse.spmatrix) -> sparse.spmatrix:
+    """M in CYCLE_DTYPE on its own index arrays (``astype`` would sum duplicates first); a
+    transfer with 1 x 6 blocks as CSR, whose products are faster than BSR's (paper-3d,
+    104 544 DOFs: 3.1 against 3.7 ms)."""
+    if M.format == "bsr" and 1 in M.blocksize:
+        M = M.tocsr()
+    if M.format not in ("csr", "bsr"):
+        return M.astype(CYCLE_DTYPE)
+    return type(M)((M.data.astype(CYCLE_DTYPE), M.indices, M.indptr), shape=M.shape)
+
+
+class VCycle(LinearOperator):
+    """One V-cycle from a zero initial guess, on double vectors, in CYCLE_DTYPE: PyAMG's
+    ``aspreconditioner`` runs its ``solve``, which adds two residuals on the finest level to
+    every cycle (a quarter of its cost on paper-3d at 104 544 DOFs)."""
+
+    def __init__(self, hierarchy):
+        super().__init__(dtype=float, shape=hierarchy.levels[0].A.shape)
+        self.hierarchy = hierarchy
+        self.levels, self.coarse = hierarchy.levels, hierarchy.coarse_solver
+
+    def _matvec(self, b):
+        return self.cycle(0, np.asarray(b, dtype=CYCLE_DTYPE).ravel()).astype(float)
+
+    def cycle(self, depth: int, b: np.ndarray) -> np.ndarray:
+        level = self.levels[depth]
+        if depth == len(self.levels) - 1:
+            return np.asarray(self.coarse(level.A, b), dtype=CYCLE_DTYPE)
+        x = np.zeros_like(b)
+        level.presmoother(level.A, x, b)
+        x += level.P @ self.cycle(depth + 1, level.R @ (b - level.A @ x))
+        level.postsmoother(level.A, x, b)
+        return x
 
 
 register_backend(Backend(
