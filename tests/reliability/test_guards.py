@@ -152,11 +152,17 @@ def test_an_output_folder_that_cannot_be_written_is_refused_first(capsys, folder
     assert "cannot be written" in err and "Traceback" not in err
 
 
-@pytest.fixture
-def small_results(tmp_path):
-    out = tmp_path / "res"
+@pytest.fixture(scope="module")
+def small_run(tmp_path_factory):
+    out = tmp_path_factory.mktemp("small") / "res"
     assert main(["run", "--max-dofs", "300", "--out", str(out)]) == 0
     return out
+
+
+@pytest.fixture
+def small_results(small_run, tmp_path):
+    """A copy of one small run, for a test to damage."""
+    return shutil.copytree(small_run, tmp_path / "res")
 
 
 def test_a_truncated_parquet_without_partitions_falls_back_to_its_csv_mirror(small_results,

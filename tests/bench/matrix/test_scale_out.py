@@ -1,6 +1,7 @@
 """The store under concurrent writers and interrupts, resume, sweeps, and the matrix on Dask."""
 
 import os
+import shutil
 import signal
 import time
 
@@ -16,6 +17,13 @@ from conftest import interruptible_bench
 NUMBERS = ["ndofs", "energy", "contact_force", "eta", "energy_error", "effectivity_index"]
 SMALL = dict(scenes=("free-boundary",), formulations=("mixed", "vi"), solvers=("active-set",),
              estimators=("residual",), strategies=("uniform", "adaptive"), max_dofs=2500)
+
+
+@pytest.fixture(scope="module")
+def small_run(tmp_path_factory):
+    """(folder, result) of one in-process run of SMALL, for the tests to compare with or copy."""
+    out = tmp_path_factory.mktemp("small")
+    return out, run(RunConfig(**SMALL, out=str(out)))
 
 
 def same_rows(a: pd.DataFrame, b: pd.DataFrame) -> None:
@@ -50,11 +58,11 @@ def test_two_runs_into_one_folder_at_once_lose_nothing(tmp_path):
     assert set(table["sequence_end"]) <= {"budget", "max_levels"}
 
 
-def test_a_rerun_reuses_finished_sequences_and_reruns_the_rest(tmp_path):
-    config = RunConfig(**SMALL, out=str(tmp_path))
-    first = run(config)
+def test_a_rerun_reuses_finished_sequences_and_reruns_the_rest(small_run, tmp_path):
+    out = shutil.copytree(small_run[0], tmp_path / "rerun")
+    config, first = RunConfig(**SMALL, out=str(out)), small_run[1]
     assert len(first.rows) == len(first.table) and not first.reused
-    store = ResultStore(tmp_path)
+    store = ResultStore(out)
     # cut one sequence short, as a killed run leaves it: no end recorded, levels missing
     key = first.table["sequence_key"].iloc[0]
     part = store.partitions / f"{key}.parquet"
@@ -64,12 +72,12 @@ def test_a_rerun_reuses_finished_sequences_and_reruns_the_rest(tmp_path):
     assert set(second.reused) == set(first.table["sequence_key"]) - {key}
     assert {r.sequence_key for r in second.rows} == {key}
     same_rows(first.table, second.table)
-    assert len(pd.read_parquet(tmp_path / "results.parquet")) == len(first.table)
-    assert len(run(RunConfig(**SMALL, out=str(tmp_path), overwrite=True)).reused) == 0
+    assert len(pd.read_parquet(out / "results.parquet")) == len(first.table)
+    assert len(run(RunConfig(**SMALL, out=str(out), overwrite=True)).reused) == 0
 
 
-def test_the_report_prefers_a_finished_sequence_over_a_cut_short_rerun(tmp_path):
-    table = run(RunConfig(**SMALL, out=str(tmp_path))).table
+def test_the_report_prefers_a_finished_sequence_over_a_cut_short_rerun(small_run):
+    table = small_run[1].table
     short = table[table["level"] <= 1].assign(run_id="99999999T999999-ffffff",
                                               sequence_end="interrupted")
     shown = latest_run(pd.concat([table, short], ignore_index=True))
@@ -129,8 +137,8 @@ def test_sweep_values_are_checked_by_name_and_by_value(tmp_path):
         run(RunConfig(formulations=("mixed:ratio=1",), max_dofs=300, out=str(tmp_path)))
 
 
-def test_two_dask_workers_give_the_rows_of_the_in_process_run(tmp_path):
-    here = run(RunConfig(**SMALL, out=str(tmp_path / "here"))).table
+def test_two_dask_workers_give_the_rows_of_the_in_process_run(small_run, tmp_path):
+    here = small_run[1].table
     dask = run(RunConfig(**SMALL, out=str(tmp_path / "dask"), workers=2)).table
     same_rows(here, dask)
     assert len(pd.read_parquet(tmp_path / "dask" / "results.parquet")) == len(here)
