@@ -107,9 +107,8 @@ def test_a_problem_whose_solution_is_zero_gets_exactly_zero(formulation):
 def test_the_v_cycle_is_pyamgs_own_in_single_precision(scene, refine):
     """The back-end's V-cycle against PyAMG's ``aspreconditioner`` on the same single-precision
     hierarchy (a cycle of its ``solve``, which also computes residuals around it): the same
-    operations in float32, so they agree to a few float32 roundings (eps 6e-8; 1e-5 leaves room
-    for the coarse LU and the sweeps' accumulation), and the cycle is symmetric to that
-    accuracy (CG needs it)."""
+    operations in float32 (measured identical; 1e-5 allows a different order of a few float32
+    roundings, eps 6e-8), and the cycle is symmetric to that accuracy (CG needs it)."""
     scene = get_scene(scene)
     qp = get_formulation("vi")(scene, scene.mesh.refined(refine)).qp
     solve_k = backends.factorise(qp.K, "amg", qp.near_null)
@@ -122,5 +121,6 @@ def test_the_v_cycle_is_pyamgs_own_in_single_precision(scene, refine):
     ours = cycle @ x
     theirs = pyamg_cycle @ x.astype(amg.CYCLE_DTYPE)
     assert np.linalg.norm(ours - theirs) <= 1e-5 * np.linalg.norm(theirs)
-    # a one-sided cycle (forward sweeps both times) leaves about |y||Mx| / sqrt(n) here
+    # measured 1.2e-8 (paper) and 4.6e-9 (paper-3d) relative; a one-sided cycle (forward
+    # sweeps before and after) leaves 2.0e-4 and 8.1e-4, twenty times the bound and more
     assert abs(y @ ours - x @ (cycle @ y)) <= 1e-5 * np.linalg.norm(y) * np.linalg.norm(ours)
