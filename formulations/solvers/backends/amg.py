@@ -23,6 +23,7 @@ import numpy as np
 from scipy import sparse
 from scipy.sparse.linalg import LinearOperator, cg, gmres
 
+from formulations.solvers.backends.amg_hierarchy import MAX_COARSE, smoothed_aggregation
 from formulations.solvers.backends.base import Backend, FactorisationError, register_backend
 
 # relative residual |b - K x| / |b| of every solve. Energy-norm difference to the direct
@@ -101,11 +102,14 @@ def factorise(K: sparse.spmatrix, near_null: np.ndarray | None = None) -> Iterat
 
     K = sparse.csr_matrix(K)
     symmetric = is_symmetric(K)
-    modes = None if near_null is None else np.ascontiguousarray(near_null, dtype=CYCLE_DTYPE)
-    hierarchy = pyamg.smoothed_aggregation_solver(
-        K.astype(CYCLE_DTYPE), B=modes, symmetry="symmetric" if symmetric else "nonsymmetric",
-        strength=("symmetric", {"theta": 0.0}), max_coarse=500, coarse_solver="splu",
-        presmoother=SMOOTHING[0], postsmoother=SMOOTHING[1])
+    modes = np.ones((K.shape[0], 1)) if near_null is None else near_null
+    if symmetric:  # PyAMG's steps, its spectral radius estimated in single precision
+        hierarchy = smoothed_aggregation(K.astype(CYCLE_DTYPE), modes)
+    else:
+        hierarchy = pyamg.smoothed_aggregation_solver(
+            K.astype(CYCLE_DTYPE), B=np.asarray(modes, dtype=CYCLE_DTYPE),
+            symmetry="nonsymmetric", strength=("symmetric", {"theta": 0.0}),
+            max_coarse=MAX_COARSE, coarse_solver="splu")
     in_single(hierarchy)
     return IterativeSolve(K, VCycle(hierarchy), symmetric)
 
