@@ -63,8 +63,10 @@ REFINED = 1e-11
 # steps each): condensed 0.77 / 2.88 / 6.92 / 22.9 s against sparse 1.14 / 1.99 / 3.73 /
 # 8.29 s at nq = 1068 / 1810 / 2556 / 4262 (86k to 504k DOFs)
 SPARSE_NEWTON_FROM = 1500
-# an iterative back-end's relative residual while the active set changes (``projected``)
-SEARCH_RTOL = 1e-4
+# an iterative back-end's relative residual while the active set changes. paper-3d P1,
+# V-cycles in all with 1e-4 / 1e-3, the same u: penalty 120 / 123 at 13 872 DOFs and
+# 561 / 290 at 104 544, nitsche 115 / 94 and 207 / 189
+SEARCH_RTOL = 1e-3
 
 
 
