@@ -6,7 +6,8 @@ V-cycles on a mesh-independent hierarchy. ``factorise(K, near_null)`` builds the
 and returns a solve that runs conjugate gradients (symmetric K) or GMRES (a nonsymmetric
 Jacobian: Nitsche with theta != 1) to the relative residual ``RTOL``. A solve that does not
 reach RTOL raises ``FactorisationError`` with the residual reached: never an inaccurate answer
-passed on.
+passed on. The hierarchy of a symmetric K comes from ``amg_hierarchy`` (PyAMG's steps, every
+level in single precision); a nonsymmetric one from PyAMG's ``smoothed_aggregation_solver``.
 
 There is no cheap Schur complement, so the active-set solver runs its projected iteration
 (``formulations.solvers.projected``) and the semismooth Newton its sparse steps on this
