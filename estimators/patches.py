@@ -5,7 +5,8 @@ to the patch of that vertex. A patch's unknowns are the RT DOFs of its elements 
 neither on the facets opposite its vertex (zero flux) nor prescribed (Neumann and contact
 data), then per element the P_k DG multipliers of the divergence constraint; the two rows of
 the stress share the matrix and are its two right-hand sides. Patches of the same system size
-are stacked and solved by one batched dense LU.
+are stacked; a chunk of them is solved by one batched dense LU, or, where patches share their
+system (``estimators.patch_classes``), by the inverses of the chunk's distinct systems.
 """
 
 from __future__ import annotations
@@ -15,6 +16,8 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
+
+from estimators.patch_classes import element_classes, patch_classes
 
 ZERO, FREE, FIXED = 0, 1, 2
 BATCH = 2000  # patches per stacked solve: bounds the memory of the dense systems
@@ -37,7 +40,8 @@ class PatchLayout:
     (P, n_rt) the position of a FREE DOF of row 0 (row 1 follows after ``n_free``),
     ``n_free`` (n_vertices,), ``rank`` (P,) the pair's position among its patch's elements,
     ``count`` (n_vertices,) elements per patch, ``key_dof`` the global DOF of each distinct
-    (patch, DOF) FREE unknown and ``key_of`` (P, n_rt) the key of each FREE DOF."""
+    (patch, DOF) FREE unknown, ``key_of`` (P, n_rt) the key of each FREE DOF, and ``by_patch``
+    the pairs patch by patch, each patch's in rank order, from ``start`` (n_vertices,)."""
 
     patch: np.ndarray
     status: np.ndarray
@@ -47,6 +51,14 @@ class PatchLayout:
     count: np.ndarray
     key_dof: np.ndarray
     key_of: np.ndarray
+    by_patch: np.ndarray
+    start: np.ndarray
+
+    def pairs_of(self, patches: np.ndarray) -> np.ndarray:
+        """The pairs of ``patches``, patch by patch in that order."""
+        count = self.count[patches]
+        offset = np.arange(count.sum()) - np.repeat(np.cumsum(count) - count, count)
+        return self.by_patch[np.repeat(self.start[patches], count) + offset]
 
 
 def layout(patch: np.ndarray, dofs: np.ndarray, status: np.ndarray, holder: np.ndarray,
@@ -74,7 +86,8 @@ def layout(patch: np.ndarray, dofs: np.ndarray, status: np.ndarray, holder: np.n
     key_dof[key_of[own]] = dofs[own]
     return PatchLayout(patch=patch, status=status,
                        local=np.where(free, key_of - first[patch][:, None], -1),
-                       n_free=n_free, rank=rank, count=count, key_dof=key_dof, key_of=key_of)
+                       n_free=n_free, rank=rank, count=count, key_dof=key_dof, key_of=key_of,
+                       by_patch=order, start=starts)
 
 
 @dataclass(frozen=True, eq=False)
@@ -98,53 +111,122 @@ def solve_patches(lay: PatchLayout, pairs: PairMatrices, clamped: np.ndarray) ->
 
     one system per patch with the two rows of the stress as right-hand sides. Off Gamma_D
     (``clamped`` False) the first multiplier is dropped: the data balance, so its equation
-    follows from the others (docs/theory.md, 13.2)."""
+    follows from the others (docs/theory.md, 13.2). Patches with equal systems
+    (``estimators.patch_classes``) share one factorisation."""
     rhs, data = pairs.rhs.copy(), pairs.data.copy()
     touched = np.flatnonzero((lay.status == FIXED).any(axis=1))  # pairs on Gamma_N, Gamma_C
     fixed, element = pairs.fixed[touched], touched // 3
     rhs[touched] -= np.matmul(pairs.mass[element], fixed)
     data[touched] -= np.matmul(pairs.divergence[element], fixed)
     size = lay.n_free + lay.count * pairs.divergence.shape[1]
+    owner = _owners(lay, pairs, clamped, size)
     out = np.zeros((lay.key_dof.size, 2))
-    jobs = [(chunk, int(n)) for n in np.unique(size)
-            for chunk in np.array_split(np.flatnonzero(size == n),
-                                        max(1, -(-(size == n).sum() // BATCH)))]
+    jobs = []
+    for n in np.unique(size):
+        members = np.flatnonzero(size == n)
+        members = members[np.argsort(owner[members], kind="stable")]   # classes together
+        jobs += [(chunk, int(n)) for chunk in np.array_split(members, -(-members.size // BATCH))]
     with ThreadPoolExecutor(max_workers=worker_count()) as pool:
-        list(pool.map(lambda job: _solve_chunk(lay, job[0], job[1], pairs,
-                                               (rhs, data), clamped, out), jobs))
+        list(pool.map(lambda job: _solve_chunk(lay, job[0], job[1], pairs, (rhs, data),
+                                               clamped, owner, out), jobs))
     return out
 
 
-def _solve_chunk(lay, chunk, n, pairs, right, clamped, out) -> None:
-    rhs, data = right
-    position = np.full(lay.n_free.size, -1)
-    position[chunk] = np.arange(chunk.size)
-    sel = np.flatnonzero(position[lay.patch] >= 0)
-    g = position[lay.patch[sel]]
-    nf = lay.n_free[lay.patch[sel]]
-    n_dg = pairs.divergence.shape[1]
-    free = lay.status[sel] == FREE
-    loc = lay.local[sel]
-    div_at = nf + lay.rank[sel] * n_dg
+def _owners(lay: PatchLayout, pairs: PairMatrices, clamped: np.ndarray,
+            size: np.ndarray) -> np.ndarray:
+    """For every patch a patch with the same system: equal size, clamping, and per element
+    rank the same element matrices at the same positions."""
+    element_owner = element_classes(pairs.mass, pairs.divergence)
+    n_rt = lay.local.shape[1]
+    owner = np.arange(lay.count.size)
+    for n in np.unique(size):
+        members = np.flatnonzero(size == n)
+        count = lay.count[members]
+        keys = np.full((members.size, 2 + count.max() * (1 + n_rt)), -2, dtype=np.int64)
+        keys[:, 0], keys[:, 1] = count, clamped[members]
+        for r in range(count.max()):
+            has = count > r
+            pair = lay.by_patch[lay.start[members[has]] + r]
+            column = 2 + r * (1 + n_rt)
+            keys[has, column] = element_owner[pair // 3]
+            keys[has, column + 1:column + 1 + n_rt] = lay.local[pair]
+        owner[members] = members[patch_classes(keys)]
+    return owner
+
+
+def _solve_chunk(lay, chunk, n, pairs, right, clamped, owner, out) -> None:
+    """The patches ``chunk`` (of system size n): one system per class in the chunk, then
+    either one LU per patch or, where classes repeat, the classes' inverses."""
+    classes, position = np.unique(owner[chunk], return_inverse=True)
+    A = _systems(lay, classes, n, pairs, clamped)
+    view = _ChunkPairs.of(lay, chunk, n, pairs.divergence.shape[1])
+    b = _right_hand_sides(lay, view, n, pairs, right, clamped)
+    if 4 * classes.size > chunk.size:     # few repeats: an LU per patch is cheaper
+        x = np.linalg.solve(A[position.ravel()], b)
+    else:                                 # chunk sorted by class: one product per class
+        x = np.empty_like(b)
+        bounds = np.flatnonzero(np.diff(position.ravel(), prepend=-1, append=-1))
+        for c, (lo, hi) in enumerate(zip(bounds[:-1], bounds[1:], strict=True)):
+            x[lo:hi] = np.einsum("ij,mjr->mir", np.linalg.inv(A[c]), b[lo:hi], optimize=True)
+    gf = np.broadcast_to(view.g[:, None], view.free.shape)[view.free]
+    out[lay.key_of[view.sel][view.free]] = x[gf, view.loc[view.free]]
+
+
+@dataclass(frozen=True, eq=False)
+class _ChunkPairs:
+    """The pairs ``sel`` of a chunk of ``size`` patches: their patch's position ``g`` in the
+    chunk, FREE mask, local positions and first multiplier row ``div_at``."""
+
+    size: int
+    sel: np.ndarray
+    g: np.ndarray
+    free: np.ndarray
+    loc: np.ndarray
+    div_at: np.ndarray
+
+    @staticmethod
+    def of(lay: PatchLayout, chunk: np.ndarray, n: int, n_dg: int) -> _ChunkPairs:
+        sel = lay.pairs_of(chunk)
+        g = np.repeat(np.arange(chunk.size), lay.count[chunk])
+        return _ChunkPairs(size=chunk.size, sel=sel, g=g,
+                           free=lay.status[sel] == FREE, loc=lay.local[sel],
+                           div_at=lay.n_free[lay.patch[sel]] + lay.rank[sel] * n_dg)
+
+    def dropped(self, lay: PatchLayout, clamped: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The patch positions and rows of the dropped multipliers (off Gamma_D)."""
+        neumann = (lay.rank[self.sel] == 0) & ~clamped[lay.patch[self.sel]]
+        return self.g[neumann], self.div_at[neumann]
+
+
+def _systems(lay, chunk, n, pairs, clamped) -> np.ndarray:
+    """The matrices (len(chunk), n, n) of the patches ``chunk``."""
+    view = _ChunkPairs.of(lay, chunk, n, pairs.divergence.shape[1])
     entries = _Entries(chunk.size, n, 2)
-    element = sel // 3
-    entries.matrix(g, loc[:, :, None], loc[:, None, :], pairs.mass[element],
+    element = view.sel // 3
+    free = view.free
+    entries.matrix(view.g, view.loc[:, :, None], view.loc[:, None, :], pairs.mass[element],
                    free[:, :, None] & free[:, None, :])
-    _constraint(entries, g, div_at, loc, free, pairs.divergence[element])
-    rows = div_at[:, None] + np.arange(n_dg)
-    for r in (0, 1):
-        entries.vector(g, loc, rhs[sel][..., r], free, r)
-        entries.vector(g, rows, data[sel][..., r], np.ones(rows.shape, bool), r)
-    A, b = entries.assembled()
-    neumann = (lay.rank[sel] == 0) & ~clamped[lay.patch[sel]]
-    k, d = g[neumann], div_at[neumann]
+    _constraint(entries, view.g, view.div_at, view.loc, free, pairs.divergence[element])
+    A = entries.assembled_matrix()
+    k, d = view.dropped(lay, clamped)
     A[k, d, :] = 0.0
     A[k, :, d] = 0.0
     A[k, d, d] = 1.0
+    return A
+
+
+def _right_hand_sides(lay, view, n, pairs, right, clamped) -> np.ndarray:
+    """The right-hand sides (patches, n, 2) of the chunk ``view``."""
+    rhs, data = right
+    entries = _Entries(view.size, n, 2)
+    rows = view.div_at[:, None] + np.arange(pairs.divergence.shape[1])
+    for r in (0, 1):
+        entries.vector(view.g, view.loc, rhs[view.sel][..., r], view.free, r)
+        entries.vector(view.g, rows, data[view.sel][..., r], np.ones(rows.shape, bool), r)
+    b = entries.assembled_vector()
+    k, d = view.dropped(lay, clamped)
     b[k, d] = 0.0
-    x = np.linalg.solve(A, b)
-    gf = np.broadcast_to(g[:, None], free.shape)[free]
-    out[lay.key_of[sel][free]] = x[gf, loc[free]]
+    return b
 
 
 class _Entries:
@@ -167,13 +249,14 @@ class _Entries:
         self.b_index.append(flat[mask])
         self.b_value.append(values[mask])
 
-    def assembled(self) -> tuple[np.ndarray, np.ndarray]:
-        size = self.count * self.n
-        A = np.bincount(np.concatenate(self.a_index), np.concatenate(self.a_value),
-                        minlength=size * self.n).reshape(self.count, self.n, self.n)
-        b = np.bincount(np.concatenate(self.b_index), np.concatenate(self.b_value),
-                        minlength=size * self.columns).reshape(self.count, self.n, self.columns)
-        return A, b
+    def assembled_matrix(self) -> np.ndarray:
+        return np.bincount(np.concatenate(self.a_index), np.concatenate(self.a_value),
+                           minlength=self.count * self.n**2).reshape(self.count, self.n, self.n)
+
+    def assembled_vector(self) -> np.ndarray:
+        return np.bincount(np.concatenate(self.b_index), np.concatenate(self.b_value),
+                           minlength=self.count * self.n * self.columns
+                           ).reshape(self.count, self.n, self.columns)
 
 
 def _constraint(entries: _Entries, g, start, loc, free, block) -> None:

@@ -1,0 +1,65 @@
+"""Vertex patches whose saddle-point systems are equal (docs/theory.md, section 13.2, "Patch
+classes").
+
+With the Piola map the RT_k mass matrix of a triangle depends only on its shape up to
+translation, rotation and scale (J'J / |det J|) and the orientations of its facets, and the
+divergence matrix only on those orientations. A patch system is assembled from its elements'
+matrices at positions fixed by the patch layout, so two patches whose elements have equal
+matrices, in the same order and at the same positions, have the same system; only the
+right-hand sides differ. Meshes refined from a few starting triangles have few such classes
+(143 for the 261 121 interior patches of `paper` refined seven times), so each class's system
+is factorised once.
+
+Grouping is by hashes; every member is then compared with its class's representative, and a
+member that differs (a hash collision, or matrices that differ by more than round-off) forms a
+class of its own, so a class never holds two different systems.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+ELEMENT_TOLERANCE = 1e-12  # relative: equal up to round-off of the reference-data contraction
+_SEED = 20261129
+
+
+def element_classes(mass: np.ndarray, divergence: np.ndarray) -> np.ndarray:
+    """For every element the index of an element with the same mass (n_el, n, n) and
+    divergence (n_el, m, n) matrices, to ``ELEMENT_TOLERANCE`` of the largest entry."""
+    n_el = mass.shape[0]
+    flat = [mass.reshape(n_el, -1), divergence.reshape(n_el, -1)]
+    scale = max(max(f.max(initial=0.0), -f.min(initial=0.0)) for f in flat) or 1.0
+    owner = _first_with_hash(element_hash(flat, scale))
+    differs = np.zeros(n_el, dtype=bool)
+    for chunk in np.array_split(np.arange(n_el), max(1, n_el // 100_000)):
+        for f in flat:
+            differs[chunk] |= (np.abs(f[chunk] - f[owner[chunk]]).max(axis=1)
+                               > ELEMENT_TOLERANCE * scale)
+    owner[differs] = np.flatnonzero(differs)
+    return owner
+
+
+def patch_classes(keys: np.ndarray) -> np.ndarray:
+    """For every row of the integer ``keys`` (m, L) the index of the first row equal to it."""
+    owner = _first_with_hash(key_hash(keys))
+    differs = np.flatnonzero((keys != keys[owner]).any(axis=1))
+    owner[differs] = differs
+    return owner
+
+
+def element_hash(flat: list[np.ndarray], scale: float) -> np.ndarray:
+    """A random projection of each element's matrices, rounded to 7 digits of ``scale``."""
+    rng = np.random.default_rng(_SEED)
+    return np.round(sum(f @ rng.standard_normal(f.shape[1]) for f in flat) / scale * 1e7)
+
+
+def key_hash(keys: np.ndarray) -> np.ndarray:
+    """A random integer combination of each row (wrapping on overflow)."""
+    weights = np.random.default_rng(_SEED).integers(1, 2**61, size=keys.shape[1])
+    with np.errstate(over="ignore"):
+        return (keys.astype(np.int64) * weights).sum(axis=1)
+
+
+def _first_with_hash(h: np.ndarray) -> np.ndarray:
+    _, first, inverse = np.unique(h, return_index=True, return_inverse=True)
+    return first[inverse.ravel()]

@@ -1,0 +1,75 @@
+"""Patches that share their saddle-point system (docs/theory.md, 13.2, "Patch classes")."""
+
+import numpy as np
+import pytest
+from skfem import MeshTri
+
+from estimators import patch_classes, patches
+from estimators.equilibrated import equilibrate
+from estimators.patch_classes import element_classes
+from estimators.rt_reference import ReferenceRT, element_matrices, scalar_values
+from formulations import get_formulation, solve
+from formulations.elasticity import ELEMENTS
+from scenes import get_scene
+
+
+def matrices(mesh, k=1):
+    X, W = ReferenceRT.build(mesh, k, 2 * k + 2).quadrature
+    return element_matrices(mesh, k, X, W, scalar_values(ELEMENTS[k](), X))
+
+
+def test_congruent_elements_share_a_class_and_others_do_not(skewed_mesh):
+    uniform = MeshTri.init_symmetric().refined(3)
+    mass, divergence = matrices(uniform)
+    owner = element_classes(mass, divergence)
+    # red refinement of the four starting triangles: few shapes and facet orientations
+    assert np.unique(owner).size <= 32
+    assert np.abs(mass - mass[owner]).max() <= 1e-12 * np.abs(mass).max()
+    assert np.array_equal(divergence, divergence[owner])   # orientation signs only
+    mass, divergence = matrices(skewed_mesh)
+    owner = element_classes(mass, divergence)
+    # the sheared mesh: an element shares a class only with an equal one (to round-off)
+    assert np.abs(mass - mass[owner]).max() <= 1e-12 * np.abs(mass).max()
+    assert np.unique(owner).size > mass.shape[0] // 2
+
+
+def test_a_hash_collision_does_not_merge_different_systems(monkeypatch, skewed_mesh):
+    mass, divergence = matrices(skewed_mesh)
+    monkeypatch.setattr(patch_classes, "element_hash", lambda flat, scale: np.zeros(len(flat[0])))
+    owner = element_classes(mass, divergence)
+    assert np.abs(mass - mass[owner]).max() <= 1e-12 * np.abs(mass).max()
+    keys = np.array([[1, 2, 3], [1, 2, 4], [1, 2, 3], [0, 0, 0]])
+    monkeypatch.setattr(patch_classes, "key_hash", lambda k: np.zeros(k.shape[0]))
+    assert patch_classes.patch_classes(keys).tolist() == [0, 1, 0, 3]
+
+
+def locally_refined(scene, times):
+    mesh = scene.mesh.refined(2)
+    for _ in range(times):
+        centre = mesh.p[:, mesh.t].mean(axis=1)
+        mesh = mesh.refined(np.flatnonzero(centre[0] + centre[1] < centre.sum(axis=0).mean()))
+    return mesh
+
+
+def row_by_row(reconstruction, *_):
+    """No symmetrising correction: the patch solves' own stress."""
+    return reconstruction
+
+
+@pytest.mark.parametrize("order", [1, 2])
+def test_shared_systems_give_the_stress_of_one_solve_per_patch(monkeypatch, order):
+    """The classes' inverses against one LU per patch (every element its own class): the same
+    stress to round-off of the dense solves (seen 4e-15 at P1 and 6e-14 at P2, relative;
+    bound 1e-11)."""
+    scene = get_scene("paper")
+    solution = solve(get_formulation("vi")(scene, locally_refined(scene, 3), order=order),
+                     "active-set")
+    monkeypatch.setattr(patches, "BATCH", 64)      # several chunks, several classes each
+    owners, classify = [], patches._owners
+    monkeypatch.setattr(patches, "_owners", lambda *a: owners.append(classify(*a)) or owners[-1])
+    shared = equilibrate(scene, solution, symmetrise=row_by_row)[0].dofs
+    # the classes repeat: most chunks take the inverses, not an LU per patch
+    assert 8 * np.unique(owners[0]).size < owners[0].size
+    monkeypatch.setattr(patches, "element_classes", lambda mass, div: np.arange(len(mass)))
+    alone = equilibrate(scene, solution, symmetrise=row_by_row)[0].dofs
+    assert np.abs(shared - alone).max() <= 1e-11 * np.abs(alone).max()
