@@ -17,6 +17,8 @@ class of its own, so a class never holds two different systems.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 ELEMENT_TOLERANCE = 1e-12  # relative: equal up to round-off of the reference-data contraction
@@ -26,8 +28,14 @@ _SEED = 20261129
 def element_classes(mass: np.ndarray, divergence: np.ndarray) -> np.ndarray:
     """For every element the index of an element with the same mass (n_el, n, n) and
     divergence (n_el, m, n) matrices, to ``ELEMENT_TOLERANCE`` of the largest entry."""
-    n_el = mass.shape[0]
-    flat = [mass.reshape(n_el, -1), divergence.reshape(n_el, -1)]
+    return equal_rows([mass, divergence])
+
+
+def equal_rows(arrays: list[np.ndarray]) -> np.ndarray:
+    """For every index i of the first axis the first index whose entries in all ``arrays``
+    equal those of i to ``ELEMENT_TOLERANCE`` of the largest entry."""
+    n_el = arrays[0].shape[0]
+    flat = [a.reshape(n_el, -1) for a in arrays]
     scale = max(max(f.max(initial=0.0), -f.min(initial=0.0)) for f in flat) or 1.0
     owner = _first_with_hash(element_hash(flat, scale))
     differs = np.zeros(n_el, dtype=bool)
@@ -37,6 +45,37 @@ def element_classes(mass: np.ndarray, divergence: np.ndarray) -> np.ndarray:
                                > ELEMENT_TOLERANCE * scale)
     owner[differs] = np.flatnonzero(differs)
     return owner
+
+
+@dataclass(frozen=True, eq=False)
+class Classes:
+    """Elements grouped by equal matrices: ``of`` (n_el,) the class of each, ``first``
+    (n_classes,) an element of each class, ``order`` the elements class by class and ``bounds``
+    (n_classes + 1,) where each class starts in ``order``."""
+
+    of: np.ndarray
+    first: np.ndarray
+    order: np.ndarray
+    bounds: np.ndarray
+
+    @staticmethod
+    def of_owners(owner: np.ndarray) -> Classes:
+        first, of = np.unique(owner, return_inverse=True)
+        of = of.ravel()
+        order = np.argsort(of, kind="stable")
+        return Classes(of=of, first=first, order=order,
+                       bounds=np.searchsorted(of[order], np.arange(first.size + 1)))
+
+    def products(self, matrices: np.ndarray, local: np.ndarray) -> np.ndarray:
+        """matrices[of[e]] @ local[e] for the class matrices (n_classes, m, m) and ``local``
+        (n_el, m) given class by class (element ``order[i]`` in row i): one matrix product per
+        class where classes repeat, else one per element."""
+        if 8 * self.first.size > self.of.size:
+            return np.matmul(matrices[self.of[self.order]], local[..., None])[..., 0]
+        out = np.empty(local.shape, dtype=np.result_type(matrices, local))
+        for c, (lo, hi) in enumerate(zip(self.bounds[:-1], self.bounds[1:], strict=True)):
+            out[lo:hi] = local[lo:hi] @ matrices[c].T
+        return out
 
 
 def patch_classes(keys: np.ndarray) -> np.ndarray:

@@ -148,7 +148,7 @@ def constrained_stream_function(rt, residual: np.ndarray, values: np.ndarray,
     elements = stream_elements(rt, residual, prescribed, lame, korn)
     B = (constraint_matrix(rt) @ sp.diags(elements.free.astype(float))).tocsr()
     g = -skew_moments(rt, values)
-    D = node_blocks(elements.matrices, elements.index, elements.free)
+    D = node_blocks(elements)
     solve_s = factorise((B @ D @ B.T).tocsc())  # the default direct back-end
 
     def onto(x: np.ndarray) -> np.ndarray:  # the D-nearest phi with B phi = g

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from skfem import MeshTri
 
-from estimators import patch_classes, patches
+from estimators import patch_classes, patches, symmetrisation
 from estimators.equilibrated import equilibrate
 from estimators.patch_classes import element_classes
 from estimators.rt_reference import ReferenceRT, element_matrices, scalar_values
@@ -73,3 +73,31 @@ def test_shared_systems_give_the_stress_of_one_solve_per_patch(monkeypatch, orde
     monkeypatch.setattr(patches, "element_classes", lambda mass, div: np.arange(len(mass)))
     alone = equilibrate(scene, solution, symmetrise=row_by_row)[0].dofs
     assert np.abs(shared - alone).max() <= 1e-11 * np.abs(alone).max()
+
+
+@pytest.mark.parametrize("refine", [3, 0])
+def test_class_products_equal_the_element_products(refine):
+    """One product per class (uniform mesh: few classes) and one per element (a coarse mesh,
+    classes barely repeat) against the element matrices one by one (float64: round-off)."""
+    mesh = MeshTri.init_symmetric().refined(refine)
+    classes = patch_classes.Classes.of_owners(element_classes(*matrices(mesh)))
+    rng = np.random.default_rng(refine)
+    per_class = rng.standard_normal((classes.first.size, 5, 5))
+    local = rng.standard_normal((classes.of.size, 5))
+    expected = np.einsum("eij,ej->ei", per_class[classes.of], local)
+    got = classes.products(per_class, local[classes.order])
+    assert np.abs(got - expected[classes.order]).max() <= 1e-13 * np.abs(expected).max()
+
+
+def test_stream_matrices_of_a_class_are_its_elements_own(skewed_mesh):
+    """``curl_classes`` groups elements whose stream matrices agree to round-off, and on a
+    uniform mesh it finds few classes."""
+    # red refinement: four shapes, each in a few local vertex orders (24 classes seen)
+    for mesh, most in ((MeshTri.init_symmetric().refined(3), 32), (skewed_mesh, None)):
+        rt = ReferenceRT.build(mesh, 1, 4)
+        Q = symmetrisation.density(1.0, 1.0, 20.0)
+        own = symmetrisation.element_system(rt, Q, np.zeros((2, 2) + rt.dx.shape))[0]
+        classes = symmetrisation.curl_classes(mesh)
+        assert np.abs(own[classes.first][classes.of] - own).max() <= 1e-12 * np.abs(own).max()
+        if most:
+            assert classes.first.size <= most
