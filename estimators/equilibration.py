@@ -26,6 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 from skfem import ElementTriP1, FacetBasis
 
+from estimators.patch_classes import element_classes
 from estimators.patch_data import Interior
 from estimators.patches import FIXED, FREE, ZERO, PairMatrices, layout, solve_patches
 from estimators.raviart_thomas import ElementTriRTk
@@ -74,8 +75,11 @@ class Flux:
 def boundary_flux(interior: Interior, part: BoundaryData) -> Flux:
     """The ``Flux`` of ``part`` at the RT degree and quadrature of ``interior``."""
     mesh, k, facets = interior.rt.mesh, interior.k, part.facets
-    fb = FacetBasis(mesh, ElementTriRTk(k), facets=facets, intorder=interior.intorder)
-    hats = FacetBasis(mesh, ElementTriP1(), facets=facets, quadrature=fb.quadrature)
+    # no DOF locations: mapping them would cost a pass over every element of the mesh
+    fb = FacetBasis(mesh, ElementTriRTk(k), facets=facets, intorder=interior.intorder,
+                    disable_doflocs=True)
+    hats = FacetBasis(mesh, ElementTriP1(), facets=facets, quadrature=fb.quadrature,
+                      disable_doflocs=True)
     local = _local_facet(mesh, facets, fb.tind)
     rows = np.arange(facets.size)
     normal_trace = np.array([np.einsum("ifp,ifp->fp", np.asarray(b[0]), fb.normals)
@@ -136,6 +140,7 @@ def reconstruct(interior: Interior, fluxes: list[Flux],
                 fixed[p, (k + 1) * flux.local + j] = flux.values[:, v, :, j]
     balance = boundary_balance(n_v, fluxes)
     pairs = PairMatrices(mass=interior.mass, divergence=interior.divergence,
+                         element_owner=element_classes(mesh, k),
                          rhs=interior.rhs.reshape(-1, 2, n_rt).transpose(0, 2, 1),
                          data=interior.data.reshape(-1, 2, n_dg).transpose(0, 2, 1), fixed=fixed)
     lay = layout(patch, dofs, status, facet_holders(mesh, rt.element_dofs, k), n_v)

@@ -21,19 +21,25 @@ from dataclasses import dataclass
 
 import numpy as np
 
-ELEMENT_TOLERANCE = 1e-12  # relative: equal up to round-off of the reference-data contraction
+from estimators.rt_reference import orientations
+
+ELEMENT_TOLERANCE = 1e-12  # relative: equal up to the round-off of computing J from the mesh
 _SEED = 20261129
 
 
-def element_classes(mass: np.ndarray, divergence: np.ndarray) -> np.ndarray:
-    """For every element the index of an element with the same mass (n_el, n, n) and
-    divergence (n_el, m, n) matrices, to ``ELEMENT_TOLERANCE`` of the largest entry."""
-    return equal_rows([mass, divergence])
+def element_classes(mesh, k: int) -> np.ndarray:
+    """For every triangle the index of a triangle with the same RT_k mass and divergence
+    matrices: the same J'J / |det J| and facet orientations, all that
+    ``estimators.rt_reference.element_matrices`` makes them of."""
+    mapping = mesh.mapping()
+    metric = np.einsum("ice,ide->ecd", mapping.A, mapping.A).reshape(-1, 4)
+    signs = orientations(mesh, 3 * (k + 1), k)[:, ::k + 1]
+    return equal_rows([metric / np.abs(mapping.detA)[:, None], signs])
 
 
 def equal_rows(arrays: list[np.ndarray]) -> np.ndarray:
     """For every index i of the first axis the first index whose entries in all ``arrays``
-    equal those of i to ``ELEMENT_TOLERANCE`` of the largest entry."""
+    equal those of i, in each array to ``ELEMENT_TOLERANCE`` of its row's largest entry."""
     n_el = arrays[0].shape[0]
     flat = [a.reshape(n_el, -1) for a in arrays]
     scale = max(max(f.max(initial=0.0), -f.min(initial=0.0)) for f in flat) or 1.0
@@ -41,8 +47,9 @@ def equal_rows(arrays: list[np.ndarray]) -> np.ndarray:
     differs = np.zeros(n_el, dtype=bool)
     for chunk in np.array_split(np.arange(n_el), max(1, n_el // 100_000)):
         for f in flat:
-            differs[chunk] |= (np.abs(f[chunk] - f[owner[chunk]]).max(axis=1)
-                               > ELEMENT_TOLERANCE * scale)
+            theirs = f[owner[chunk]]
+            differs[chunk] |= (np.abs(f[chunk] - theirs).max(axis=1)
+                               > ELEMENT_TOLERANCE * np.abs(theirs).max(axis=1))
     owner[differs] = np.flatnonzero(differs)
     return owner
 

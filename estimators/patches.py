@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from estimators.patch_classes import element_classes, patch_classes
+from estimators.patch_classes import patch_classes
 
 ZERO, FREE, FIXED = 0, 1, 2
 BATCH = 2000  # patches per stacked solve: bounds the memory of the dense systems
@@ -92,12 +92,15 @@ def layout(patch: np.ndarray, dofs: np.ndarray, status: np.ndarray, holder: np.n
 
 @dataclass(frozen=True, eq=False)
 class PairMatrices:
-    """Per element (pair p belongs to element p // 3): ``mass`` (n_el, n_rt, n_rt) and
-    ``divergence`` (n_el, n_dg, n_rt); per pair: ``rhs`` (P, n_rt, 2), ``data`` (P, n_dg, 2)
-    and the prescribed values ``fixed`` (P, n_rt, 2) (zero where not FIXED)."""
+    """Per element (pair p belongs to element p // 3): ``mass`` (n_el, n_rt, n_rt),
+    ``divergence`` (n_el, n_dg, n_rt) and ``element_owner`` (n_el,), an element with the same
+    matrices (``estimators.patch_classes.element_classes``); per pair: ``rhs`` (P, n_rt, 2),
+    ``data`` (P, n_dg, 2) and the prescribed values ``fixed`` (P, n_rt, 2) (zero where not
+    FIXED)."""
 
     mass: np.ndarray
     divergence: np.ndarray
+    element_owner: np.ndarray
     rhs: np.ndarray
     data: np.ndarray
     fixed: np.ndarray
@@ -119,7 +122,7 @@ def solve_patches(lay: PatchLayout, pairs: PairMatrices, clamped: np.ndarray) ->
     rhs[touched] -= np.matmul(pairs.mass[element], fixed)
     data[touched] -= np.matmul(pairs.divergence[element], fixed)
     size = lay.n_free + lay.count * pairs.divergence.shape[1]
-    owner = _owners(lay, pairs, clamped, size)
+    owner = _owners(lay, pairs.element_owner, clamped, size)
     out = np.zeros((lay.key_dof.size, 2))
     jobs = []
     for n in np.unique(size):
@@ -132,11 +135,11 @@ def solve_patches(lay: PatchLayout, pairs: PairMatrices, clamped: np.ndarray) ->
     return out
 
 
-def _owners(lay: PatchLayout, pairs: PairMatrices, clamped: np.ndarray,
+def _owners(lay: PatchLayout, element_owner: np.ndarray, clamped: np.ndarray,
             size: np.ndarray) -> np.ndarray:
     """For every patch a patch with the same system: equal size, clamping, and per element
-    rank the same element matrices at the same positions."""
-    element_owner = element_classes(pairs.mass, pairs.divergence)
+    rank the same element matrices (``element_owner``: an element with the same) at the same
+    positions."""
     n_rt = lay.local.shape[1]
     owner = np.arange(lay.count.size)
     for n in np.unique(size):
