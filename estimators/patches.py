@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from estimators.patch_classes import patch_classes
+from estimators.patch_classes import Classes, patch_classes
 
 ZERO, FREE, FIXED = 0, 1, 2
 BATCH = 2000  # patches per stacked solve: bounds the memory of the dense systems
@@ -160,17 +160,15 @@ def _owners(lay: PatchLayout, element_owner: np.ndarray, clamped: np.ndarray,
 def _solve_chunk(lay, chunk, n, pairs, right, clamped, owner, out) -> None:
     """The patches ``chunk`` (of system size n): one system per class in the chunk, then
     either one LU per patch or, where classes repeat, the classes' inverses."""
-    classes, position = np.unique(owner[chunk], return_inverse=True)
-    A = _systems(lay, classes, n, pairs, clamped)
+    classes = Classes.of_owners(owner[chunk])
+    A = _systems(lay, classes.first, n, pairs, clamped)
     view = _ChunkPairs.of(lay, chunk, n, pairs.divergence.shape[1])
     b = _right_hand_sides(lay, view, n, pairs, right, clamped)
-    if 4 * classes.size > chunk.size:     # few repeats: an LU per patch is cheaper
-        x = np.linalg.solve(A[position.ravel()], b)
-    else:                                 # chunk sorted by class: one product per class
+    if 4 * classes.first.size > chunk.size:     # few repeats: an LU per patch is cheaper
+        x = np.linalg.solve(A[classes.of], b)
+    else:
         x = np.empty_like(b)
-        bounds = np.flatnonzero(np.diff(position.ravel(), prepend=-1, append=-1))
-        for c, (lo, hi) in enumerate(zip(bounds[:-1], bounds[1:], strict=True)):
-            x[lo:hi] = np.einsum("ij,mjr->mir", np.linalg.inv(A[c]), b[lo:hi], optimize=True)
+        x[classes.order] = classes.products(np.linalg.inv(A), b[classes.order])
     gf = np.broadcast_to(view.g[:, None], view.free.shape)[view.free]
     out[lay.key_of[view.sel][view.free]] = x[gf, view.loc[view.free]]
 

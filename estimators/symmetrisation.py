@@ -103,7 +103,7 @@ class StreamElements:
     """The minimisation of the module docstring, element by element: ``vectors`` (n_el, m)
     for the unknowns ``index`` (n_el, m; row r's values at r n + node), ``free``, the values
     not pinned, and the matrices (n_classes, m, m) of the element ``classes``
-    (``element_matrices`` gives them per element)."""
+    (``matrices`` gives them per element)."""
 
     class_matrices: np.ndarray
     vectors: np.ndarray
