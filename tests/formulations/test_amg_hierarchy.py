@@ -24,7 +24,9 @@ def pyamgs(K32, modes):
     import pyamg
 
     return pyamg.smoothed_aggregation_solver(
-        K32, B=modes, symmetry="symmetric", strength=("symmetric", {"theta": 0.0}),
+        K32, B=modes, symmetry="symmetric",
+        strength=[("symmetric", {"theta": 0.0}),
+                  ("symmetric", {"theta": amg_hierarchy.COARSE_THETA})],
         max_coarse=amg_hierarchy.MAX_COARSE, coarse_solver="splu", keep=True)
 
 
@@ -71,3 +73,25 @@ def test_cg_takes_as_many_iterations_as_with_pyamgs_hierarchy(scene, refine):
         solve(b)
         counts += solve.iterations
     assert abs(counts[0] - counts[1]) <= 1
+
+
+@pytest.mark.slow
+def test_the_coarse_threshold_keeps_the_iterations_from_growing_with_the_levels(monkeypatch):
+    """paper-3d at 104 544 P1 DOFs, three levels: with theta = 0 below the finest level the
+    aggregates grow (113 nodes each on level 1 against 25 on level 0) and CG took 42
+    iterations for the load that took 22 at 9 450 DOFs on two levels; with COARSE_THETA 32.
+    Asserted: at most 1.5 times the two-level count (the mesh-independence aimed at), and
+    fewer than with theta = 0 everywhere."""
+    from bench.perf.scaling import linear_rhs
+    from bench.perf.scaling_3d import paper_3d_problem
+
+    counts, coarse = {}, amg_hierarchy.COARSE_THETA
+    for size in ("1e4", "1e5"):
+        qp = get_formulation("vi")(*paper_3d_problem(size)).qp
+        for theta in (0.0, coarse):
+            monkeypatch.setattr(amg_hierarchy, "COARSE_THETA", theta)
+            solve = amg.factorise(qp.K, qp.near_null)
+            solve(linear_rhs(qp))
+            counts[size, theta] = solve.iterations[0]
+    assert counts["1e5", coarse] <= 1.5 * counts["1e4", coarse], counts
+    assert counts["1e5", coarse] < counts["1e5", 0.0], counts

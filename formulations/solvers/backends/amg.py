@@ -24,7 +24,11 @@ import numpy as np
 from scipy import sparse
 from scipy.sparse.linalg import LinearOperator, cg, gmres
 
-from formulations.solvers.backends.amg_hierarchy import MAX_COARSE, smoothed_aggregation
+from formulations.solvers.backends.amg_hierarchy import (
+    COARSE_THETA,
+    MAX_COARSE,
+    smoothed_aggregation,
+)
 from formulations.solvers.backends.base import Backend, FactorisationError, register_backend
 
 # relative residual |b - K x| / |b| of every solve. Energy-norm difference to the direct
@@ -109,7 +113,8 @@ def factorise(K: sparse.spmatrix, near_null: np.ndarray | None = None) -> Iterat
     else:
         hierarchy = pyamg.smoothed_aggregation_solver(
             K.astype(CYCLE_DTYPE), B=np.asarray(modes, dtype=CYCLE_DTYPE),
-            symmetry="nonsymmetric", strength=("symmetric", {"theta": 0.0}),
+            symmetry="nonsymmetric", strength=[("symmetric", {"theta": 0.0}),
+                      ("symmetric", {"theta": COARSE_THETA})],
             max_coarse=MAX_COARSE, coarse_solver="splu")
     in_single(hierarchy)
     return IterativeSolve(K, VCycle(hierarchy), symmetric)

@@ -3,15 +3,21 @@ section 16): PyAMG's own steps and defaults, with the spectral radius estimated 
 operator's single precision from a fixed start vector.
 
 Each level, as PyAMG's ``smoothed_aggregation_solver`` builds it: symmetric strength of
-connection (theta = 0), standard aggregation, the near-null candidates improved by four
-symmetric block Gauss-Seidel sweeps on A B = 0 (finest level only), the tentative prolongator
-T fitted to them, one Jacobi smoothing step P = T - omega / rho(D^-1 A) D^-1 A T with
-omega = 4/3, R = P' and the Galerkin operator R A P. The one change is rho: PyAMG starts its
-Arnoldi iteration from a random double vector, so every product with the single-precision
-D^-1 A converted the whole matrix to double (5.3 s of a 15-s set-up at 5.5e5 DOFs on
-paper-3d) and the hierarchy differed from run to run. Here the same estimator
-(``approximate_spectral_radius``, relative tolerance 1e-2) starts from a seeded vector in A's
-precision, and omega / rho keeps that precision, so P and the coarse operators stay in it.
+connection, standard aggregation, the near-null candidates improved by four symmetric block
+Gauss-Seidel sweeps on A B = 0 (finest level only), the tentative prolongator T fitted to
+them, one Jacobi smoothing step P = T - omega / rho(D^-1 A) D^-1 A T with omega = 4/3,
+R = P' and the Galerkin operator R A P. Two changes:
+
+- the strength threshold: theta = 0 (PyAMG's) on the finest level, COARSE_THETA below it.
+  The Galerkin operators hold small couplings that theta = 0 counts as strong, so their
+  aggregates grew level by level (paper-3d, 104 544 P1 DOFs: 25 nodes per aggregate on the
+  finest level, 113 on the next) and the coarse correction weakened as levels were added;
+- rho: PyAMG starts its Arnoldi iteration from a random double vector, so every product with
+  the single-precision D^-1 A converted the whole matrix to double (5.3 s of a 15-s set-up at
+  5.5e5 DOFs on paper-3d) and the hierarchy differed from run to run. Here the same estimator
+  (``approximate_spectral_radius``, relative tolerance 1e-2) starts from a seeded vector in
+  A's precision, and omega / rho keeps that precision, so P and the coarse operators stay in
+  it.
 """
 
 from __future__ import annotations
@@ -20,6 +26,11 @@ import numpy as np
 from scipy import sparse
 
 OMEGA = 4.0 / 3.0  # PyAMG's Jacobi damping for the prolongation smoother
+# strength threshold below the finest level. paper-3d, vi P1, CG iterations of one linear
+# solve at 9 450 / 104 544 / 545 832 DOFs: theta = 0 on every level 22 / 42 / 47; 0.02 on
+# every level 22 / 33 / 34; 0 on the finest and 0.04 below 22 / 32 / 33 (the 545 832-DOF
+# solve 11.9 s against 16.7 s; its coarsest level 2 304 unknowns against 480)
+COARSE_THETA = 0.04
 MAX_COARSE = 500  # nodes on the coarsest level, solved by a sparse LU
 MAX_LEVELS = 10  # PyAMG's default
 # PyAMG's default improvement of the candidates on the finest level
@@ -40,20 +51,22 @@ def smoothed_aggregation(A: sparse.csr_matrix, B: np.ndarray):
     levels = [finest]
     while (len(levels) < MAX_LEVELS
            and levels[-1].A.shape[0] // get_blocksize(levels[-1].A) > MAX_COARSE):
-        levels.append(coarser(levels[-1], improve=len(levels) == 1))
+        levels.append(coarser(levels[-1], finest=len(levels) == 1))
     return MultilevelSolver(levels, coarse_solver="splu")
 
 
-def coarser(level, improve: bool):
-    """The next level below ``level``, whose P and R are set on the way (module docstring)."""
+def coarser(level, finest: bool):
+    """The next level below ``level``, whose P and R are set on the way (module docstring);
+    ``finest``: ``level`` is the finest (theta = 0 and improved candidates)."""
     from pyamg.aggregation import fit_candidates, standard_aggregation
     from pyamg.multilevel import MultilevelSolver
     from pyamg.relaxation.utils import relaxation_as_linear_operator
     from pyamg.strength import symmetric_strength_of_connection
 
     A = level.A
-    aggregates, _ = standard_aggregation(symmetric_strength_of_connection(A, theta=0.0))
-    if improve:
+    theta = 0.0 if finest else COARSE_THETA
+    aggregates, _ = standard_aggregation(symmetric_strength_of_connection(A, theta=theta))
+    if finest:
         zero = np.zeros((A.shape[0], 1), dtype=A.dtype)
         level.B = relaxation_as_linear_operator(IMPROVE, A, zero) @ level.B
     T, B_coarse = fit_candidates(aggregates, level.B)
