@@ -182,16 +182,15 @@ def memory_refusal(level: int, ndofs: int, solver: str, config: LoopConfig,
     return level_memory(level, ndofs, solver, config, dim).refusal
 
 
-def level_refusal(level: int, ndofs: int, solver: str, config: LoopConfig,
-                  dim: int) -> tuple[str, str] | None:
+def level_refusal(level: int, ndofs: int, config: LoopConfig,
+                  route: MemoryRoute) -> tuple[str, str] | None:
     """Why a level of ``ndofs`` unknowns is not built, as (end of the sequence, the failed
     row's reason, '' for none), or None: over the DOF budget (a failed row only for the
-    starting mesh) or over the memory."""
+    starting mesh) or over the memory (``route``, from ``level_memory``)."""
     if ndofs > config.max_dofs:
         return "budget", (f"budget: the starting mesh has {ndofs} DOFs, over max_dofs="
                           f"{config.max_dofs}" if level == 0 else "")
-    refusal = memory_refusal(level, ndofs, solver, config, dim)
-    return None if refusal is None else ("memory", refusal)
+    return None if route.refusal is None else ("memory", route.refusal)
 
 
 def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
@@ -215,7 +214,11 @@ def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
     t_refine, previous = 0.0, None
     for level in range(config.max_levels):
         ndofs = family.count_free_dofs(scene, mesh, config.order)  # before any assembly
-        refusal = level_refusal(level, ndofs, solver, config, scene.dim)
+        # decided once, before the assembly: the prediction includes the assembly's memory,
+        # and asked again after it, a level admitted on an iterative back-end could be
+        # refused there and fall back to the configured direct one
+        route = level_memory(level, ndofs, solver, config, scene.dim)
+        refusal = level_refusal(level, ndofs, config, route)
         if refusal is not None:  # over the budget or the memory: a failed row says so
             end, reason = refusal
             if reason:  # a later level over the budget is just the end
@@ -228,9 +231,8 @@ def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
         disc = discretise(scene, mesh)
         t_assemble = time.perf_counter() - start
         options = config.options()
-        rerouted = level_memory(level, ndofs, solver, config, scene.dim)
-        if rerouted.backend is not None:
-            options["backend"] = rerouted.backend
+        if route.backend is not None:
+            options["backend"] = route.backend
         if config.nested and previous is not None and previous.ok:
             options["warm_start"] = disc.warm_start(previous, solver)  # nested iteration
         sol = previous = solve(disc, solver, **options)
@@ -253,7 +255,7 @@ def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
             if solver != REFERENCE_SOLVER and disc.ndofs <= crosscheck_dofs:
                 numbers.update(crosscheck_columns(disc, sol))
         reached = None if failed else target_reason(config, est)
-        numbers["reason"] = "; ".join(filter(None, (numbers["reason"], rerouted.note,
+        numbers["reason"] = "; ".join(filter(None, (numbers["reason"], route.note,
                                                     reached)))
         yield LevelResult(ResultRow(**ident, **numbers), sol, est)
         if failed:
