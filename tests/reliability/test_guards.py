@@ -92,24 +92,15 @@ def test_the_route_is_chosen_before_the_assembly_takes_its_memory(monkeypatch):
     less memory free: asked again after it, the route was a refusal, and the level fell back
     to the configured direct back-end (a paper-3d P2 reference past 1.4e6 DOFs then failed on
     a dense Schur block of 16.6 GiB)."""
-    built = []
+    built = assembled_sizes(monkeypatch)
 
     def predicted(ndofs, solver, backend, order=1, dim=2):  # only level 4 is too large
         return 100.0 if ndofs > 2112 and not backends.iterative(backend) else 0.1
 
     def free_memory():  # the assembly of level 4 takes what amg would need
         return 0.05 if 8320 in built else 1.0
-    real = loop_module.get_formulation
-
-    def recording(name):
-        def wrapped(scene, mesh, **options):
-            disc = real(name)(scene, mesh, **options)
-            built.append(disc.ndofs)
-            return disc
-        return wrapped
     monkeypatch.setattr(memory_module, "predict_peak_gib", predicted)
     monkeypatch.setattr(loop_module, "available_gib", free_memory)
-    monkeypatch.setattr(loop_module, "get_formulation", recording)
     rows = [r.row for r in run_sequence(get_scene("paper"), "mixed", "active-set", "residual",
                                         LoopConfig(strategy="uniform", max_dofs=8400))]
     assert rows[-1].ndofs == 8320 and rows[-1].status == "ok"
