@@ -25,8 +25,7 @@ def pyamgs(K32, modes):
 
     return pyamg.smoothed_aggregation_solver(
         K32, B=modes, symmetry="symmetric",
-        strength=[("symmetric", {"theta": 0.0}),
-                  ("symmetric", {"theta": amg_hierarchy.COARSE_THETA})],
+        strength=amg_hierarchy.strength_per_level(),
         max_coarse=amg_hierarchy.MAX_COARSE, coarse_solver="splu", keep=True)
 
 

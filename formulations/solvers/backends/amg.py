@@ -25,9 +25,9 @@ from scipy import sparse
 from scipy.sparse.linalg import LinearOperator, cg, gmres
 
 from formulations.solvers.backends.amg_hierarchy import (
-    COARSE_THETA,
     MAX_COARSE,
     smoothed_aggregation,
+    strength_per_level,
 )
 from formulations.solvers.backends.base import Backend, FactorisationError, register_backend
 
@@ -113,8 +113,7 @@ def factorise(K: sparse.spmatrix, near_null: np.ndarray | None = None) -> Iterat
     else:
         hierarchy = pyamg.smoothed_aggregation_solver(
             K.astype(CYCLE_DTYPE), B=np.asarray(modes, dtype=CYCLE_DTYPE),
-            symmetry="nonsymmetric", strength=[("symmetric", {"theta": 0.0}),
-                      ("symmetric", {"theta": COARSE_THETA})],
+            symmetry="nonsymmetric", strength=strength_per_level(),
             max_coarse=MAX_COARSE, coarse_solver="splu")
     in_single(hierarchy)
     return IterativeSolve(K, VCycle(hierarchy), symmetric)

@@ -38,6 +38,12 @@ IMPROVE = ("block_gauss_seidel", {"sweep": "symmetric", "iterations": 4})
 SEED = 0  # the spectral-radius estimate's start vector: the same hierarchy on every run
 
 
+def strength_per_level() -> list:
+    """PyAMG's ``strength`` argument for the thresholds above: theta = 0 on the finest level,
+    COARSE_THETA below it (a new list: PyAMG extends it in place)."""
+    return [("symmetric", {"theta": 0.0}), ("symmetric", {"theta": COARSE_THETA})]
+
+
 def smoothed_aggregation(A: sparse.csr_matrix, B: np.ndarray):
     """The hierarchy (a PyAMG ``MultilevelSolver``, coarsest level solved by ``splu``) of the
     symmetric A with near-null space B (n x k), in A's precision; smoothers are set by the
