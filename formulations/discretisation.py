@@ -114,6 +114,17 @@ def why_unsolvable(discretisation: Discretisation, solver: str) -> str | None:
     return f"solver {solver!r} has no method for a QP"
 
 
+def dense_block_size(discretisation: Discretisation, solver: str, backend: str | None) -> int:
+    """The columns of the dense Schur block ``solver`` would form on ``backend`` for this
+    problem: what its registration declares (``meta["dense_block_size"](problem, backend)``),
+    0 if it declares nothing (docs/theory.md, section 7)."""
+    on_system = uses_system(discretisation, solver)
+    registry = SYSTEM_SOLVERS if on_system else SOLVERS
+    size = registry.meta(solver, "dense_block_size")
+    problem = discretisation.system if on_system else discretisation.qp
+    return 0 if size is None or problem is None else int(size(problem, backend))
+
+
 def solve(discretisation: Discretisation, solver: str, **options) -> DiscreteSolution:
     """Solve with the named solver, compute the residuals (KKT for a QP, the nonlinear
     residual for a system) from the returned arrays, and give the final status. A failed

@@ -18,13 +18,14 @@ from bench.sequence.columns import (
     solver_columns,
 )
 from bench.sequence.marking import MARKINGS, check_marking, grade_contact_trace, mark
-from bench.sequence.memory import MemoryRoute, available_gib, memory_route
+from bench.sequence.memory import MemoryRoute, available_gib, dense_block_route, memory_route
 from bench.sequence.options import option
 from bench.sequence.rows import ResultRow, identity_columns
 from estimators.base import estimator_on
 from formulations import STATUS_FAILED, get_formulation, solve
 from formulations.cells import DEFAULT_CELL, check_cell, family_for
 from formulations.cells.base import Plan
+from formulations.discretisation import dense_block_size
 from formulations.elasticity import check_order, element_diameters
 from formulations.solvers.backends import backend_names, check_backend
 from formulations.solvers.registry import REFERENCE_SOLVER
@@ -193,6 +194,22 @@ def level_refusal(level: int, ndofs: int, config: LoopConfig,
     return None if route.refusal is None else ("memory", route.refusal)
 
 
+def level_options(level: int, disc, solver: str, config: LoopConfig, route: MemoryRoute,
+                  previous) -> tuple[dict, MemoryRoute]:
+    """The solve's options on the level's ``route``, moved to an iterative back-end if the
+    assembled level's dense Schur block does not fit (``dense_block_route``), with the
+    ``previous`` level's solution as warm start (nested iteration)."""
+    options = config.options()
+    backend = check_backend(options.get("backend"))
+    route = dense_block_route(route, level, disc.ndofs, dense_block_size(disc, solver, backend),
+                              solver, backend, config.order, disc.elasticity.mesh.dim())
+    if route.backend is not None:
+        options["backend"] = route.backend
+    if config.nested and previous is not None and previous.ok:
+        options["warm_start"] = disc.warm_start(previous, solver)
+    return options, route
+
+
 def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
                  config: LoopConfig, identity: dict | None = None,
                  mesh: MeshTri | None = None, truth=None, crosscheck_dofs: int = 0,
@@ -230,11 +247,7 @@ def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
         start = time.perf_counter()
         disc = discretise(scene, mesh)
         t_assemble = time.perf_counter() - start
-        options = config.options()
-        if route.backend is not None:
-            options["backend"] = route.backend
-        if config.nested and previous is not None and previous.ok:
-            options["warm_start"] = disc.warm_start(previous, solver)  # nested iteration
+        options, route = level_options(level, disc, solver, config, route, previous)
         sol = previous = solve(disc, solver, **options)
         failed = sol.status == STATUS_FAILED
         start = time.perf_counter()

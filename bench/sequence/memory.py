@@ -18,6 +18,13 @@ that does (``iterative_route``; the row's reason says so) instead of refused.
 
 Formulations differ by a few slack unknowns per contact point, which the model ignores.
 
+A condensing back-end (pardiso, cholmod) also forms a dense Schur block over the contact DOFs,
+DENSE_COPIES arrays of m^2 doubles, which grows with the square of the contact zone and which
+no line in N sees (27 265 contact DOFs of a 3D P2 level: 16.6 GiB). The assembled level knows
+m (``formulations.discretisation.dense_block_size``), and ``dense_block_route`` moves a level
+whose block does not fit beside the rest to an iterative back-end, within the memory the
+level's route was chosen in before its assembly.
+
 Higher order: a P_p DOF couples to more DOFs (stiffness nonzeros per row 12 / 22 / 33 for
 p = 1 / 2 / 3; CHOLMOD's factor about the same per DOF), so the per-DOF slope is scaled by
 ORDER_FACTOR, measured with ``python -m bench scaling --sizes 1e4,1e5 --order 1,2,3`` (cholmod):
@@ -39,6 +46,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+from formulations.solvers.backends import DENSE_COPIES
 from formulations.solvers.backends.base import REGISTRY as BACKENDS
 from formulations.solvers.registry import REFERENCE_SOLVER
 
@@ -101,6 +109,7 @@ class MemoryRoute:
     backend: str | None = None
     note: str = ""
     refusal: str | None = None
+    limit_gib: float = float("inf")  # the memory the route was chosen within
 
 
 def memory_route(level: int, ndofs: int, solver: str, backend: str, limit_gib: float,
@@ -109,13 +118,38 @@ def memory_route(level: int, ndofs: int, solver: str, backend: str, limit_gib: f
     else on an iterative back-end that fits, else refused."""
     need = predict_peak_gib(ndofs, solver, backend, order, dim)
     if need <= limit_gib:
-        return MemoryRoute()
+        return MemoryRoute(limit_gib=limit_gib)
     why = (f"level {level} needs ~{need:.2f} GiB ({ndofs} DOFs, {route(solver, backend)}), "
            f"{limit_gib:.2f} available")
     instead = iterative_route(ndofs, solver, backend, limit_gib, order, dim)
     if instead is not None:
-        return MemoryRoute(instead, f"memory: {why}; solved by {instead} instead")
-    return MemoryRoute(refusal=f"memory: {why}")
+        return MemoryRoute(instead, f"memory: {why}; solved by {instead} instead", None,
+                           limit_gib)
+    return MemoryRoute(refusal=f"memory: {why}", limit_gib=limit_gib)
+
+
+def dense_block_route(chosen: MemoryRoute, level: int, ndofs: int, dense_size: int,
+                      solver: str, backend: str, order: int = 1, dim: int = 2) -> MemoryRoute:
+    """``chosen`` (``memory_route``, before the assembly) once the assembled level shows the
+    dense Schur block of ``dense_size`` columns its condensing back-end would form
+    (DENSE_COPIES arrays of dense_size^2 doubles, which the line in N does not see): on an
+    iterative back-end if the two together do not fit in the memory the route was chosen
+    within. Otherwise unchanged; where no iterative back-end fits either, the back-end's own
+    check (``check_dense_block``) has the last word."""
+    if chosen.backend is not None or chosen.refusal is not None or dense_size == 0:
+        return chosen
+    dense = DENSE_COPIES * 8.0 * dense_size**2 / 2**30
+    need = predict_peak_gib(ndofs, solver, backend, order, dim) + dense
+    if need <= chosen.limit_gib:
+        return chosen
+    instead = iterative_route(ndofs, solver, backend, chosen.limit_gib, order, dim)
+    if instead is None:
+        return chosen
+    why = (f"level {level}'s dense Schur block of {dense_size} contact DOFs needs "
+           f"~{dense:.2f} GiB ({backend}), ~{need:.2f} GiB with the rest, "
+           f"{chosen.limit_gib:.2f} available")
+    return MemoryRoute(instead, f"memory: {why}; solved by {instead} instead", None,
+                       chosen.limit_gib)
 
 
 def iterative_route(ndofs: int, solver: str, backend: str, limit_gib: float, order: int = 1,

@@ -68,10 +68,21 @@ def _fallback(qp: ContactQP, why: str, diagnostics: SolverDiagnostics,
                    diagnostics=replace(diagnostics, safeguard="reference fallback"))
 
 
+def dense_block_size(qp: ContactQP, backend: str | None = None) -> int:
+    """The columns of the dense Schur block ``solve_active_set`` forms on ``backend`` (0: the
+    back-end does not condense): every DOF the constraint rows touch, and the tangential rows'
+    too with friction."""
+    if not condenses(backend):
+        return 0
+    rows = qp.B if qp.friction is None else sparse.vstack([qp.B, qp.friction.T], format="csr")
+    return int(np.unique(rows.indices).size)
+
+
 @register_solver(FAST_SOLVER, "primal-dual active set (semismooth Newton): condensed "
                               "B K^-1 B' from one factorisation (pardiso, cholmod), the "
                               "augmented saddle-point system (splu) or projected CG with "
-                              "multigrid (amg); nested iteration")
+                              "multigrid (amg); nested iteration",
+                 meta={"dense_block_size": dense_block_size})
 def solve_active_set(qp: ContactQP, warm_start: np.ndarray | None = None,
                      max_iter: int = 100, backend: str | None = None) -> QPSolution:
     """``backend``: 'pardiso' or 'cholmod' (condensed iteration), 'splu' (augmented

@@ -182,8 +182,17 @@ def sparse_problem(system: SemismoothSystem, backend: str | None = None) -> Line
                       krylov, tighten)
 
 
+def dense_block_size(system: SemismoothSystem, backend: str | None = None) -> int:
+    """The columns of the dense Schur block ``solve_semismooth`` forms on ``backend`` (0: its
+    route takes sparse steps, ``newton_route``)."""
+    if not condenses(backend) or not newton_route(system, check_backend(backend))[0]:
+        return 0
+    return int(np.unique(system.T.indices).size)
+
+
 @register_system_solver(FAST_SOLVER, "semismooth Newton (primal-dual active set) on the "
-                                      "contact values, condensed from one factorisation")
+                                      "contact values, condensed from one factorisation",
+                        meta={"dense_block_size": dense_block_size})
 def solve_semismooth(system: SemismoothSystem, warm_start: np.ndarray | None = None,
                      max_iter: int = 50, backend: str | None = None) -> QPSolution:
     """``warm_start``: a pressure per quadrature point (> 0 where active)."""
