@@ -64,9 +64,10 @@ class Locator:
         xi = self.reference_coordinates(x, cells)
         return np.array([1.0 - xi[0] - xi[1], xi[0], xi[1]])
 
-    def find(self, x: np.ndarray) -> np.ndarray:
-        """The element containing each point of x (2, n); ValueError for a point outside."""
-        return walk(self, x)
+    def find(self, x: np.ndarray, start: np.ndarray | None = None) -> np.ndarray:
+        """The element containing each point of x (2, n), walking from the elements
+        ``start`` if given; ValueError for a point outside."""
+        return walk(self, x, start)
 
     def finish(self, x, cells, todo) -> np.ndarray:
         """matplotlib's trapezoid finder for the points the walk left."""

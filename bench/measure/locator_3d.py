@@ -56,9 +56,10 @@ class TetLocator:
         xi = self.reference_coordinates(x, cells)
         return np.vstack([1.0 - xi.sum(axis=0), xi])
 
-    def find(self, x: np.ndarray) -> np.ndarray:
-        """The element containing each point of x (3, n); ValueError for a point outside."""
-        return walk(self, x)
+    def find(self, x: np.ndarray, start: np.ndarray | None = None) -> np.ndarray:
+        """The element containing each point of x (3, n), walking from the elements
+        ``start`` if given; ValueError for a point outside."""
+        return walk(self, x, start)
 
     def finish(self, x, cells, todo) -> np.ndarray:
         """The nearest centroids' elements for the points the walk left: the first that

@@ -80,9 +80,10 @@ def energy_difference(first: GradientField, second: GradientField, lame) -> floa
     rule = get_quadrature(RefTet if three else RefTri, 2 * max(first.degree, second.degree))
     corners = mesh.p[:, mesh.t]
     parent = np.arange(mesh.t.shape[1])
-    total = 0.0
+    total, near = 0.0, None
     for depth in range(MAX_SPLITS + 1):
-        located = second.locator.find(corners.mean(axis=1))
+        # a child's centroid lies near its parent's: the walk starts from the parent's element
+        located = second.locator.find(corners.mean(axis=1), near)
         area = _measure(corners)
         split = area > second.area[located]
         if depth == MAX_SPLITS:
@@ -96,5 +97,6 @@ def energy_difference(first: GradientField, second: GradientField, lame) -> floa
             break
         children = _tet_children if three else _children
         corners = children(corners[:, :, split])
-        parent = np.tile(parent[split], corners.shape[2] // split.sum())
+        copies = corners.shape[2] // split.sum()
+        parent, near = np.tile(parent[split], copies), np.tile(located[split], copies)
     return float(np.sqrt(max(total, 0.0)))

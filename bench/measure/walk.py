@@ -29,10 +29,12 @@ def element_neighbours(mesh) -> np.ndarray:
     return out
 
 
-def walk(locator, x: np.ndarray) -> np.ndarray:
-    """The element of ``locator`` containing each point of x (d, n): the walk, then
+def walk(locator, x: np.ndarray, start: np.ndarray | None = None) -> np.ndarray:
+    """The element of ``locator`` containing each point of x (d, n): the walk (from the
+    elements ``start``, if given: a good guess saves the nearest-centroid query), then
     ``locator.finish`` for the points it left (ValueError for a point outside)."""
-    cells = locator.tree.query(x.T, workers=-1)[1]  # all cores: the same answer, sooner
+    cells = (locator.tree.query(x.T, workers=-1)[1] if start is None  # all cores, sooner
+             else np.array(start, dtype=np.int64))
     todo = np.arange(x.shape[1])
     for _ in range(MAX_WALK):
         bary = locator.barycentric(x[:, todo], cells[todo])
