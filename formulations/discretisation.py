@@ -117,7 +117,7 @@ def why_unsolvable(discretisation: Discretisation, solver: str) -> str | None:
 def dense_block_size(discretisation: Discretisation, solver: str, backend: str | None) -> int:
     """The columns of the dense Schur block ``solver`` would form on ``backend`` for this
     problem: what its registration declares (``meta["dense_block_size"](problem, backend)``),
-    0 if it declares nothing (docs/theory.md, section 7)."""
+    0 if it declares nothing (docs/theory.md, section 16, "Route choice")."""
     on_system = uses_system(discretisation, solver)
     registry = SYSTEM_SOLVERS if on_system else SOLVERS
     size = registry.meta(solver, "dense_block_size")

@@ -1,5 +1,5 @@
 """The memory route of a level once its dense Schur block is known (bench.sequence.memory,
-docs/theory.md, section 7)."""
+docs/theory.md, sections 7 and 16)."""
 
 import pytest
 
