@@ -49,7 +49,7 @@ from formulations.solvers.backends import (
     factorise_condensed,
     iterative,
 )
-from formulations.solvers.friction import solve_frictional
+from formulations.solvers.friction import condensed_rows, solve_frictional
 from formulations.solvers.lcp import CYCLING_EXAMPLE, condition_1, least_index_pivoting, pdas
 from formulations.solvers.projected import solve_projected
 from formulations.solvers.reference import solve_reference
@@ -74,7 +74,7 @@ def dense_block_size(qp: ContactQP, backend: str | None = None) -> int:
     too with friction."""
     if not condenses(backend):
         return 0
-    rows = qp.B if qp.friction is None else sparse.vstack([qp.B, qp.friction.T], format="csr")
+    rows = qp.B if qp.friction is None else condensed_rows(qp)
     return int(np.unique(rows.indices).size)
 
 

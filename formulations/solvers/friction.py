@@ -56,10 +56,15 @@ class FrictionError(ValueError):
     """A frictional problem this solver does not handle."""
 
 
+def condensed_rows(qp: ContactQP) -> sparse.csr_matrix:
+    """The rows the frictional solvers condense onto: B's, then the tangential ones."""
+    return sparse.vstack([qp.B, qp.friction.T], format="csr")
+
+
 def condensed_system(qp: ContactQP, backend: str):
     """(solve, S, r, phases): a factorisation of K, the condensed C K^-1 C' and its right-hand
     side, on a direct back-end (an iterative one takes ``solve_without_factorisation``)."""
-    C = sparse.vstack([qp.B, qp.friction.T], format="csr")
+    C = condensed_rows(qp)
     clock = time.perf_counter()
     if condenses(backend):
         factor = factorise_condensed(qp.K, np.unique(C.indices), backend)

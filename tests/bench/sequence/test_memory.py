@@ -16,13 +16,15 @@ CONDENSING = [b for b in backends.available_backends() if backends.condenses(b)]
 HAS_AMG = "amg" in backends.available_backends()
 
 
+@pytest.mark.parametrize("scene_name", ["paper", "stick-slip"])  # without and with friction
 @pytest.mark.parametrize("formulation", formulation_names())
 @pytest.mark.skipif(not CONDENSING, reason="no condensing back-end")
-def test_the_declared_block_is_the_one_the_back_end_allocates(formulation, monkeypatch):
+def test_the_declared_block_is_the_one_the_back_end_allocates(formulation, scene_name,
+                                                              monkeypatch):
     allocated, real = [], backends.check_dense_block
     monkeypatch.setattr(backends, "check_dense_block",
                         lambda size: (allocated.append(size), real(size))[1])
-    scene = get_scene("paper")
+    scene = get_scene(scene_name)
     disc = get_formulation(formulation)(scene, scene.mesh.refined(3))
     declared = dense_block_size(disc, FAST_SOLVER, CONDENSING[0])
     assert solve(disc, FAST_SOLVER, backend=CONDENSING[0]).status == "ok"
