@@ -17,18 +17,20 @@ PEAK_SAMPLES = 8001  # points over +-4 half-widths where the computed peak press
 PEAK_GRID_3D = 201  # 3D: a grid of 201 x 201 points over +-2 contact radii
 
 
-def closed_form_table(run: dict) -> pd.DataFrame:
-    """One row per sequence of ``run`` (the ``[closed_form]`` entry of expected.toml, a run
-    file's keys: one per formulation and order): computed and predicted half-width (the contact
-    radius in 3D, that of the disc of the contact zone's area), the same with the zone's edge
-    placed by the square-root law (``edge_half_width``, ``bench.measure.zone_edge``) and peak
-    pressure, and their relative errors, at the last level."""
+def closed_form_table(runs: list[dict]) -> pd.DataFrame:
+    """One row per sequence of ``runs`` (the ``[[closed_form]]`` entries of expected.toml, a
+    run file's keys each: one per scene, formulation and order): computed and predicted
+    half-width (the contact radius in 3D, that of the disc of the contact zone's area), the same
+    with the zone's edge placed by the square-root law (``edge_half_width``,
+    ``bench.measure.zone_edge``) and peak pressure, and their relative errors, at the last
+    level."""
     rows = []
-    for spec in RunConfig(**run_fields(run, "[closed_form]")).specs():
-        scene = build_scene(spec)
-        *_, result = run_sequence(scene, spec.formulation, spec.solver, spec.estimator,
-                                  spec.loop)
-        rows.append(_compare(scene, spec, result))
+    for k, run in enumerate(runs):
+        for spec in RunConfig(**run_fields(run, f"[[closed_form]] {k + 1}")).specs():
+            scene = build_scene(spec)
+            *_, result = run_sequence(scene, spec.formulation, spec.solver, spec.estimator,
+                                      spec.loop)
+            rows.append(_compare(scene, spec, result))
     table = pd.DataFrame(rows)
     table["half_width_error"] = table["half_width"] / table["predicted_half_width"] - 1
     table["edge_half_width_error"] = (table["edge_half_width"] / table["predicted_half_width"]

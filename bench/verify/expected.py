@@ -16,7 +16,7 @@ EXPECTED = Path(__file__).with_name("expected.toml")
 def load_expected(path: str | Path = EXPECTED) -> dict:
     with open(path, "rb") as handle:
         expected = tomllib.load(handle)
-    for run in [*expected.get("run", []), expected.get("closed_form", {}),
+    for run in [*expected.get("run", []), *expected.get("closed_form", []),
                 expected.get("partial_slip", {})]:
         # a table that names none runs every registered one (one name or a list)
         if "formulation" not in run:
