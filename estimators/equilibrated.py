@@ -108,11 +108,11 @@ def estimate(scene, solution: DiscreteSolution) -> Estimate:
         tau_skew[jump.elements] = constants.korn * np.sqrt(jump.skew)
     grad_constant = np.sqrt(1 / (2 * mu) + constants.korn**2)
     volume = (np.sqrt(compliance) + constants.korn * np.sqrt(skew) + grad_constant * osc
-              + tau_sym + tau_skew + constants.friedrichs * np.sqrt(load)) ** 2
+              + tau_sym + tau_skew + constants.friedrichs * np.sqrt(load.squares)) ** 2
     parts = dict(symmetric=np.sqrt(compliance.sum()), skew=constants.korn * np.sqrt(skew.sum()),
                  oscillation=(grad_constant * np.sqrt((osc**2).sum())
                               + np.sqrt((tau_sym**2).sum()) + np.sqrt((tau_skew**2).sum())),
-                 load=constants.friedrichs * np.sqrt(load.sum()))
+                 load=constants.friedrichs * np.sqrt(load.squares.sum()))
     return smallest(scene, solution, parts, volume, bounds, shear, "equilibrated")
 
 
@@ -123,21 +123,27 @@ def compliance_squares(rec, interior, lame: tuple[float, float]) -> np.ndarray:
     return (compliance_energy(sym, *lame) * rec.basis.dx).sum(axis=1)
 
 
-def smallest(scene, solution, parts: dict, volume: np.ndarray, bounds, shear, name: str
+def smallest(scene, solution, parts: dict, volume: np.ndarray, bounds, shear, name: str,
+             trace_constant: float | None = None, negative_traction: float | None = None
              ) -> Estimate:
-    """Every extension d gives a bound (13.3): the smallest, as estimator ``name``."""
-    return min((_combined(scene, solution, parts, volume, bound, shear, name)
-                for bound in bounds), key=lambda est: est.eta)
+    """Every extension d gives a bound (13.3): the smallest, as estimator ``name``
+    (``trace_constant``: C_T, by default the computed one of 13.4; ``negative_traction``: N,
+    by default C_T ||lambda*_-||)."""
+    if trace_constant is None:
+        trace_constant = domain_constants(scene).trace
+    return min((_combined(scene, solution, parts, volume, bound, shear, name, trace_constant,
+                          negative_traction) for bound in bounds), key=lambda est: est.eta)
 
 
-def _combined(scene, solution, parts: dict, volume: np.ndarray, bound, shear, name: str
-              ) -> Estimate:
+def _combined(scene, solution, parts: dict, volume: np.ndarray, bound, shear, name: str,
+              trace_constant: float, negative_traction: float | None) -> Estimate:
     """eta of 13.1 from the parts of A (``BoundTerms``' volume fields), the contact terms of
     one extension (``bound``) and, under friction, those of sigma*_t (17.5)."""
-    constants = domain_constants(scene)
     friction = None if shear is None else friction_bound(scene, solution, shear, bound.field)
-    terms = BoundTerms(**parts, negative_traction=constants.trace * bound.negative,
-                       **friction_terms(friction, constants.trace))
+    if negative_traction is None:
+        negative_traction = trace_constant * bound.negative
+    terms = BoundTerms(**parts, negative_traction=negative_traction,
+                       **friction_terms(friction, trace_constant))
     A = terms.symmetric + terms.skew + terms.oscillation + terms.load
     a = A + bound.extension + terms.negative_traction + terms.excess_shear
     # b only grows when rounded up to 0: e^2 <= a e + b stays true (docs/theory.md, 17.5)
@@ -167,12 +173,14 @@ def marking_shares(eta: float, A: float, volume: np.ndarray, terms: BoundTerms,
     return np.zeros_like(volume) + local
 
 
-def equilibrate(scene, solution: DiscreteSolution, symmetrise=None):
+def equilibrate(scene, solution: DiscreteSolution, symmetrise=None,
+                trace_constant: float | None = None):
     """sigma* (a ``Reconstruction``, symmetrised by ``estimators.symmetrisation``, or by
-    ``symmetrise(rec, interior, prescribed, lame)`` if given), the patch data, ||rho||_T^2,
-    the contact terms of lambda* (a ``ContactBound`` per extension), the Neumann data of the
-    auxiliary problem, the clamped vertices and sigma*_t (None without friction)
-    (docs/theory.md, 13.2, 13.3 and 17.5)."""
+    ``symmetrise(rec, interior, prescribed, lame)`` if given), the patch data, rho,
+    the contact terms of lambda* (a ``ContactBound`` per extension, lambda* chosen with
+    ``trace_constant``, by default the computed C_T), the Neumann data of the auxiliary
+    problem, the clamped vertices and sigma*_t (None without friction) (docs/theory.md, 13.2,
+    13.3 and 17.5)."""
     elasticity = solution.elasticity
     mesh, order = elasticity.mesh, elasticity.order
     lam, mu = elasticity.lame
@@ -194,7 +202,8 @@ def equilibrate(scene, solution: DiscreteSolution, symmetrise=None):
         BoundaryData(trace.facets, lambda x: shear_at(trace, raw_shear(solution), x))]
     lam_star, bounds = contact_traction(  # the normal balance net of sigma_t,h's own
         scene, solution, interior,
-        reaction - boundary_balance(n_v, boundary_fluxes(interior, sheared)), clamped)
+        reaction - boundary_balance(n_v, boundary_fluxes(interior, sheared)), clamped,
+        trace_constant)
     normal = BoundaryData(trace.facets, lambda x: traction_at(trace, lam_star, x))
     contact = normal
     if sheared:  # sigma*_t balances what is left along the tangents (17.5)
@@ -218,7 +227,8 @@ def equilibrate(scene, solution: DiscreteSolution, symmetrise=None):
     return rec, interior, load, bounds, [neumann, contact], clamped, shear
 
 
-def contact_traction(scene, solution, interior, reaction: np.ndarray, clamped: np.ndarray
+def contact_traction(scene, solution, interior, reaction: np.ndarray, clamped: np.ndarray,
+                     trace_constant: float | None = None
                      ) -> tuple[ContactTraction, tuple[ContactBound, ...]]:
     """lambda* (docs/theory.md, 13.3): of three tractions that balance u_h on the contact
     patches, the one with the smallest terms 2 D + C_T ||lambda*_-|| + sqrt(B) (over the
@@ -238,7 +248,8 @@ def contact_traction(scene, solution, interior, reaction: np.ndarray, clamped: n
     candidates = [balanced_traction(trace, pressure,
                                     reaction - _balance(interior, trace, pressure), clamped)
                   for pressure in pressures]
-    trace_constant = domain_constants(scene).trace
+    if trace_constant is None:
+        trace_constant = domain_constants(scene).trace
     fields = [extend(scene, solution, clamped) for extend in EXTENSIONS]
     bounds = [tuple(contact_bound(scene, solution, traction, d) for d in fields)
               for traction in candidates]

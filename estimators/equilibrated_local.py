@@ -1,6 +1,7 @@
-"""``equilibrated-local``: the bound of ``equilibrated`` with the Korn-type constant C_K, a
-discrete eigenvalue computed from below, replaced by local constants proved from the geometry
-(docs/theory.md, section 13.4, "Local Korn constants").
+"""``equilibrated-local``: the bound of ``equilibrated`` with its three constants, discrete
+eigenvalues computed from below, replaced by constants proved from the geometry
+(docs/theory.md, section 13.4, "Local Korn constants" and "Trace and Friedrichs constants
+with a proof").
 
 * sigma* is weakly symmetric: its skew part is orthogonal to the continuous piecewise linear
   functions (``estimators.weak_symmetry``). Then, for v in H^1_D, with the vertex patches'
@@ -19,8 +20,9 @@ discrete eigenvalue computed from below, replaced by local constants proved from
 * Where f jumps, tau's skew part has zero mean on every such element and is charged with
   ((K_T - 1) / (2 mu))^(1/2) (``estimators.jump_equilibration``).
 
-C_T and C_F (the negative traction and the balancing load) remain the computed constants of
-``estimators.constants``.
+* C_T and C_F (the negative traction and the balancing load) are those of
+  ``estimators.proved_constants``, from the domain's geometry: no constant is computed from
+  below.
 """
 
 from __future__ import annotations
@@ -29,7 +31,6 @@ import numpy as np
 from skfem import Basis, ElementTriP1
 
 from estimators.base import register_estimator
-from estimators.constants import domain_constants
 from estimators.equilibrated import (
     BALANCE_TOLERANCE,
     NotEquilibrated,
@@ -38,11 +39,15 @@ from estimators.equilibrated import (
     smallest,
     tresca_only_for,
 )
+from estimators.guaranteed_contact import QUADRATURE
 from estimators.jump_equilibration import jump_oscillation
 from estimators.local_korn import element_korn, vertex_korn
 from estimators.oscillation import oscillation
+from estimators.proved_constants import proved_constants
+from estimators.rigid_duals import RigidChain
 from estimators.weak_symmetry import weakly_symmetrised
 from formulations import DiscreteSolution
+from formulations.contact import gauss_legendre
 
 NAME = "equilibrated-local"
 
@@ -58,8 +63,9 @@ def skew_squares(rec, korn: np.ndarray, mu: float) -> np.ndarray:
     return (t.shape[0]) / (2 * mu) * weighted.sum(axis=1)
 
 
-@register_estimator(NAME, "equilibrated with local Korn constants proved from the patches' "
-                          "angles (weakly symmetric stress) instead of the computed C_K",
+@register_estimator(NAME, "equilibrated with every constant proved: local Korn constants "
+                          "from the patches' angles (weakly symmetric stress) and trace and "
+                          "Friedrichs constants from the domain's geometry",
                     guaranteed=True, applies=tresca_only_for(NAME), friction=True)
 def estimate(scene, solution: DiscreteSolution):
     mesh = solution.elasticity.mesh
@@ -78,7 +84,9 @@ def estimate(scene, solution: DiscreteSolution):
                                   f"(relative) > {BALANCE_TOLERANCE:g}: no bound")
         return symmetric
 
-    rec, interior, load, bounds, boundary, _, shear = equilibrate(scene, solution, weak)
+    constants = proved_constants(scene)
+    rec, interior, load, bounds, boundary, _, shear = equilibrate(scene, solution, weak,
+                                                                  constants.trace)
     compliance = compliance_squares(rec, interior, (lam, mu))
     skew = skew_squares(rec, vertex, mu)
     jump = jump_oscillation(mesh, scene.body_force, rec.basis.elem.k, (lam, mu), 0.0,
@@ -91,11 +99,28 @@ def estimate(scene, solution: DiscreteSolution):
                                   f"(relative) > {BALANCE_TOLERANCE:g}: no bound")
         tau_sym[jump.elements] = np.sqrt(jump.symmetric)
         tau_skew[jump.elements] = np.sqrt((element[jump.elements] - 1) / (2 * mu) * jump.skew)
-    friedrichs = domain_constants(scene).friedrichs
-    volume = (np.sqrt(compliance) + np.sqrt(skew) + osc + tau_sym + tau_skew
-              + friedrichs * np.sqrt(load)) ** 2
     parts = dict(symmetric=np.sqrt(compliance.sum()), skew=np.sqrt(skew.sum()),
                  oscillation=(np.sqrt((osc**2).sum()) + np.sqrt((tau_sym**2).sum())
-                              + np.sqrt((tau_skew**2).sum())),
-                 load=friedrichs * np.sqrt(load.sum()))
-    return smallest(scene, solution, parts, volume, bounds, shear, NAME)
+                              + np.sqrt((tau_skew**2).sum())))
+    parts["load"], negative = dual_terms(scene, solution, constants, load, bounds[0],
+                                         sum(parts.values()))
+    spread = parts["load"] * np.sqrt(load.squares / max(load.squares.sum(), 1e-300))
+    volume = (np.sqrt(compliance) + np.sqrt(skew) + osc + tau_sym + tau_skew + spread) ** 2
+    return smallest(scene, solution, parts, volume, bounds, shear, NAME, constants.trace,
+                    negative)
+
+
+def dual_terms(scene, solution, constants, load, bound, rest: float) -> tuple[float, float]:
+    """The load term and N (13.4): C_F ||rho|| and C_T ||lambda*_-||, or the chained dual
+    norms of rho and lambda*_- (``estimators.rigid_duals``) where smaller. Both bound the
+    same functionals; the chain costs a sparse factorisation, built only where the two
+    weigh (above 1e-6 of the rest of A)."""
+    load_term = constants.friedrichs * np.sqrt(load.squares.sum())
+    negative = constants.trace * bound.negative
+    if load_term + negative <= 1e-6 * rest:
+        return load_term, negative
+    elasticity = solution.elasticity
+    chain = RigidChain.of(scene, elasticity.mesh, elasticity.lame)
+    t, w = gauss_legendre(QUADRATURE)
+    return (min(load_term, chain.load(load.nodal)),
+            min(negative, chain.traction(solution.trace, bound.negative_part, t, w)))

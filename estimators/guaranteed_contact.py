@@ -113,6 +113,7 @@ class ContactBound:
     complementarity: float  # (lambda*_+, g - u_hn - d . n)_{Gamma_C} >= 0
     energy: np.ndarray      # a(d, d) per element
     negative_squares: np.ndarray  # ||lambda*_-||^2 over each element's contact facets
+    negative_part: np.ndarray     # lambda*_- (n_facets, QUADRATURE) at the Gauss points
     slack: np.ndarray       # |(lambda*_+, g - u_hn - d . n)| over each element's contact facets
     field: Extension        # d itself
 
@@ -131,4 +132,5 @@ def contact_bound(scene, solution, traction: ContactTraction, d: Extension) -> C
                         negative=float(np.sqrt(negative.sum())),
                         complementarity=float(max(slack.sum(), 0.0)), energy=energy,
                         negative_squares=np.bincount(trace.element, negative, n_el),
+                        negative_part=np.minimum(lam, 0.0),
                         slack=np.bincount(trace.element, np.abs(slack), n_el), field=d)

@@ -54,7 +54,7 @@ def element_korn(mesh) -> np.ndarray:
     return korn_from_angle(element_angles(mesh).min(axis=0) / 2)
 
 
-def _edge_angle(a, b, c, inner) -> np.ndarray:
+def edge_angle(a, b, c, inner) -> np.ndarray:
     """min(alpha_a, alpha_b) of the module docstring for edges [a, b] (2, m) seen from
     centres c (2, m), 0 where c is not strictly on the side of ``inner`` (2, m)."""
     ab = b - a
@@ -114,7 +114,7 @@ def vertex_korn(mesh) -> np.ndarray:
     pair_centre = np.repeat(np.arange(centre_owner.size), repeats)
     offsets = np.arange(repeats.sum()) - np.repeat(np.cumsum(repeats) - repeats, repeats)
     pair_edge = edge_order[np.repeat(first[centre_owner], repeats) + offsets]
-    angle = _edge_angle(a[:, pair_edge], b[:, pair_edge], centre[:, pair_centre],
+    angle = edge_angle(a[:, pair_edge], b[:, pair_edge], centre[:, pair_centre],
                         inner[:, pair_edge])
     seen = np.full(centre_owner.size, np.inf)
     np.minimum.at(seen, pair_centre, angle)                 # a centre's angle: its worst edge

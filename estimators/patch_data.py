@@ -74,11 +74,19 @@ def load_moments(mesh, body_force, k: int) -> np.ndarray:
     return np.einsum("mre,am,lm->earl", per_node, hats, q)
 
 
+@dataclass(frozen=True, eq=False)
+class BalancingLoad:
+    """rho = sum_a nodal_a psi_a (``nodal`` (n_vertices, 2)) and ||rho||_{0,T}^2 per element."""
+
+    nodal: np.ndarray
+    squares: np.ndarray
+
+
 def rebalanced(interior: Interior, defect: np.ndarray,
-               clamped: np.ndarray) -> tuple[Interior, np.ndarray]:
+               clamped: np.ndarray) -> tuple[Interior, BalancingLoad]:
     """The patch data with the load rho = sum_a (defect_a / int psi_a) psi_a (off Gamma_D)
-    added, so that every patch balances, and ||rho||_{0,T}^2 per element (docs/theory.md,
-    13.2): sum_T int_T (data) then equals the boundary fluxes for every vertex."""
+    added, so that every patch balances, and rho (docs/theory.md, 13.2): sum_T int_T (data)
+    then equals the boundary fluxes for every vertex."""
     mesh = interior.rt.mesh
     area = element_areas(mesh)
     weight = np.bincount(mesh.t.ravel(), np.tile(area / 3, 3), minlength=mesh.p.shape[1])
@@ -87,7 +95,7 @@ def rebalanced(interior: Interior, defect: np.ndarray,
     data = interior.data - np.einsum("ier,il,e->eirl", local, _hat_moments(interior.k), area)
     norm2 = area / 12 * ((local**2).sum(axis=0) + local.sum(axis=0) ** 2).sum(axis=-1)
     total = interior.total - np.where(clamped[:, None], 0.0, defect)
-    return replace(interior, data=data, total=total), norm2
+    return replace(interior, data=data, total=total), BalancingLoad(c, norm2)
 
 
 def _hat_moments(k: int) -> np.ndarray:
