@@ -26,7 +26,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.sparse.linalg import splu
 
 from estimators.chained_constants import (
     OPPOSITE,
@@ -37,6 +36,7 @@ from estimators.chained_constants import (
     triangle_rule,
 )
 from estimators.local_korn import element_korn
+from formulations.solvers.backends import factorise
 
 
 @dataclass(frozen=True, eq=False)
@@ -48,7 +48,7 @@ class RigidChain:
     poincare: np.ndarray  # P_T = h_T / pi
     korn: np.ndarray      # K_T
     tau2: np.ndarray      # (3, n_el) tau^2 per side, in the mesh's t2f order
-    factor: object        # splu of J_w
+    solve: object         # J_w^-1, by the default direct back-end
     stiffness: float      # s
 
     @staticmethod
@@ -62,14 +62,14 @@ class RigidChain:
         centres = mesh.p[:, mesh.t].mean(axis=1)
         J = jump_form(mesh, centres, 0.5 / worst, 1.0 / worst, scene.dirichlet_facets(mesh))
         lam, mu = lame
-        return RigidChain(mesh, centres, poincare, korn, tau2, splu(J.tocsc()),
+        return RigidChain(mesh, centres, poincare, korn, tau2, factorise(J.tocsc()),
                           2 * mu + 2 * min(lam, 0.0))
 
     def bound(self, local: np.ndarray, moments: np.ndarray) -> float:
         """sup l(v) / ||v|| for l with the local parts ``local`` (n_el,) (||rho||_T P_T +
         sum_F ||lambda||_F tau_F) and the rigid moments ``moments`` (n_el, 3)."""
         m = moments.ravel()
-        rigid = np.sqrt(3.0 * max(float(m @ self.factor.solve(m)), 0.0))
+        rigid = np.sqrt(3.0 * max(float(m @ self.solve(m)), 0.0))
         return float((np.sqrt((local**2 * self.korn).sum()) + rigid) / np.sqrt(self.stiffness))
 
     def load(self, nodal: np.ndarray) -> float:
