@@ -56,6 +56,16 @@ def side_lengths(mesh) -> np.ndarray:
                      for i in range(3)])
 
 
+def element_factors(mesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """P_T = h_T / pi, K_T and tau^2 (3, n_el) per side in the mesh's t2f order (module
+    docstring)."""
+    sides = side_lengths(mesh)                                   # opposite vertex i
+    h = sides.max(axis=0)
+    poincare = h / np.pi
+    tau2 = (sides / triangle_areas(mesh) * (poincare**2 + h * poincare))[OPPOSITE]
+    return poincare, element_korn(mesh), tau2
+
+
 def side_rule(mesh, facets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Simpson's rule on ``facets``: points (2, m, 3) and weights (m, 3), exact for cubics."""
     a, b = mesh.p[:, mesh.facets[0, facets]], mesh.p[:, mesh.facets[1, facets]]
@@ -113,11 +123,8 @@ def _largest(A: sp.csr_matrix, B: sp.csr_matrix) -> float:
 
 def chained_constants(scene, mesh) -> tuple[float, float]:
     """(C_T, C_F) of the module docstring on ``mesh``, a triangulation of the scene's domain."""
-    x = mesh.p[:, mesh.t]
-    n, area, sides = mesh.t.shape[1], triangle_areas(mesh), side_lengths(mesh)
-    h = sides.max(axis=0)
-    korn, poincare = element_korn(mesh), h / np.pi
-    tau2 = (sides / area * (poincare**2 + h * poincare))[OPPOSITE]   # per t2f side
+    n = mesh.t.shape[1]
+    poincare, korn, tau2 = element_factors(mesh)
     on = np.zeros((3, mesh.facets.shape[1]), dtype=bool)
     on[0, mesh.f2t[1] >= 0] = True
     on[1, scene.dirichlet_facets(mesh)] = True
@@ -125,7 +132,7 @@ def chained_constants(scene, mesh) -> tuple[float, float]:
     interior, clamped, contact = on[:, mesh.t2f]
     chain = (tau2 * (2.0 * interior + clamped)).sum(axis=0) * korn
     touching = (tau2 * contact).sum(axis=0) * korn
-    centres = x.mean(axis=1)
+    centres = mesh.p[:, mesh.t].mean(axis=1)
     J = jump_form(mesh, centres, 1.0, 1.0, np.flatnonzero(on[1]))
     contact_gram = _sparse(*_side_gram(mesh, np.flatnonzero(on[2]), centres, False), 3 * n)
     points, weights = triangle_rule(mesh)

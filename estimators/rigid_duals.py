@@ -28,14 +28,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from estimators.chained_constants import (
-    OPPOSITE,
+    element_factors,
     jump_form,
     rigid_at,
-    side_lengths,
     triangle_areas,
     triangle_rule,
 )
-from estimators.local_korn import element_korn
 from formulations.solvers.backends import factorise
 
 
@@ -53,10 +51,7 @@ class RigidChain:
 
     @staticmethod
     def of(scene, mesh, lame: tuple[float, float]) -> RigidChain:
-        sides = side_lengths(mesh)                                   # opposite vertex i
-        h = sides.max(axis=0)
-        korn, poincare = element_korn(mesh), h / np.pi
-        tau2 = (sides / triangle_areas(mesh) * (poincare**2 + h * poincare))[OPPOSITE]
+        poincare, korn, tau2 = element_factors(mesh)
         worst = np.zeros(mesh.facets.shape[1])
         np.maximum.at(worst, mesh.t2f.ravel(), (tau2 * korn).ravel())
         centres = mesh.p[:, mesh.t].mean(axis=1)
