@@ -29,6 +29,7 @@ import scipy.sparse as sp
 from scipy.linalg import eigh
 from scipy.sparse.linalg import eigsh
 
+from estimators.averaging import element_areas
 from estimators.local_korn import element_korn
 
 DENSE_UNKNOWNS = 3000  # rigid motions (3 per triangle) up to which the pencil is solved densely
@@ -43,10 +44,10 @@ def rigid_at(x: np.ndarray, centre: np.ndarray) -> np.ndarray:
                      [centre[1][:, None] - x[1], x[0] - centre[0][:, None]]])
 
 
-def triangle_areas(mesh) -> np.ndarray:
-    x = mesh.p[:, mesh.t]
-    u, w = x[:, 1] - x[:, 0], x[:, 2] - x[:, 0]
-    return 0.5 * np.abs(u[0] * w[1] - u[1] * w[0])
+def strain_floor(lame: tuple[float, float]) -> float:
+    """s with a(v, v) >= s ||eps(v)||^2 in 2D: 2 mu + 2 min(lambda, 0) ((tr e)^2 <= 2 |e|^2)."""
+    lam, mu = lame
+    return 2 * mu + 2 * min(lam, 0.0)
 
 
 def side_lengths(mesh) -> np.ndarray:
@@ -62,7 +63,7 @@ def element_factors(mesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     sides = side_lengths(mesh)                                   # opposite vertex i
     h = sides.max(axis=0)
     poincare = h / np.pi
-    tau2 = (sides / triangle_areas(mesh) * (poincare**2 + h * poincare))[OPPOSITE]
+    tau2 = (sides / element_areas(mesh) * (poincare**2 + h * poincare))[OPPOSITE]
     return poincare, element_korn(mesh), tau2
 
 
@@ -78,7 +79,7 @@ def triangle_rule(mesh) -> tuple[np.ndarray, np.ndarray]:
     quadratics."""
     x = mesh.p[:, mesh.t]
     points = np.stack([0.5 * (x[:, i] + x[:, (i + 1) % 3]) for i in range(3)], axis=-1)
-    return points, np.repeat(triangle_areas(mesh)[:, None] / 3, 3, axis=1)
+    return points, np.repeat(element_areas(mesh)[:, None] / 3, 3, axis=1)
 
 
 def _sparse(blocks: np.ndarray, index: np.ndarray, n: int) -> sp.csr_matrix:
@@ -139,8 +140,7 @@ def chained_constants(scene, mesh) -> tuple[float, float]:
     E = rigid_at(points, centres)
     mass = _sparse(np.einsum("idmq,jdmq,mq->mij", E, E, weights),
                    3 * np.arange(n)[:, None] + np.arange(3), 3 * n)
-    lam, mu = scene.material.lame
-    s = 2 * mu + 2 * min(lam, 0.0)
+    s = strain_floor(scene.material.lame)
     g_domain, g_contact = _largest(mass, J), max(_largest(contact_gram, J), 0.0)
     friedrichs = (np.sqrt((poincare**2 * korn).max()) + np.sqrt(g_domain * chain.max()))
     trace = np.sqrt(touching.max()) + np.sqrt(g_contact * chain.max())

@@ -122,5 +122,5 @@ def dual_terms(scene, solution, constants, load, bound, rest: float) -> tuple[fl
     elasticity = solution.elasticity
     chain = RigidChain.of(scene, elasticity.mesh, elasticity.lame)
     t, w = gauss_legendre(QUADRATURE)
-    return (min(load_term, chain.load(load.nodal)),
+    return (min(load_term, chain.load(load)),
             min(negative, chain.traction(solution.trace, bound.negative_part, t, w)))

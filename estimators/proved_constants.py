@@ -33,11 +33,12 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import eigh
 
+from estimators.averaging import element_areas
 from estimators.chained_constants import (
     chained_constants,
     rigid_at,
     side_rule,
-    triangle_areas,
+    strain_floor,
     triangle_rule,
 )
 from estimators.local_korn import edge_angle, korn_from_angle
@@ -71,7 +72,7 @@ class Outline:
         normal = np.array([edge[1], -edge[0]]) / np.linalg.norm(edge, axis=0)
         normal *= np.sign((normal * (mesh.p[:, third] - mesh.p[:, a])).sum(axis=0))
         x = mesh.p[:, mesh.t]
-        area = triangle_areas(mesh)
+        area = element_areas(mesh)
         centroid = (x.mean(axis=1) * area).sum(axis=1) / area.sum()
         return Outline(mesh.p[:, a], mesh.p[:, b], normal, mesh.p[:, third], centroid)
 
@@ -94,13 +95,10 @@ _CACHE: dict[str, ProvedConstants] = {}
 
 
 def proved_constants(scene) -> ProvedConstants:
-    """C_T and C_F of ``scene``: the smaller of the whole domain's (if convex) and the chained
-    ones (cached per scene name and parameters)."""
+    """C_T and C_F of ``scene`` (a triangle mesh): the smaller of the whole domain's (if
+    convex) and the chained ones (cached per scene name and parameters)."""
     key = f"{scene.name}:{sorted(scene.parameters.items())!r}"
     if key not in _CACHE:
-        if scene.dim != 2:
-            raise ValueError(f"scene={scene.name!r} is {scene.dim}D: the proved trace and "
-                             "Friedrichs constants are built on triangles")
         convex = convex_constants(scene) if Outline.of(scene.mesh).convex() else None
         chained = chained_constants(scene, scene.mesh)
         both = [pair for pair in (convex, chained) if pair is not None]
@@ -126,7 +124,6 @@ def convex_constants(scene) -> tuple[float, float]:
                                 eigvals_only=True).max())
     contact = rigid_gram(side_rule(mesh, scene.contact_facets(mesh)), c)
     rigid_contact = np.sqrt(max(eigh(contact, clamped, eigvals_only=True).max(), 0.0))
-    lam, mu = scene.material.lame
-    scale = np.sqrt(korn / (2 * mu + 2 * min(lam, 0.0)))
+    scale = np.sqrt(korn / strain_floor(scene.material.lame))
     return (float((1 + rigid_contact) * boundary * scale),
             float((poincare + rigid_domain * boundary) * scale))

@@ -31,7 +31,7 @@ from estimators.chained_constants import (
     element_factors,
     jump_form,
     rigid_at,
-    triangle_areas,
+    strain_floor,
     triangle_rule,
 )
 from formulations.solvers.backends import factorise
@@ -56,9 +56,8 @@ class RigidChain:
         np.maximum.at(worst, mesh.t2f.ravel(), (tau2 * korn).ravel())
         centres = mesh.p[:, mesh.t].mean(axis=1)
         J = jump_form(mesh, centres, 0.5 / worst, 1.0 / worst, scene.dirichlet_facets(mesh))
-        lam, mu = lame
         return RigidChain(mesh, centres, poincare, korn, tau2, factorise(J.tocsc()),
-                          2 * mu + 2 * min(lam, 0.0))
+                          strain_floor(lame))
 
     def bound(self, local: np.ndarray, moments: np.ndarray) -> float:
         """sup l(v) / ||v|| for l with the local parts ``local`` (n_el,) (||rho||_T P_T +
@@ -67,15 +66,14 @@ class RigidChain:
         rigid = np.sqrt(3.0 * max(float(m @ self.solve(m)), 0.0))
         return float((np.sqrt((local**2 * self.korn).sum()) + rigid) / np.sqrt(self.stiffness))
 
-    def load(self, nodal: np.ndarray) -> float:
-        """The bound for rho = sum_a nodal_a psi_a, a continuous P1 field (n_vertices, 2)."""
-        t, area = self.mesh.t, triangle_areas(self.mesh)
-        local = nodal[t]                                                 # (3, n_el, 2)
-        norm = np.sqrt(area / 12 * ((local**2).sum(axis=0) + local.sum(axis=0) ** 2).sum(-1))
+    def load(self, rho) -> float:
+        """The bound for the balancing load ``rho`` (``estimators.patch_data.BalancingLoad``:
+        a continuous P1 field and its squared norms per element)."""
+        local = rho.nodal[self.mesh.t]                                   # (3, n_el, 2)
         points, weights = triangle_rule(self.mesh)                       # edge midpoints
         values = np.stack([0.5 * (local[i] + local[(i + 1) % 3]) for i in range(3)], axis=-1)
         moments = np.einsum("idnq,ndq,nq->ni", rigid_at(points, self.centres), values, weights)
-        return self.bound(norm * self.poincare, moments)
+        return self.bound(np.sqrt(rho.squares) * self.poincare, moments)
 
     def traction(self, trace, values: np.ndarray, t: np.ndarray, w: np.ndarray) -> float:
         """The bound for a normal traction on Gamma_C given at the points t (weights w) of
