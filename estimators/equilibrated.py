@@ -20,6 +20,8 @@ D and eta_complementarity sqrt(B).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from estimators.averaging import compliance_energy
@@ -77,11 +79,23 @@ def tresca_only_for(name: str):
 tresca_only = tresca_only_for("equilibrated")
 
 
-def friction_terms(friction, trace_constant: float) -> dict[str, float]:
+@dataclass(frozen=True)
+class DualNorms:
+    """What replaces C_T times a norm in N and N_t (``estimators.equilibrated_local``): the
+    trace constant, and N and N_t themselves where they are bounded otherwise (None: C_T
+    ||lambda*_-|| and C_T ||(|sigma*_t| - s)_+||)."""
+
+    trace: float
+    negative_traction: float | None = None
+    excess_shear: float | None = None
+
+
+def friction_terms(friction, duals: DualNorms) -> dict[str, float]:
     """The friction parts of ``BoundTerms``: N_t and sqrt(B_t^+) (0 without friction)."""
     if friction is None:
         return {}
-    return {"excess_shear": trace_constant * friction.excess,
+    excess = duals.excess_shear
+    return {"excess_shear": duals.trace * friction.excess if excess is None else excess,
             "friction_complementarity": float(np.sqrt(max(friction.complementarity, 0.0)))}
 
 
@@ -124,26 +138,25 @@ def compliance_squares(rec, interior, lame: tuple[float, float]) -> np.ndarray:
 
 
 def smallest(scene, solution, parts: dict, volume: np.ndarray, bounds, shear, name: str,
-             trace_constant: float | None = None, negative_traction: float | None = None
-             ) -> Estimate:
+             duals: DualNorms | None = None) -> Estimate:
     """Every extension d gives a bound (13.3): the smallest, as estimator ``name``
-    (``trace_constant``: C_T, by default the computed one of 13.4; ``negative_traction``: N,
-    by default C_T ||lambda*_-||)."""
-    if trace_constant is None:
-        trace_constant = domain_constants(scene).trace
-    return min((_combined(scene, solution, parts, volume, bound, shear, name, trace_constant,
-                          negative_traction) for bound in bounds), key=lambda est: est.eta)
+    (``duals``: by default the computed C_T of 13.4 times the norms)."""
+    if duals is None:
+        duals = DualNorms(trace=domain_constants(scene).trace)
+    return min((_combined(scene, solution, parts, volume, bound, shear, name, duals)
+                for bound in bounds), key=lambda est: est.eta)
 
 
 def _combined(scene, solution, parts: dict, volume: np.ndarray, bound, shear, name: str,
-              trace_constant: float, negative_traction: float | None) -> Estimate:
+              duals: DualNorms) -> Estimate:
     """eta of 13.1 from the parts of A (``BoundTerms``' volume fields), the contact terms of
     one extension (``bound``) and, under friction, those of sigma*_t (17.5)."""
     friction = None if shear is None else friction_bound(scene, solution, shear, bound.field)
+    negative_traction = duals.negative_traction
     if negative_traction is None:
-        negative_traction = trace_constant * bound.negative
+        negative_traction = duals.trace * bound.negative
     terms = BoundTerms(**parts, negative_traction=negative_traction,
-                       **friction_terms(friction, trace_constant))
+                       **friction_terms(friction, duals))
     A = terms.symmetric + terms.skew + terms.oscillation + terms.load
     a = A + bound.extension + terms.negative_traction + terms.excess_shear
     # b only grows when rounded up to 0: e^2 <= a e + b stays true (docs/theory.md, 17.5)

@@ -33,6 +33,7 @@ from skfem import Basis, ElementTriP1
 from estimators.base import register_estimator
 from estimators.equilibrated import (
     BALANCE_TOLERANCE,
+    DualNorms,
     NotEquilibrated,
     compliance_squares,
     equilibrate,
@@ -40,6 +41,7 @@ from estimators.equilibrated import (
     tresca_only_for,
 )
 from estimators.guaranteed_contact import QUADRATURE
+from estimators.guaranteed_friction import shear_excess
 from estimators.jump_equilibration import jump_oscillation
 from estimators.local_korn import element_korn, vertex_korn
 from estimators.oscillation import oscillation
@@ -102,25 +104,29 @@ def estimate(scene, solution: DiscreteSolution):
     parts = dict(symmetric=np.sqrt(compliance.sum()), skew=np.sqrt(skew.sum()),
                  oscillation=(np.sqrt((osc**2).sum()) + np.sqrt((tau_sym**2).sum())
                               + np.sqrt((tau_skew**2).sum())))
-    parts["load"], negative = dual_terms(scene, solution, constants, load, bounds[0],
-                                         sum(parts.values()))
+    parts["load"], duals = dual_terms(scene, solution, constants, load, bounds[0], shear,
+                                      sum(parts.values()))
     spread = parts["load"] * np.sqrt(load.squares / max(load.squares.sum(), 1e-300))
     volume = (np.sqrt(compliance) + np.sqrt(skew) + osc + tau_sym + tau_skew + spread) ** 2
-    return smallest(scene, solution, parts, volume, bounds, shear, NAME, constants.trace,
-                    negative)
+    return smallest(scene, solution, parts, volume, bounds, shear, NAME, duals)
 
 
-def dual_terms(scene, solution, constants, load, bound, rest: float) -> tuple[float, float]:
-    """The load term and N (13.4): C_F ||rho|| and C_T ||lambda*_-||, or the chained dual
-    norms of rho and lambda*_- (``estimators.rigid_duals``) where smaller. Both bound the
-    same functionals; the chain costs a sparse factorisation, built only where the two
-    weigh (above 1e-6 of the rest of A)."""
+def dual_terms(scene, solution, constants, load, bound, shear, rest: float
+               ) -> tuple[float, DualNorms]:
+    """The load term, N and N_t (13.4, 17.5): C_F ||rho||, C_T ||lambda*_-|| and C_T
+    ||(|sigma*_t| - s)_+||, or the chained dual norms of ``estimators.rigid_duals`` where
+    smaller. Both bound the same functionals; the chain costs a sparse factorisation, built
+    only where the three weigh (above 1e-6 of the rest of A)."""
     load_term = constants.friedrichs * np.sqrt(load.squares.sum())
     negative = constants.trace * bound.negative
-    if load_term + negative <= 1e-6 * rest:
-        return load_term, negative
+    t, w = gauss_legendre(QUADRATURE)
+    excess = None if shear is None else shear_excess(scene, solution, shear, t)[2]
+    excess_norm = 0.0 if excess is None else np.sqrt(solution.trace.integrate(excess**2, w).sum())
+    if load_term + negative + constants.trace * excess_norm <= 1e-6 * rest:
+        return load_term, DualNorms(constants.trace, negative)
     elasticity = solution.elasticity
     chain = RigidChain.of(scene, elasticity.mesh, elasticity.lame)
-    t, w = gauss_legendre(QUADRATURE)
-    return (min(load_term, chain.load(load)),
-            min(negative, chain.traction(solution.trace, bound.negative_part, t, w)))
+    negative = min(negative, chain.traction(solution.trace, bound.negative_part, t, w))
+    shear_term = None if excess is None else min(
+        constants.trace * excess_norm, chain.absolute_tangential(solution.trace, excess, w))
+    return min(load_term, chain.load(load)), DualNorms(constants.trace, negative, shear_term)

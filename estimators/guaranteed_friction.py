@@ -65,6 +65,15 @@ def shear_at(trace, shear: ContactTraction, x: np.ndarray) -> np.ndarray:
     return traction_at(trace, shear, x, direction=contact_tangent(trace))
 
 
+def shear_excess(scene, solution, shear: ContactTraction, t: np.ndarray
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """sigma*_t, s and (|sigma*_t| - s)_+ at the points t of every contact facet, (n_f, nq)."""
+    trace = solution.trace
+    bound = scene.friction.slip_bound_at(trace.points(t)).reshape(trace.size, t.size)
+    sigma = shear(t)
+    return sigma, bound, np.maximum(np.abs(sigma) - bound, 0.0)
+
+
 def friction_bound(scene, solution, shear: ContactTraction, d: Extension) -> FrictionBound:
     """N_t / C_T and B_t of the module docstring; ``d`` the extension of the contact terms."""
     trace, law = solution.trace, scene.friction
@@ -74,9 +83,7 @@ def friction_bound(scene, solution, shear: ContactTraction, d: Extension) -> Fri
     xi = (at.matrix(np.repeat(tangent, t.size, axis=1)) @ solution.u).reshape(
         trace.size, t.size) - law.slide
     y = xi + d.along(trace, tangent, t)
-    bound = law.slip_bound_at(trace.points(t)).reshape(trace.size, t.size)
-    sigma = shear(t)
-    excess = np.maximum(np.abs(sigma) - bound, 0.0)
+    sigma, bound, excess = shear_excess(scene, solution, shear, t)
     per_facet = trace.integrate(bound * np.abs(y) + sigma * y + excess * np.abs(xi), w)
     per_element = np.bincount(trace.element, np.abs(per_facet), trace.mesh.t.shape[1])
     return FrictionBound(excess=float(np.sqrt(trace.integrate(excess**2, w).sum())),

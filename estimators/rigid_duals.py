@@ -75,15 +75,45 @@ class RigidChain:
         moments = np.einsum("idnq,ndq,nq->ni", rigid_at(points, self.centres), values, weights)
         return self.bound(np.sqrt(rho.squares) * self.poincare, moments)
 
+    def facet_local(self, trace, values: np.ndarray, w: np.ndarray) -> np.ndarray:
+        """sum_F ||g||_F tau_(T,F) per triangle for g given at the points of weights w of
+        each contact facet of ``trace``, ``values`` (n_facets, nq)."""
+        owner = trace.element
+        side = np.argmax(self.mesh.t2f[:, owner] == trace.facets, axis=0)
+        norms = np.sqrt(trace.integrate(values**2, w))
+        return np.bincount(owner, norms * np.sqrt(self.tau2[side, owner]), self.mesh.t.shape[1])
+
     def traction(self, trace, values: np.ndarray, t: np.ndarray, w: np.ndarray) -> float:
         """The bound for a normal traction on Gamma_C given at the points t (weights w) of
         each contact facet of ``trace``: ``values`` (n_facets, nq)."""
         n_el, owner = self.mesh.t.shape[1], trace.element
-        side = np.argmax(self.mesh.t2f[:, owner] == trace.facets, axis=0)
-        norms = np.sqrt(trace.integrate(values**2, w))
-        local = np.bincount(owner, norms * np.sqrt(self.tau2[side, owner]), n_el)
         r = rigid_at(trace.points(t), self.centres[:, owner])            # (3, 2, n_f, nq)
         along = np.einsum("idfq,df->ifq", r, trace.normal)
         per_facet = (along * (values * w)[None]).sum(axis=-1) * trace.length   # (3, n_f)
         moments = np.stack([np.bincount(owner, per_facet[i], n_el) for i in range(3)], axis=1)
-        return self.bound(local, moments)
+        return self.bound(self.facet_local(trace, values, w), moments)
+
+    def absolute_tangential(self, trace, values: np.ndarray, w: np.ndarray) -> float:
+        """The bound for v -> int_(Gamma_C) g |v . t| with g >= 0 given as in ``traction``
+        and t the facets' tangents (the excess shear of Tresca friction, docs/theory.md
+        17.5). The functional is not linear, but the rigid part of v . t is constant on a
+        straight facet, m_F . r_T, so sum_F G_F |m_F . r_T| (G_F = int_F g) is at most
+        sum_F G_F (m_F . J_w^-1 m_F)^(1/2) J_w(r)^(1/2): one solve per facet where g > 0."""
+        owner, n_rigid = trace.element, 3 * self.mesh.t.shape[1]
+        weights = trace.integrate(values, w)
+        live = np.flatnonzero(weights > 0)
+        middle = trace.points(np.array([0.5]))[:, live, 0]
+        r = rigid_at(middle[:, :, None], self.centres[:, owner[live]])[..., 0]   # (3, 2, k)
+        tangent = np.array([-trace.normal[1, live], trace.normal[0, live]])
+        m = np.einsum("idk,dk->ki", r, tangent)                          # (k, 3)
+        rigid = 0.0
+        # 32 right-hand sides at a time: 3 n_el x 32 doubles, 77 MB at 1e5 triangles
+        for start in range(0, live.size, 32):
+            chunk = np.arange(start, min(start + 32, live.size))
+            rhs = np.zeros((n_rigid, chunk.size))
+            rows = 3 * owner[live[chunk]][:, None] + np.arange(3)
+            rhs[rows, np.arange(chunk.size)[:, None]] = m[chunk]
+            dual = np.maximum((rhs * self.solve(rhs)).sum(axis=0), 0.0)
+            rigid += float(weights[live[chunk]] @ np.sqrt(3.0 * dual))
+        local = self.facet_local(trace, values, w)
+        return float((np.sqrt((local**2 * self.korn).sum()) + rigid) / np.sqrt(self.stiffness))
