@@ -103,20 +103,47 @@ def estimator_summary(rows: pd.DataFrame) -> pd.DataFrame:
                     if len(late) else "",
                     "levels with eta < error": f"{int((eff < 1).sum())} "
                                                f"({100 * float((eff < 1).mean()):.0f} %)",
-                    "parts of the bound from 1e3 DOFs": bound_parts_text(group)})
+                    "parts of the bound from 1e3 DOFs": bound_parts_text(group),
+                    "largest part at the max from 1e3 DOFs": worst_part_text(group)})
     return pd.DataFrame(out)
+
+
+def _part_shares(group: pd.DataFrame) -> pd.DataFrame:
+    """Each part of a guaranteed bound's A + N (``BoundTerms``) over their sum, on the levels
+    from 1e3 DOFs that report them."""
+    columns = [f"eta_{f.name}" for f in fields(BoundTerms) if f"eta_{f.name}" in group]
+    late = group.loc[group["ndofs"] >= EFFECTIVITY_FROM_DOFS, columns].dropna()
+    late = late[late.sum(axis=1) > 0]
+    return late.div(late.sum(axis=1), axis=0)
+
+
+def _part_name(column: str) -> str:
+    return column.removeprefix("eta_").replace("_", " ")
 
 
 def bound_parts_text(group: pd.DataFrame) -> str:
     """The median share of each part of a guaranteed bound's A + N (``BoundTerms``) over the
     levels from 1e3 DOFs, largest first ('' for an estimator without parts)."""
-    columns = [f"eta_{f.name}" for f in fields(BoundTerms) if f"eta_{f.name}" in group]
-    late = group.loc[group["ndofs"] >= EFFECTIVITY_FROM_DOFS, columns].dropna()
-    if late.empty:
+    shares = _part_shares(group)
+    if shares.empty:
         return ""
-    shares = late.div(late.sum(axis=1), axis=0).median().sort_values(ascending=False)
-    return ", ".join(f"{name.removeprefix('eta_').replace('_', ' ')} {100 * share:.0f} %"
-                     for name, share in shares.items() if share >= 0.005)
+    median = shares.median().sort_values(ascending=False)
+    return ", ".join(f"{_part_name(name)} {100 * share:.0f} %"
+                     for name, share in median.items() if share >= 0.005)
+
+
+def worst_part_text(group: pd.DataFrame) -> str:
+    """The part that dominates A + N on the level of largest effectivity from 1e3 DOFs, with
+    its share and the level ('' for an estimator without parts): where the bound is
+    loosest, what makes it so."""
+    shares = _part_shares(group)
+    if shares.empty:
+        return ""
+    worst = group.loc[shares.index, "effectivity_index"].idxmax()
+    part, level = shares.loc[worst].idxmax(), group.loc[worst]
+    return (f"{_part_name(part)} {100 * shares.loc[worst, part]:.0f} % ({level['scene']}, "
+            f"{level['formulation']}, {level['strategy']} P{int(level['order'])}, "
+            f"{int(level['ndofs'])} DOFs, effectivity {_fmt(level['effectivity_index'])})")
 
 
 def _total_time(group: pd.DataFrame) -> float:
