@@ -1,5 +1,6 @@
-"""Dual norms of a load and of a negative contact traction on H^1_D, chained over the triangles
-of the mesh (docs/theory.md, section 13.4, "Localised dual norms").
+"""Dual norms of a load, of a negative contact traction and of Tresca friction's excess shear
+on H^1_D, chained over the triangles of the mesh (docs/theory.md, section 13.4, "Localised dual
+norms").
 
 For v in H^1_D split on each triangle as in ``estimators.chained_constants`` (v = w_T + r_T,
 a_T = ||grad w_T||_T <= K_T^(1/2) ||eps(v)||_T), a functional l(v) = (rho, v) + (lambda, v . n)

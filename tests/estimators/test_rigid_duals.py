@@ -76,8 +76,9 @@ def test_the_absolute_shear_bound_lies_above_every_signed_discrete_dual_norm(sig
     elasticity = assemble_elasticity(scene, mesh, order=2)
     trace = solve(get_formulation("vi")(scene, mesh), "active-set").trace
     t, w = gauss_legendre(10)
-    values = np.abs(RNG.standard_normal((trace.size, 1))) * (1 + t[None, :])    # >= 0
-    sign = np.ones((trace.size, 1)) if signs == "equal" else RNG.choice([-1.0, 1.0],
+    rng = np.random.default_rng(11)   # its own: the same values in whatever order tests run
+    values = np.abs(rng.standard_normal((trace.size, 1))) * (1 + t[None, :])    # >= 0
+    sign = np.ones((trace.size, 1)) if signs == "equal" else rng.choice([-1.0, 1.0],
                                                                         (trace.size, 1))
     weights = (w[None, :] * trace.length[:, None]).ravel()
     load = np.zeros(elasticity.K.shape[0])
@@ -86,5 +87,5 @@ def test_the_absolute_shear_bound_lies_above_every_signed_discrete_dual_norm(sig
     bound = RigidChain.of(scene, mesh, elasticity.lame).absolute_tangential(trace, values, w)
     below = _discrete_dual(elasticity, load)
     assert bound >= below
-    if signs == "equal":  # the sign that cancels least: measured 55x (random signs: 116x)
+    if signs == "equal":  # the sign that cancels least: measured 55x (random signs: 245x)
         assert bound <= 100 * below
