@@ -16,8 +16,6 @@ from formulations.evaluation import normal_trace_matrix
 from formulations.slack_friction import tangential_rows
 from scenes import get_scene
 
-RNG = np.random.default_rng(7)
-
 
 @LinearForm
 def _load(v, w):
@@ -36,7 +34,8 @@ def test_the_load_bound_lies_above_the_discrete_dual_norm(rough):
     scene = get_scene("paper")
     mesh = scene.mesh.refined(2)
     elasticity = assemble_elasticity(scene, mesh, order=2)
-    nodal = (RNG.standard_normal((mesh.p.shape[1], 2)) if rough
+    rng = np.random.default_rng(7)   # each test its own: the same values in any test order
+    nodal = (rng.standard_normal((mesh.p.shape[1], 2)) if rough
              else np.stack([1 + mesh.p[1], mesh.p[0] ** 2], axis=1))
     field = Basis(mesh, ElementVector(ElementTriP1()), quadrature=elasticity.basis.quadrature)
     dofs = np.zeros(field.N)
@@ -58,13 +57,14 @@ def test_the_traction_bound_lies_above_the_discrete_dual_norm():
     elasticity = assemble_elasticity(scene, mesh, order=2)
     trace = solve(get_formulation("vi")(scene, mesh), "active-set").trace
     t, w = gauss_legendre(10)
-    values = -np.abs(RNG.standard_normal((trace.size, 1))) * (1 + t[None, :])   # <= 0
+    rng = np.random.default_rng(7)
+    values = -np.abs(rng.standard_normal((trace.size, 1))) * (1 + t[None, :])   # <= 0
     weights = (w[None, :] * trace.length[:, None]).ravel()
     load = normal_trace_matrix(elasticity.basis, trace, t).T @ (values.ravel() * weights)
     bound = RigidChain.of(scene, mesh, elasticity.lame).traction(trace, values, t, w)
     below = _discrete_dual(elasticity, load)
     assert bound >= below
-    assert bound <= 100 * below  # measured 42x (C_T ||lambda||: 68x)
+    assert bound <= 100 * below  # measured 43x (C_T ||lambda||: 71x)
 
 
 @pytest.mark.parametrize("signs", ["equal", "random"])
