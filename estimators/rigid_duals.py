@@ -35,6 +35,7 @@ from estimators.chained_constants import (
     strain_floor,
     triangle_rule,
 )
+from formulations.slack_friction import contact_tangent
 from formulations.solvers.backends import factorise
 
 
@@ -105,7 +106,7 @@ class RigidChain:
         live = np.flatnonzero(weights > 0)
         middle = trace.points(np.array([0.5]))[:, live, 0]
         r = rigid_at(middle[:, :, None], self.centres[:, owner[live]])[..., 0]   # (3, 2, k)
-        tangent = np.array([-trace.normal[1, live], trace.normal[0, live]])
+        tangent = contact_tangent(trace)[:, live]
         m = np.einsum("idk,dk->ki", r, tangent)                          # (k, 3)
         rigid = 0.0
         # 32 right-hand sides at a time: 3 n_el x 32 doubles, 77 MB at 1e5 triangles
