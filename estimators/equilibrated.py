@@ -26,6 +26,7 @@ import numpy as np
 
 from estimators.averaging import compliance_energy
 from estimators.base import BoundTerms, Estimate, planar_only, register_estimator
+from estimators.bounded_shear import auxiliary_shear, l2_excess_term
 from estimators.constants import domain_constants
 from estimators.contact_extension import EXTENSIONS
 from estimators.equilibration import (
@@ -43,7 +44,7 @@ from estimators.guaranteed_contact import (
     projected_pressure,
     traction_at,
 )
-from estimators.guaranteed_friction import balanced_shear, friction_bound, raw_shear, shear_at
+from estimators.guaranteed_friction import friction_bound, raw_shear, shear_at
 from estimators.jump_equilibration import jump_oscillation
 from estimators.nonnegative_traction import nonnegative_pressure
 from estimators.oscillation import oscillation
@@ -187,12 +188,13 @@ def marking_shares(eta: float, A: float, volume: np.ndarray, terms: BoundTerms,
 
 
 def equilibrate(scene, solution: DiscreteSolution, symmetrise=None,
-                trace_constant: float | None = None):
+                trace_constant: float | None = None, excess_term=None):
     """sigma* (a ``Reconstruction``, symmetrised by ``estimators.symmetrisation``, or by
     ``symmetrise(rec, interior, prescribed, lame)`` if given), the patch data, rho,
     the contact terms of lambda* (a ``ContactBound`` per extension, lambda* chosen with
     ``trace_constant``, by default the computed C_T), the Neumann data of the auxiliary
-    problem, the clamped vertices and sigma*_t (None without friction) (docs/theory.md, 13.2,
+    problem, the clamped vertices and sigma*_t (None without friction; chosen with
+    ``excess_term``, by default C_T ||g||, ``estimators.bounded_shear``) (docs/theory.md, 13.2,
     13.3 and 17.5)."""
     elasticity = solution.elasticity
     mesh, order = elasticity.mesh, elasticity.order
@@ -220,9 +222,12 @@ def equilibrate(scene, solution: DiscreteSolution, symmetrise=None,
     normal = BoundaryData(trace.facets, lambda x: traction_at(trace, lam_star, x))
     contact = normal
     if sheared:  # sigma*_t balances what is left along the tangents (17.5)
-        defect = reaction - boundary_balance(n_v, boundary_fluxes(interior,
-                                                                  [normal, *sheared]))
-        shear = balanced_shear(solution, defect, clamped)
+        left = reaction - boundary_balance(n_v, boundary_fluxes(interior, [normal]))
+        if excess_term is None:
+            excess_term = l2_excess_term(trace, domain_constants(scene).trace
+                                         if trace_constant is None else trace_constant)
+        shear = auxiliary_shear(scene, solution, interior, left, clamped, bounds,
+                                excess_term)
         contact = BoundaryData(trace.facets, lambda x: traction_at(trace, lam_star, x)
                                + shear_at(trace, shear, x))
     fluxes = neumann_flux + boundary_fluxes(interior, [contact])

@@ -27,10 +27,13 @@ with a proof").
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 from skfem import Basis, ElementTriP1
 
 from estimators.base import register_estimator
+from estimators.bounded_shear import l2_excess_term
 from estimators.equilibrated import (
     BALANCE_TOLERANCE,
     DualNorms,
@@ -87,8 +90,17 @@ def estimate(scene, solution: DiscreteSolution):
         return symmetric
 
     constants = proved_constants(scene)
-    rec, interior, load, bounds, boundary, _, shear = equilibrate(scene, solution, weak,
-                                                                  constants.trace)
+
+    @functools.cache
+    def chain() -> RigidChain:
+        return RigidChain.of(scene, mesh, (lam, mu))
+
+    def excess_term(excess, w):  # N_t as ``dual_terms`` will charge it
+        plain = l2_excess_term(solution.trace, constants.trace)(excess, w)
+        return min(plain, chain().absolute_tangential(solution.trace, excess, w))
+
+    rec, interior, load, bounds, boundary, _, shear = equilibrate(
+        scene, solution, weak, constants.trace, excess_term)
     compliance = compliance_squares(rec, interior, (lam, mu))
     skew = skew_squares(rec, vertex, mu)
     jump = jump_oscillation(mesh, scene.body_force, rec.basis.elem.k, (lam, mu), 0.0,
@@ -105,18 +117,18 @@ def estimate(scene, solution: DiscreteSolution):
                  oscillation=(np.sqrt((osc**2).sum()) + np.sqrt((tau_sym**2).sum())
                               + np.sqrt((tau_skew**2).sum())))
     parts["load"], duals = dual_terms(scene, solution, constants, load, bounds[0], shear,
-                                      sum(parts.values()))
+                                      sum(parts.values()), chain)
     spread = parts["load"] * np.sqrt(load.squares / max(load.squares.sum(), 1e-300))
     volume = (np.sqrt(compliance) + np.sqrt(skew) + osc + tau_sym + tau_skew + spread) ** 2
     return smallest(scene, solution, parts, volume, bounds, shear, NAME, duals)
 
 
-def dual_terms(scene, solution, constants, load, bound, shear, rest: float
+def dual_terms(scene, solution, constants, load, bound, shear, rest: float, chain
                ) -> tuple[float, DualNorms]:
     """The load term, N and N_t (13.4, 17.5): C_F ||rho||, C_T ||lambda*_-|| and C_T
     ||(|sigma*_t| - s)_+||, or the chained dual norms of ``estimators.rigid_duals`` where
-    smaller. Both bound the same functionals; the chain costs a sparse factorisation, built
-    only where the three weigh (above 1e-6 of the rest of A)."""
+    smaller. Both bound the same functionals; the chain (``chain()``) costs a sparse
+    factorisation, built only where the three weigh (above 1e-6 of the rest of A)."""
     load_term = constants.friedrichs * np.sqrt(load.squares.sum())
     negative = constants.trace * bound.negative
     t, w = gauss_legendre(QUADRATURE)
@@ -124,9 +136,7 @@ def dual_terms(scene, solution, constants, load, bound, shear, rest: float
     excess_norm = 0.0 if excess is None else np.sqrt(solution.trace.integrate(excess**2, w).sum())
     if load_term + negative + constants.trace * excess_norm <= 1e-6 * rest:
         return load_term, DualNorms(constants.trace, negative)
-    elasticity = solution.elasticity
-    chain = RigidChain.of(scene, elasticity.mesh, elasticity.lame)
-    negative = min(negative, chain.traction(solution.trace, bound.negative_part, t, w))
+    negative = min(negative, chain().traction(solution.trace, bound.negative_part, t, w))
     shear_term = None if excess is None else min(
-        constants.trace * excess_norm, chain.absolute_tangential(solution.trace, excess, w))
-    return min(load_term, chain.load(load)), DualNorms(constants.trace, negative, shear_term)
+        constants.trace * excess_norm, chain().absolute_tangential(solution.trace, excess, w))
+    return min(load_term, chain().load(load)), DualNorms(constants.trace, negative, shear_term)

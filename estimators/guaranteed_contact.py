@@ -82,6 +82,16 @@ def traction_at(trace, pressure, x: np.ndarray, direction: np.ndarray | None = N
     return np.take_along_axis(values, index, axis=1)[None] * vector[:, :, None]
 
 
+def contact_mass(trace) -> sparse.csr_matrix:
+    """The mass matrix of continuous P1 on Gamma_C over all mesh vertices."""
+    start, end = trace.vertices
+    n_v, h = trace.mesh.p.shape[1], trace.length
+    rows = np.concatenate([start, start, end, end])
+    cols = np.concatenate([start, end, start, end])
+    vals = np.concatenate([h / 3, h / 6, h / 6, h / 3])
+    return sparse.coo_matrix((vals, (rows, cols)), shape=(n_v, n_v)).tocsr()
+
+
 def balanced_traction(trace, pressure, defect: np.ndarray, clamped: np.ndarray,
                       orientation: float = -1.0, directions: np.ndarray | None = None):
     """lambda* from lambda_h and the per-vertex imbalance ``defect`` (n_vertices, 2) of the
@@ -91,11 +101,7 @@ def balanced_traction(trace, pressure, defect: np.ndarray, clamped: np.ndarray,
     general: M delta = orientation defect . directions (a shear: +1 and the vertex tangents)."""
     start, end = trace.vertices
     n_v = trace.mesh.p.shape[1]
-    h = trace.length
-    rows = np.concatenate([start, start, end, end])
-    cols = np.concatenate([start, end, start, end])
-    vals = np.concatenate([h / 3, h / 6, h / 6, h / 3])
-    M = sparse.coo_matrix((vals, (rows, cols)), shape=(n_v, n_v)).tocsr()
+    M = contact_mass(trace)
     nu = vertex_normals(trace) if directions is None else directions
     on = np.unique(np.concatenate([start, end]))
     on = on[~clamped[on]]

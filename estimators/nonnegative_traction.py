@@ -57,9 +57,16 @@ def nonnegative_pressure(trace, reaction: np.ndarray, clamped: np.ndarray, k: in
     x = bounded_least_squares(sparse.diags(row_scale) @ G, row_scale * R, EPSILON * norm)
     # unsolved: lambda* is candidate (ii) of 13.3 again, still a bound
     x = (np.zeros(norm.size) if x is None else x).reshape(trace.size, k + 1)
+    return bernstein_polynomial(x)
 
-    def pressure(t):
+
+def bernstein_polynomial(x: np.ndarray) -> FacetPolynomial:
+    """sum_j x_j B_j on each contact facet, Bernstein coefficients x (n_f, k + 1), in Legendre
+    form (exact: the projection onto P_k keeps a polynomial of degree k)."""
+    k = x.shape[1] - 1
+
+    def value(t):
         bernstein = np.array([comb(k, j) * t**j * (1 - t) ** (k - j) for j in range(k + 1)])
         return x @ bernstein
 
-    return projected_pressure(pressure, k)
+    return projected_pressure(value, k)
