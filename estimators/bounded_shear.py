@@ -5,11 +5,11 @@ The bound charges the excess of sigma*_t over the slip bound s with the trace co
 C_T ||(|sigma*_t| - s)_+||. The projection of sigma_t,h plus its P1 correction
 (``guaranteed_friction.balanced_shear``) exceeds s where the discrete shear does (the mixed
 method's multiplier between the nodes where it is bounded, the penalty's projection) and where
-the correction adds to it (vi's). This one is a polynomial of degree k on
-each contact facet whose Bernstein coefficients x_j lie in [-s(t_j), s(t_j)], t_j = j / k the
-Greville points (so |sigma*_t| <= s wherever s is concave along the facet), and whose moments
-against the hat functions along the vertex tangents are what u_h leaves unbalanced after
-lambda*, as far as such a shear has them: a box-constrained least-squares problem on Gamma_C,
+the correction adds to it (vi's). This one is a polynomial of degree k on each contact facet
+whose Bernstein coefficients x_j lie in [-s(t_j), s(t_j)], t_j = j / k the Greville points
+(so |sigma*_t| <= s wherever s is concave along the facet), and whose moments against the hat
+functions along the vertex tangents are what u_h leaves unbalanced after lambda*, as far as
+such a shear has them: a box-constrained least-squares problem on Gamma_C,
 
     min_{|x_j| <= s(t_j)} ||M^(-1/2) (G x - R)||^2 + EPSILON^2 ||sigma*_t||^2_{0,Gamma_C},
 

@@ -17,7 +17,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.sparse.linalg import spsolve
 from skfem import Basis, BilinearForm, ElementTriP2, ElementVector, MeshTri, asm
-from skfem.helpers import ddot, sym_grad, trace
+from skfem.helpers import ddot, sym_grad
+from skfem.helpers import trace as matrix_trace
 
 from estimators.contact_extension import Extension
 
@@ -28,7 +29,8 @@ LAYERS = 4
 
 @dataclass(frozen=True, eq=False)
 class StripExtension:
-    """d with the trace of ``surface`` on Gamma_C and a(d, d) per element ``energies``."""
+    """d with the trace of ``surface`` on Gamma_C and a(d, d) per element ``energies`` (with
+    the Lame parameters it was relaxed with)."""
 
     surface: Extension
     energies: np.ndarray
@@ -81,15 +83,15 @@ def relaxed(d: Extension, trace, lame: tuple[float, float], clamped_facets: np.n
 def _elasticity(lam: float, mu: float) -> BilinearForm:
     @BilinearForm
     def form(u, v, _):
-        return 2 * mu * ddot(sym_grad(u), sym_grad(v)) + lam * trace(sym_grad(u)) * trace(
-            sym_grad(v))
+        eps_u, eps_v = sym_grad(u), sym_grad(v)
+        return 2 * mu * ddot(eps_u, eps_v) + lam * matrix_trace(eps_u) * matrix_trace(eps_v)
     return form
 
 
 def _element_energies(basis, x: np.ndarray, lame: tuple[float, float]) -> np.ndarray:
     lam, mu = lame
     eps = sym_grad(basis.interpolate(x))
-    density = 2 * mu * ddot(eps, eps) + lam * trace(eps) ** 2
+    density = 2 * mu * ddot(eps, eps) + lam * matrix_trace(eps) ** 2
     return (density * basis.dx).sum(axis=1)
 
 
