@@ -50,7 +50,6 @@ from estimators.nonnegative_traction import nonnegative_pressure
 from estimators.oscillation import oscillation
 from estimators.patch_data import interior_data, rebalanced
 from estimators.residual import stress_tensor
-from estimators.strip_extension import relaxed
 from estimators.symmetrisation import symmetrised
 from formulations import DiscreteSolution
 from formulations.elasticity import stress_from_gradient
@@ -269,9 +268,7 @@ def contact_traction(scene, solution, interior, reaction: np.ndarray, clamped: n
                   for pressure in pressures]
     if trace_constant is None:
         trace_constant = domain_constants(scene).trace
-    dirichlet = scene.dirichlet_facets(solution.elasticity.mesh)
-    fields = [relaxed(extend(scene, solution, clamped), trace, solution.elasticity.lame,
-                      dirichlet) for extend in EXTENSIONS]
+    fields = [extend(scene, solution, clamped) for extend in EXTENSIONS]
     bounds = [tuple(contact_bound(scene, solution, traction, d) for d in fields)
               for traction in candidates]
     terms = [min(2 * b.extension + trace_constant * b.negative + np.sqrt(b.complementarity)

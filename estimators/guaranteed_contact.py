@@ -18,7 +18,6 @@ from scipy import sparse
 from scipy.sparse.linalg import spsolve
 
 from estimators.contact_extension import Extension, discrete_gap, vertex_normals
-from estimators.strip_extension import StripExtension
 from formulations.contact import gauss_legendre
 
 QUADRATURE = 10     # Gauss points per contact facet for the kinked integrands
@@ -122,11 +121,10 @@ class ContactBound:
     negative_squares: np.ndarray  # ||lambda*_-||^2 over each element's contact facets
     negative_part: np.ndarray     # lambda*_- (n_facets, QUADRATURE) at the Gauss points
     slack: np.ndarray       # |(lambda*_+, g - u_hn - d . n)| over each element's contact facets
-    field: Extension | StripExtension  # d itself
+    field: Extension        # d itself
 
 
-def contact_bound(scene, solution, traction: ContactTraction,
-                  d: Extension | StripExtension) -> ContactBound:
+def contact_bound(scene, solution, traction: ContactTraction, d: Extension) -> ContactBound:
     """D, ||lambda*_-|| and B of lambda* = ``traction`` with the extension ``d`` (13.1)."""
     trace = solution.trace
     energy = d.energy(trace, solution.elasticity.lame)

@@ -65,5 +65,5 @@ def test_fitted_extension_lowers_the_complementarity_term():
     solution = solve(get_formulation("vi")(scene, scene.mesh.refined(3)), "active-set")
     floor, fitted = equilibrate(scene, solution)[3]  # in the order of EXTENSIONS
     assert EXTENSIONS == (vertex_extension, fitted_extension)
-    assert not floor.field.surface.bubble.any() and fitted.field.surface.bubble.any()
+    assert not floor.field.bubble.any() and fitted.field.bubble.any()
     assert fitted.complementarity < 0.5 * floor.complementarity
