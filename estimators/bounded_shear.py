@@ -23,12 +23,11 @@ from __future__ import annotations
 import numpy as np
 from scipy import linalg
 
-from estimators.equilibration import BoundaryData, boundary_balance, boundary_fluxes
 from estimators.guaranteed_contact import (
     ContactTraction,
     balanced_traction,
     contact_mass,
-    traction_at,
+    traction_balance,
 )
 from estimators.guaranteed_friction import (
     QUADRATURE,
@@ -76,13 +75,6 @@ def bounded_shear(scene, solution, defect: np.ndarray, clamped: np.ndarray,
                              directions=tangents)
 
 
-def shear_balance(interior, trace, pressure) -> np.ndarray:
-    """int psi_a pressure t over Gamma_C per vertex, (n_vertices, 2)."""
-    tangent = contact_tangent(trace)
-    part = BoundaryData(trace.facets, lambda x: traction_at(trace, pressure, x, tangent))
-    return boundary_balance(interior.total.shape[0], boundary_fluxes(interior, [part]))
-
-
 def l2_excess_term(trace, trace_constant: float):
     """N_t as C_T ||g||_{0,Gamma_C} for the excess g at Gauss points with weights w."""
     def term(excess: np.ndarray, w: np.ndarray) -> float:
@@ -98,7 +90,8 @@ def auxiliary_shear(scene, solution, interior, left: np.ndarray, clamped: np.nda
     ``excess_term(g, w)`` for the excess g at the Gauss points, B_t the smallest over the
     extensions of the contact terms ``bounds``; no patch problem is solved for either."""
     def balance(pressure):
-        return shear_balance(interior, solution.trace, pressure)
+        return traction_balance(interior, solution.trace, pressure,
+                                contact_tangent(solution.trace))
 
     raw = raw_shear(solution).pressure
     candidates = [balanced_shear(solution, left - balance(raw), clamped),

@@ -43,6 +43,7 @@ from estimators.guaranteed_contact import (
     contact_bound,
     projected_pressure,
     traction_at,
+    traction_balance,
 )
 from estimators.guaranteed_friction import friction_bound, raw_shear, shear_at
 from estimators.jump_equilibration import jump_oscillation
@@ -264,7 +265,8 @@ def contact_traction(scene, solution, interior, reaction: np.ndarray, clamped: n
                  FacetPolynomial(np.zeros((trace.facets.size, order + 1))),
                  nonnegative_pressure(trace, reaction, clamped, order)]
     candidates = [balanced_traction(trace, pressure,
-                                    reaction - _balance(interior, trace, pressure), clamped)
+                                    reaction - traction_balance(interior, trace, pressure),
+                                    clamped)
                   for pressure in pressures]
     if trace_constant is None:
         trace_constant = domain_constants(scene).trace
@@ -276,8 +278,3 @@ def contact_traction(scene, solution, interior, reaction: np.ndarray, clamped: n
     best = int(np.argmin(terms))
     return candidates[best], bounds[best]
 
-
-def _balance(interior, trace, pressure) -> np.ndarray:
-    """int psi_a (-pressure n) over Gamma_C per vertex, (n_vertices, 2)."""
-    part = BoundaryData(trace.facets, lambda x: traction_at(trace, pressure, x))
-    return boundary_balance(interior.total.shape[0], boundary_fluxes(interior, [part]))

@@ -18,6 +18,7 @@ from scipy import sparse
 from scipy.sparse.linalg import spsolve
 
 from estimators.contact_extension import Extension, discrete_gap, vertex_normals
+from estimators.equilibration import BoundaryData, boundary_balance, boundary_fluxes
 from formulations.contact import gauss_legendre
 
 QUADRATURE = 10     # Gauss points per contact facet for the kinked integrands
@@ -80,6 +81,14 @@ def traction_at(trace, pressure, x: np.ndarray, direction: np.ndarray | None = N
     index = np.abs(t[:, :, None] - common[None, None, :]).argmin(axis=-1)
     vector = -trace.normal if direction is None else direction
     return np.take_along_axis(values, index, axis=1)[None] * vector[:, :, None]
+
+
+def traction_balance(interior, trace, pressure, direction: np.ndarray | None = None
+                     ) -> np.ndarray:
+    """int psi_a t over Gamma_C per vertex, (n_vertices, 2), for the traction t of
+    ``pressure`` as in ``traction_at`` (-pressure n, or pressure times ``direction``)."""
+    part = BoundaryData(trace.facets, lambda x: traction_at(trace, pressure, x, direction))
+    return boundary_balance(interior.total.shape[0], boundary_fluxes(interior, [part]))
 
 
 def contact_mass(trace) -> sparse.csr_matrix:

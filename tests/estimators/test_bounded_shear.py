@@ -4,9 +4,9 @@
 import numpy as np
 import pytest
 
-from estimators.bounded_shear import bounded_shear, coefficient_bounds, shear_balance
+from estimators.bounded_shear import bounded_shear, coefficient_bounds
 from estimators.equilibrated import equilibrate
-from estimators.guaranteed_contact import QUADRATURE
+from estimators.guaranteed_contact import QUADRATURE, traction_balance
 from estimators.guaranteed_friction import (
     balanced_shear,
     raw_shear,
@@ -16,6 +16,7 @@ from estimators.guaranteed_friction import (
 from estimators.nonnegative_traction import bernstein_polynomial
 from formulations import get_formulation, solve
 from formulations.contact import gauss_legendre
+from formulations.slack_friction import contact_tangent
 from scenes import get_scene
 
 
@@ -49,7 +50,7 @@ def test_moments_that_a_bounded_shear_has_are_met_within_the_bound(stick_slip_mi
     trace = solution.trace
 
     def balance(pressure):
-        return shear_balance(interior, trace, pressure)
+        return traction_balance(interior, trace, pressure, contact_tangent(trace))
 
     s = coefficient_bounds(scene, trace, 1)
     left = balance(bernstein_polynomial(0.5 * s))
@@ -71,7 +72,7 @@ def test_the_mixed_methods_excess_shear_is_halved(stick_slip_mixed):
     trace = solution.trace
 
     def balance(pressure):
-        return shear_balance(interior, trace, pressure)
+        return traction_balance(interior, trace, pressure, contact_tangent(trace))
 
     raw = balanced_shear(solution, balance(chosen) - balance(raw_shear(solution).pressure),
                          clamped)

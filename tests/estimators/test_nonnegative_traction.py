@@ -6,7 +6,8 @@ from scipy.special import comb
 
 from estimators import get_estimator
 from estimators.contact_extension import vertex_normals
-from estimators.equilibrated import _balance, equilibrate
+from estimators.equilibrated import equilibrate
+from estimators.guaranteed_contact import traction_balance
 from estimators.nonnegative_traction import hat_moments, nonnegative_pressure
 from formulations import get_formulation, solve
 from formulations.contact import gauss_legendre
@@ -50,7 +51,8 @@ def test_the_pressure_is_non_negative_and_has_the_reactions_moments(hertz_vi):
     assert values.min() >= -1e-12 * values.max()  # round-off of the Legendre form
     on = np.unique(np.concatenate(trace.vertices))
     on = on[~clamped[on]]
-    moments = -(_balance(interior, trace, pressure)[on] * vertex_normals(trace)[:, on].T).sum(1)
+    balance = traction_balance(interior, trace, pressure)
+    moments = -(balance[on] * vertex_normals(trace)[:, on].T).sum(1)
     wanted = -(reaction[on] * vertex_normals(trace)[:, on].T).sum(1)
     assert np.linalg.norm(moments - wanted) <= 1e-4 * np.linalg.norm(wanted)
 
