@@ -88,7 +88,8 @@ def auxiliary_shear(scene, solution, interior, left: np.ndarray, clamped: np.nda
     leaves after lambda*: of the corrected projection of sigma_t,h (``balanced_shear``) and the
     bounded shear above, the one with the smaller friction terms N_t + sqrt(B_t), N_t =
     ``excess_term(g, w)`` for the excess g at the Gauss points, B_t the smallest over the
-    extensions of the contact terms ``bounds``; no patch problem is solved for either."""
+    extensions of the contact terms ``bounds`` (B_t sees only their traces); no patch problem
+    is solved for either."""
     def balance(pressure):
         return traction_balance(interior, solution.trace, pressure,
                                 contact_tangent(solution.trace))
@@ -100,7 +101,7 @@ def auxiliary_shear(scene, solution, interior, left: np.ndarray, clamped: np.nda
 
     def terms(shear):
         slack = min(friction_bound(scene, solution, shear, bound.field).complementarity
-                    for bound in bounds)
+                    for bound in bounds.marking)
         excess = shear_excess(scene, solution, shear, t)[2]
         return excess_term(excess, w) + np.sqrt(max(slack, 0.0))
 

@@ -20,7 +20,7 @@ D and eta_complementarity sqrt(B).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -37,6 +37,7 @@ from estimators.equilibration import (
 )
 from estimators.guaranteed_contact import (
     ContactBound,
+    ContactBounds,
     ContactTraction,
     FacetPolynomial,
     balanced_traction,
@@ -51,6 +52,7 @@ from estimators.nonnegative_traction import nonnegative_pressure
 from estimators.oscillation import oscillation
 from estimators.patch_data import interior_data, rebalanced
 from estimators.residual import stress_tensor
+from estimators.strip_extension import relaxed
 from estimators.symmetrisation import symmetrised
 from formulations import DiscreteSolution
 from formulations.elasticity import stress_from_gradient
@@ -139,14 +141,23 @@ def compliance_squares(rec, interior, lame: tuple[float, float]) -> np.ndarray:
     return (compliance_energy(sym, *lame) * rec.basis.dx).sum(axis=1)
 
 
-def smallest(scene, solution, parts: dict, volume: np.ndarray, bounds, shear, name: str,
-             duals: DualNorms | None = None) -> Estimate:
-    """Every extension d gives a bound (13.3): the smallest, as estimator ``name``
-    (``duals``: by default the computed C_T of 13.4 times the norms)."""
+def smallest(scene, solution, parts: dict, volume: np.ndarray, bounds: ContactBounds, shear,
+             name: str, duals: DualNorms | None = None) -> Estimate:
+    """Every extension d gives a bound (13.3): the smallest over the relaxed fields, as
+    estimator ``name`` (``duals``: by default the computed C_T of 13.4 times the norms), with
+    the indicators of the smallest over the one-layer fields, scaled to sum to eta^2: the
+    relaxed fields' energy spreads over the strip's layers, away from the elements where the
+    penetration is (13.3, "Marking")."""
     if duals is None:
         duals = DualNorms(trace=domain_constants(scene).trace)
-    return min((_combined(scene, solution, parts, volume, bound, shear, name, duals)
-                for bound in bounds), key=lambda est: est.eta)
+
+    def best(options):
+        return min((_combined(scene, solution, parts, volume, bound, shear, name, duals)
+                    for bound in options), key=lambda est: est.eta)
+
+    steering, sharp = best(bounds.marking), best(bounds.sharp)
+    scale = sharp.eta**2 / steering.indicators.sum() if steering.indicators.sum() > 0 else 0.0
+    return replace(sharp, indicators=steering.indicators * scale)
 
 
 def _combined(scene, solution, parts: dict, volume: np.ndarray, bound, shear, name: str,
@@ -192,7 +203,7 @@ def equilibrate(scene, solution: DiscreteSolution, symmetrise=None,
                 trace_constant: float | None = None, excess_term=None):
     """sigma* (a ``Reconstruction``, symmetrised by ``estimators.symmetrisation``, or by
     ``symmetrise(rec, interior, prescribed, lame)`` if given), the patch data, rho,
-    the contact terms of lambda* (a ``ContactBound`` per extension, lambda* chosen with
+    the contact terms of lambda* (``ContactBounds``, lambda* chosen with
     ``trace_constant``, by default the computed C_T), the Neumann data of the auxiliary
     problem, the clamped vertices and sigma*_t (None without friction; chosen with
     ``excess_term``, by default C_T ||g||, ``estimators.bounded_shear``) (docs/theory.md, 13.2,
@@ -248,7 +259,7 @@ def equilibrate(scene, solution: DiscreteSolution, symmetrise=None,
 
 def contact_traction(scene, solution, interior, reaction: np.ndarray, clamped: np.ndarray,
                      trace_constant: float | None = None
-                     ) -> tuple[ContactTraction, tuple[ContactBound, ...]]:
+                     ) -> tuple[ContactTraction, ContactBounds]:
     """lambda* (docs/theory.md, 13.3): of three tractions that balance u_h on the contact
     patches, the one with the smallest terms 2 D + C_T ||lambda*_-|| + sqrt(B) (over the
     extensions d of ``estimators.contact_extension``; no patch problem is solved for any).
@@ -259,7 +270,8 @@ def contact_traction(scene, solution, interior, reaction: np.ndarray, clamped: n
     that their own equations see); (iii) a non-negative traction with the reaction's moments
     where one exists (``estimators.nonnegative_traction``; the correction takes the round-off
     of its least squares, or what no non-negative traction balances). Returns it with its
-    ``ContactBound`` for every extension."""
+    ``ContactBounds`` for every extension, one-layer and relaxed off Gamma_C (the choice
+    between the tractions is made with the one-layer fields)."""
     trace, order = solution.trace, solution.elasticity.order
     pressures = [projected_pressure(solution.pressure, order),
                  FacetPolynomial(np.zeros((trace.facets.size, order + 1))),
@@ -276,5 +288,11 @@ def contact_traction(scene, solution, interior, reaction: np.ndarray, clamped: n
     terms = [min(2 * b.extension + trace_constant * b.negative + np.sqrt(b.complementarity)
                  for b in options) for options in bounds]
     best = int(np.argmin(terms))
-    return candidates[best], bounds[best]
+    dirichlet = scene.dirichlet_facets(solution.elasticity.mesh)
+    sharp = tuple(replace(bound, extension=float(np.sqrt(field.energies.sum())),
+                          energy=field.energies, field=field)
+                  for bound in bounds[best]
+                  for field in [relaxed(bound.field, trace, solution.elasticity.lame,
+                                        dirichlet)])
+    return candidates[best], ContactBounds(marking=bounds[best], sharp=sharp)
 

@@ -116,7 +116,7 @@ def estimate(scene, solution: DiscreteSolution):
     parts = dict(symmetric=np.sqrt(compliance.sum()), skew=np.sqrt(skew.sum()),
                  oscillation=(np.sqrt((osc**2).sum()) + np.sqrt((tau_sym**2).sum())
                               + np.sqrt((tau_skew**2).sum())))
-    parts["load"], duals = dual_terms(scene, solution, constants, load, bounds[0], shear,
+    parts["load"], duals = dual_terms(scene, solution, constants, load, bounds.sharp[0], shear,
                                       sum(parts.values()), chain)
     spread = parts["load"] * np.sqrt(load.squares / max(load.squares.sum(), 1e-300))
     volume = (np.sqrt(compliance) + np.sqrt(skew) + osc + tau_sym + tau_skew + spread) ** 2

@@ -19,6 +19,7 @@ from scipy.sparse.linalg import spsolve
 
 from estimators.contact_extension import Extension, discrete_gap, vertex_normals
 from estimators.equilibration import BoundaryData, boundary_balance, boundary_fluxes
+from estimators.strip_extension import StripExtension
 from formulations.contact import gauss_legendre
 
 QUADRATURE = 10     # Gauss points per contact facet for the kinked integrands
@@ -130,10 +131,21 @@ class ContactBound:
     negative_squares: np.ndarray  # ||lambda*_-||^2 over each element's contact facets
     negative_part: np.ndarray     # lambda*_- (n_facets, QUADRATURE) at the Gauss points
     slack: np.ndarray       # |(lambda*_+, g - u_hn - d . n)| over each element's contact facets
-    field: Extension        # d itself
+    field: Extension | StripExtension  # d itself
 
 
-def contact_bound(scene, solution, traction: ContactTraction, d: Extension) -> ContactBound:
+@dataclass(frozen=True)
+class ContactBounds:
+    """The contact terms of lambda* for every extension d (docs/theory.md, 13.3): with the
+    one-layer fields (``marking``: they steer marking) and with the same fields relaxed off
+    Gamma_C (``sharp``: same trace, so the same N and B, a smaller D; they enter eta)."""
+
+    marking: tuple[ContactBound, ...]
+    sharp: tuple[ContactBound, ...]
+
+
+def contact_bound(scene, solution, traction: ContactTraction,
+                  d: Extension | StripExtension) -> ContactBound:
     """D, ||lambda*_-|| and B of lambda* = ``traction`` with the extension ``d`` (13.1)."""
     trace = solution.trace
     energy = d.energy(trace, solution.elasticity.lame)

@@ -28,6 +28,7 @@ from estimators.guaranteed_contact import (
     projected_pressure,
     traction_at,
 )
+from estimators.strip_extension import StripExtension
 from formulations.contact import gauss_legendre
 from formulations.evaluation import evaluate_on_trace
 from formulations.slack_friction import contact_tangent
@@ -74,7 +75,8 @@ def shear_excess(scene, solution, shear: ContactTraction, t: np.ndarray
     return sigma, bound, np.maximum(np.abs(sigma) - bound, 0.0)
 
 
-def friction_bound(scene, solution, shear: ContactTraction, d: Extension) -> FrictionBound:
+def friction_bound(scene, solution, shear: ContactTraction,
+                   d: Extension | StripExtension) -> FrictionBound:
     """N_t / C_T and B_t of the module docstring; ``d`` the extension of the contact terms."""
     trace, law = solution.trace, scene.friction
     t, w = gauss_legendre(QUADRATURE)

@@ -63,7 +63,7 @@ def test_fitted_extension_lowers_the_complementarity_term():
     measured 1.09 -> 0.40 at 2178 DOFs, 0.506 -> 0.064 at 8450)."""
     scene = get_scene("paper")
     solution = solve(get_formulation("vi")(scene, scene.mesh.refined(3)), "active-set")
-    floor, fitted = equilibrate(scene, solution)[3]  # in the order of EXTENSIONS
+    floor, fitted = equilibrate(scene, solution)[3].marking  # in the order of EXTENSIONS
     assert EXTENSIONS == (vertex_extension, fitted_extension)
     assert not floor.field.bubble.any() and fitted.field.bubble.any()
     assert fitted.complementarity < 0.5 * floor.complementarity
