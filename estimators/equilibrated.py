@@ -289,10 +289,9 @@ def contact_traction(scene, solution, interior, reaction: np.ndarray, clamped: n
                  for b in options) for options in bounds]
     best = int(np.argmin(terms))
     dirichlet = scene.dirichlet_facets(solution.elasticity.mesh)
-    sharp = tuple(replace(bound, extension=float(np.sqrt(field.energies.sum())),
-                          energy=field.energies, field=field)
-                  for bound in bounds[best]
-                  for field in [relaxed(bound.field, trace, solution.elasticity.lame,
-                                        dirichlet)])
+    strips = relaxed(fields, trace, solution.elasticity.lame, dirichlet)
+    sharp = tuple(replace(bound, extension=float(np.sqrt(strip.energies.sum())),
+                          energy=strip.energies, field=strip)
+                  for bound, strip in zip(bounds[best], strips, strict=True))
     return candidates[best], ContactBounds(marking=bounds[best], sharp=sharp)
 

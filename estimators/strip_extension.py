@@ -15,7 +15,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.sparse.linalg import spsolve
+from scipy.sparse.linalg import splu
 from skfem import Basis, BilinearForm, ElementTriP2, ElementVector, MeshTri, asm
 from skfem.helpers import ddot, sym_grad
 from skfem.helpers import trace as matrix_trace
@@ -61,23 +61,27 @@ def strip_basis(trace, layers: int = LAYERS) -> tuple[Basis, np.ndarray, np.ndar
     return Basis(strip, ElementVector(ElementTriP2())), used, elements
 
 
-def relaxed(d: Extension, trace, lame: tuple[float, float], clamped_facets: np.ndarray,
-            layers: int = LAYERS) -> StripExtension:
-    """The least-energy P2 field of the module docstring for the one-layer field ``d``;
+def relaxed(fields: tuple[Extension, ...], trace, lame: tuple[float, float],
+            clamped_facets: np.ndarray, layers: int = LAYERS) -> tuple[StripExtension, ...]:
+    """The least-energy P2 field of the module docstring for each one-layer field of
+    ``fields`` (one factorisation for all: the strip and its fixed DOFs are theirs in common);
     ``clamped_facets`` the facets of Gamma_D."""
     mesh = trace.mesh
-    if not (np.any(d.nodal) or np.any(d.bubble)):
-        return StripExtension(d, np.zeros(mesh.t.shape[1]))
-    basis, used, elements = strip_basis(trace, layers)
-    x = _surface_values(d, trace, basis, used)
-    fixed = _fixed_dofs(basis, trace, mesh, used, clamped_facets)
-    free = np.setdiff1d(np.arange(basis.N), fixed)
-    K = asm(_elasticity(*lame), basis)
-    if free.size:
-        x[free] = spsolve(K[free][:, free].tocsc(), -(K[free][:, fixed] @ x[fixed]))
-    energies = np.zeros(mesh.t.shape[1])
-    energies[elements] = _element_energies(basis, x, lame)
-    return StripExtension(d, energies)
+    zero = np.zeros(mesh.t.shape[1])
+    moving = [i for i, d in enumerate(fields) if np.any(d.nodal) or np.any(d.bubble)]
+    energies = [zero] * len(fields)
+    if moving:
+        basis, used, elements = strip_basis(trace, layers)
+        fixed = _fixed_dofs(basis, trace, mesh, used, clamped_facets)
+        free = np.setdiff1d(np.arange(basis.N), fixed)
+        x = np.array([_surface_values(fields[i], trace, basis, used) for i in moving]).T
+        K = asm(_elasticity(*lame), basis)
+        if free.size:
+            x[free] = splu(K[free][:, free].tocsc()).solve(-(K[free][:, fixed] @ x[fixed]))
+        for column, i in enumerate(moving):
+            energies[i] = zero.copy()
+            energies[i][elements] = _element_energies(basis, x[:, column], lame)
+    return tuple(StripExtension(d, e) for d, e in zip(fields, energies, strict=True))
 
 
 def _elasticity(lam: float, mu: float) -> BilinearForm:
