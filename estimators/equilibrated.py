@@ -115,7 +115,7 @@ def estimate(scene, solution: DiscreteSolution) -> Estimate:
     compliance = compliance_squares(rec, interior, (lam, mu))
     skew = ((rec.values[0, 1] - rec.values[1, 0]) ** 2 / 2 * rec.basis.dx).sum(axis=1)
     jump = jump_oscillation(rec.basis.mesh, scene.body_force, rec.basis.elem.k, (lam, mu),
-                            constants.korn)
+                            constants.korn, level_set=scene.load_jump)
     osc = oscillation(scene, rec.basis, boundary, jump)
     tau_sym, tau_skew = np.zeros_like(osc), np.zeros_like(osc)
     if jump is not None:  # where f jumps: (r_2, v) through tau (13.2, "Where f jumps")

@@ -104,7 +104,7 @@ def estimate(scene, solution: DiscreteSolution):
     compliance = compliance_squares(rec, interior, (lam, mu))
     skew = skew_squares(rec, vertex, mu)
     jump = jump_oscillation(mesh, scene.body_force, rec.basis.elem.k, (lam, mu), 0.0,
-                            element_korn=element)
+                            element_korn=element, level_set=scene.load_jump)
     osc = np.sqrt(element / (2 * mu)) * oscillation(scene, rec.basis, boundary, jump)
     tau_sym, tau_skew = np.zeros_like(osc), np.zeros_like(osc)
     if jump is not None:

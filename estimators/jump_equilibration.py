@@ -31,6 +31,7 @@ from skfem import Basis, ElementDG, ElementVector, MeshTri
 from skfem.assembly import Dofs
 
 from estimators.averaging import compliance_energy
+from estimators.level_set_cut import cut_along
 from estimators.raviart_thomas import ElementTriRTk
 from estimators.rt_reference import (
     ReferenceRT,
@@ -45,8 +46,15 @@ from formulations.load import MAX_DEPTH, body_load, refined_rule
 
 SUB_LEVELS = 2  # each rough element in 16 sub-triangles
 SUB_ADAPTIVE = 0  # then refinements of the sub-triangles f is rough on
-# the load rule on the sub-triangles splits down to the size it reaches on the elements
-SUB_DEPTH = max(MAX_DEPTH - SUB_LEVELS - SUB_ADAPTIVE, 1)
+# where the scene gives the jump as a level set, 4 sub-triangles, cut along it: as sharp as
+# 16 (the jump left on no sub-triangle), at a third of the cost (docs/theory.md, 13.2)
+CUT_SUB_LEVELS = 1
+
+
+def sub_depth(levels: int) -> int:
+    """The load rule's depth on the sub-triangles: down to the size it reaches on the
+    elements."""
+    return max(MAX_DEPTH - levels - SUB_ADAPTIVE, 1)
 
 
 @dataclass(frozen=True, eq=False)
@@ -71,22 +79,25 @@ def rough_elements(mesh, body_force, k: int) -> np.ndarray:
 
 
 def jump_oscillation(mesh, body_force, k: int, lame: tuple[float, float], korn: float,
-                     element_korn: np.ndarray | None = None) -> JumpOscillation | None:
+                     element_korn: np.ndarray | None = None, level_set=None
+                     ) -> JumpOscillation | None:
     """The terms of the module docstring on the rough elements of ``mesh`` (None if f is
     smooth on every element); ``korn`` C_K, the weight of the skew part. With
     ``element_korn`` (K_T per element of ``mesh``, ``estimators.local_korn``) the skew part
     of tau has zero mean on every rough element and weighs (K_T - 1) / (2 mu) there instead
-    (docs/theory.md 13.4, "Local Korn constants")."""
+    (docs/theory.md 13.4, "Local Korn constants"). With ``level_set`` (the scene's
+    ``load_jump``) the sub-triangles are cut along the jump (``estimators.level_set_cut``)."""
     rough = rough_elements(mesh, body_force, k)
     if rough.size == 0:
         return None
-    sub, parent = sub_triangles(mesh, rough, body_force, k)
+    sub, parent = sub_triangles(mesh, rough, body_force, k, level_set)
     rt = ReferenceRT.build(sub, k, 2 * k + 2)
     X, W = rt.quadrature
     dg_ref = ELEMENTS[k]()
     q = scalar_values(dg_ref, X)                             # (n_dg, nq)
     _, divergence = element_matrices(sub, k, X, W, q)
-    r_2, sub_coefficients = _split_load(mesh, rough, sub, parent, body_force, k)
+    depth = sub_depth(SUB_LEVELS if level_set is None else CUT_SUB_LEVELS)
+    r_2, sub_coefficients = _split_load(mesh, rough, sub, parent, body_force, k, depth)
     if element_korn is None:
         weights, means = np.full(sub.t.shape[1], korn**2), None
     else:
@@ -111,22 +122,26 @@ def jump_oscillation(mesh, body_force, k: int, lame: tuple[float, float], korn: 
                            remainder=remainder, divergence_defect=defect)
 
 
-def sub_triangles(mesh, rough: np.ndarray, body_force, k: int) -> tuple[MeshTri, np.ndarray]:
+def sub_triangles(mesh, rough: np.ndarray, body_force, k: int, level_set=None
+                  ) -> tuple[MeshTri, np.ndarray]:
     """The rough elements refined SUB_LEVELS times, then SUB_ADAPTIVE times where f is still
-    rough (a conforming mesh of their union), and the rough element (index into ``rough``)
-    that holds each sub-triangle."""
+    rough, or, with ``level_set``, CUT_SUB_LEVELS times and cut along its zero set (a
+    conforming mesh of their union), and the rough element (index into ``rough``) that holds
+    each sub-triangle."""
     base = MeshTri(mesh.p, mesh.t[:, rough])
-    sub = base.refined(SUB_LEVELS)
+    sub = base.refined(SUB_LEVELS if level_set is None else CUT_SUB_LEVELS)
     for _ in range(SUB_ADAPTIVE):
         cut = rough_elements(sub, body_force, k)
         if cut.size == 0:
             break
         sub = sub.refined(cut)
+    if level_set is not None:
+        sub = cut_along(sub, level_set)
     centroids = sub.p[:, sub.t].mean(axis=1)
     return sub, base.element_finder()(*centroids)
 
 
-def _split_load(mesh, rough, sub, parent, body_force, k):
+def _split_load(mesh, rough, sub, parent, body_force, k, depth: int = sub_depth(SUB_LEVELS)):
     """The moments (f - ... , q_l)_S of r_2 = Pi_S f - Pi_k f against the sub-triangles' P_k
     DG functions (n_sub, 2, n_dg), and Pi_S f's nodal values (n_sub, 2, n_dg). Every integral
     of f is the load rule's (refined where f is rough), so Pi_k f is the projection that
@@ -134,7 +149,7 @@ def _split_load(mesh, rough, sub, parent, body_force, k):
     dg_ref = ELEMENTS[k]()
     basis = Basis(sub, ElementVector(ElementDG(dg_ref)), intorder=2 * k)
     n_sub = sub.t.shape[1]
-    moments = body_load(body_force, basis, SUB_DEPTH)[basis.element_dofs].reshape(-1, 2, n_sub)
+    moments = body_load(body_force, basis, depth)[basis.element_dofs].reshape(-1, 2, n_sub)
     moments = moments.transpose(2, 1, 0)                               # (n_sub, 2, n_dg)
     X, W = basis.quadrature
     q = scalar_values(dg_ref, X)

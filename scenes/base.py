@@ -168,6 +168,10 @@ class Scene:
     corners: tuple = ()
     # the friction law on Gamma_C (scenes.friction; frictionless unless a scene says otherwise)
     friction: FrictionLaw = NO_FRICTION
+    # where body_force jumps inside elements, a level set whose zero set is the jump line (f
+    # smooth on each side): the guaranteed bounds cut their sub-triangles along it
+    # (docs/theory.md, 13.2, "Where f jumps"); None: found by the load rule alone
+    load_jump: PointFunction | None = None
 
     def __post_init__(self):
         _check(isinstance(self.material, Material), "material", self.material,

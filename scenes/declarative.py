@@ -24,7 +24,7 @@ TABLES = {"geometry": ("rectangle", "divisions", "mesh"),
           "material": ("young_modulus", "poisson_ratio", "plane"),
           "boundary": ("clamped", "contact", "loaded"),
           "contact": ("gap", "coordinate"),
-          "load": ("traction", "body_force"),
+          "load": ("traction", "body_force", "load_jump"),
           "friction": ("law", "mu", "slip_bound", "slide"),
           "parameters": None}
 TOP_LEVEL = ("name", "description", "tags")
@@ -106,6 +106,7 @@ def _scene(path, data, name, description, values, digest) -> Scene:
                                  f"{path}: [contact] coordinate")
         traction = _vector(load.get("traction"), values, f"{path}: [load] traction")
         body_force = _vector(load.get("body_force"), values, f"{path}: [load] body_force")
+        load_jump = _expression(load.get("load_jump"), values, f"{path}: [load] load_jump")
         friction = _friction(path, data.get("friction", {}), values)
     except ExpressionError as error:
         raise SceneError(str(error)) from None
@@ -120,7 +121,7 @@ def _scene(path, data, name, description, values, digest) -> Scene:
         contact_coordinate=coordinate, body_force=body_force,
         traction=None if traction is None else _only_on(loaded, traction),
         parameters={**values, "source": digest}, tags=tuple(data.get("tags", ())),
-        friction=friction)
+        friction=friction, load_jump=load_jump)
 
 
 def _friction(path: Path, table: dict, values) -> FrictionLaw:

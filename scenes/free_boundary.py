@@ -98,6 +98,7 @@ def free_boundary(young_modulus: float = 1.0, poisson_ratio: float = 0.3, plane:
         exact=ExactSolution(displacement=displacement, gradient=gradient,
                             pressure=lambda s: p(np.asarray(s, dtype=float))[0],
                             contact_zone=(-a, a), source="manufactured (module docstring)"),
+        load_jump=lambda x: np.abs(x[0]) - a,
     )
 
 

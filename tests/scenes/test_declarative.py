@@ -182,3 +182,16 @@ def test_a_mesh_without_named_boundaries_is_refused(tmp_path):
         name="none", geometry='mesh = "missing.msh"', clamped="top", contact="bottom"))
     with pytest.raises(SceneError, match="does not read as a mesh"):
         register_toml_scene(tmp_path / "none.toml")
+
+
+def test_a_load_jump_is_read_as_an_expression(tmp_path, registered):
+    """``[load] load_jump`` becomes the scene's level set, evaluated like any expression;
+    without it the scene has none."""
+    text = (PAPER_TOML.format(name="toml-jump", geometry=RECTANGLE, clamped="top",
+                              contact="bottom")
+            + '[load]\nbody_force = ["0", "where(abs(x) < a, -1, 0)"]\n'
+            + 'load_jump = "abs(x) - a"\n[parameters]\na = 0.4\n')
+    name = register(tmp_path / "jump.toml", text, registered)
+    x = np.array([[-0.5, 0.0, 0.4, 0.9], [0.0, 0.3, -0.2, 0.1]])
+    assert np.allclose(get_scene(name).load_jump(x), [0.1, -0.4, 0.0, 0.5], atol=1e-15)
+    assert get_scene("paper").load_jump is None
