@@ -169,4 +169,6 @@ def stick_slip(young_modulus: float = 1.0, poisson_ratio: float = 0.3, plane: st
                             shear=shear_traction,
                             stick_zone=(-stick_half_width, stick_half_width)),
         friction=law,
+        # f jumps at |x| = a and |x| = b: phi changes sign across each
+        load_jump=lambda x: (np.abs(x[0]) - a) * (np.abs(x[0]) - stick_half_width),
     )

@@ -54,9 +54,11 @@ def test_a_cut_near_a_vertex_stays_a_margin_away():
     assert _areas(cut).min() >= (1 - 1e-9) * EDGE_MARGIN**2 * _areas(mesh).min()
 
 
-def test_the_sub_triangles_tile_every_rough_element_of_free_boundary():
-    """Per rough element, the cut sub-triangles' areas sum to its own (round-off)."""
-    scene = get_scene("free-boundary")
+@pytest.mark.parametrize("name", ["free-boundary", "stick-slip"])
+def test_the_sub_triangles_tile_every_rough_element(name):
+    """Per rough element, the cut sub-triangles' areas sum to its own (round-off); stick-slip's
+    level set has two jump lines, |x| = a and |x| = b."""
+    scene = get_scene(name)
     mesh = scene.mesh.refined(2)
     rough = rough_elements(mesh, scene.body_force, 2)
     sub, parent = sub_triangles(mesh, rough, scene.body_force, 2, scene.load_jump)
