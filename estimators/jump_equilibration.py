@@ -16,7 +16,9 @@ C_K^2 ||skw tau||^2 is computed (one sparse saddle-point solve, the two rows cou
 (r_2, v) = -(tau, grad v) <= ||C^-1/2 sym tau|| a(v, v)^1/2 + ||skw tau|| ||skw grad v|| <=
 (||C^-1/2 sym tau|| + C_K ||skw tau||) a(v, v)^1/2, and r_1 is charged by the Poincare
 bound on the sub-triangles, (h_S / pi) ||r_1||_S: a jump now costs only on the sub-triangles
-it cuts, and at their size.
+it cuts, and at their size. Where the scene gives the jump line as a level set
+(``Scene.load_jump``), the rough elements are refined CUT_SUB_LEVELS times and cut along it
+(``estimators.level_set_cut``), and no sub-triangle holds a jump at all.
 """
 
 from __future__ import annotations
