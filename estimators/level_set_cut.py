@@ -38,8 +38,8 @@ def cut_along(mesh: MeshTri, level_set) -> MeshTri:
     three along it (module docstring); the other triangles as they are."""
     p, t = mesh.p, mesh.t
     side = level_set(p) >= 0
-    odd_count = side[t].sum(axis=0)
-    crossed = np.flatnonzero((odd_count == 1) | (odd_count == 2))
+    positive = side[t].sum(axis=0)
+    crossed = np.flatnonzero((positive == 1) | (positive == 2))
     if crossed.size == 0:
         return mesh
     tc = t[:, crossed]
