@@ -34,6 +34,7 @@ from skfem.assembly import Dofs
 
 from estimators.averaging import compliance_energy
 from estimators.level_set_cut import cut_along
+from estimators.local_korn import element_korn as korn_per_element
 from estimators.raviart_thomas import ElementTriRTk
 from estimators.rt_reference import (
     ReferenceRT,
@@ -88,7 +89,9 @@ def jump_oscillation(mesh, body_force, k: int, lame: tuple[float, float], korn: 
     smooth on every element); ``korn`` C_K, the weight of the skew part. With
     ``element_korn`` (K_T per element of ``mesh``, ``estimators.local_korn``) the skew part
     of tau has zero mean on every rough element and weighs (K_T - 1) / (2 mu) there instead
-    (docs/theory.md 13.4, "Local Korn constants"). With ``level_set`` (the scene's
+    (docs/theory.md 13.4, "Local Korn constants"), and each sub-triangle's remainder is
+    scaled by its own K_S over K_T (1 on similar ones; a cut piece's K_S is larger). With
+    ``level_set`` (the scene's
     ``load_jump``) the sub-triangles are cut along the jump (``estimators.level_set_cut``)."""
     rough = rough_elements(mesh, body_force, k)
     if rough.size == 0:
@@ -119,7 +122,10 @@ def jump_oscillation(mesh, body_force, k: int, lame: tuple[float, float], korn: 
     f = body_force(np.asarray(rt.global_coordinates()))      # (2, n_sub, nq)
     projected = np.einsum("sml,lp->msp", sub_coefficients, q)
     r_1 = (((f - projected) ** 2).sum(axis=0) * dx).sum(axis=1)
-    per.append((element_diameters(sub) / np.pi) ** 2 * r_1)
+    poincare = (element_diameters(sub) / np.pi) ** 2 * r_1
+    if element_korn is not None:  # charged with K_T of the parent: K_S / K_T on each piece
+        poincare *= korn_per_element(sub) / element_korn[rough][parent]
+    per.append(poincare)
     symmetric, skew, remainder = (np.bincount(parent, p, rough.size) for p in per)
     return JumpOscillation(elements=rough, symmetric=symmetric, skew=skew,
                            remainder=remainder, divergence_defect=defect)

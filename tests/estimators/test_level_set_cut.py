@@ -9,6 +9,7 @@ from skfem import MeshTri
 from estimators.constants import domain_constants
 from estimators.jump_equilibration import jump_oscillation, rough_elements, sub_triangles
 from estimators.level_set_cut import EDGE_MARGIN, cut_along
+from estimators.local_korn import element_korn
 from scenes import get_scene
 
 
@@ -89,3 +90,33 @@ def test_the_cut_leaves_no_jump_on_free_boundary(k):
     assert np.array_equal(cut.elements, plain.elements)
     assert np.sqrt(cut.remainder.sum()) <= 1e-2 * np.sqrt(plain.remainder.sum())
     assert total(cut) <= total(plain) / 1.5
+
+
+def test_the_proved_bound_charges_each_piece_with_its_own_korn_constant():
+    """With element Korn constants (``equilibrated-local``), the remainder of a sub-triangle
+    is charged with its own K_S: on uncut sub-triangles (similar to their element) nothing
+    changes (round-off), on cut ones each element's remainder moves by a factor between the
+    smallest and the largest K_S / K_T of its pieces (from ``element_korn`` of the pieces)."""
+    scene = get_scene("free-boundary")
+    mesh = scene.mesh.refined(3)
+    lame, k = scene.material.lame, 2
+    K = element_korn(mesh)
+    plain, weighted = (jump_oscillation(mesh, scene.body_force, k, lame, 0.0, element_korn=e)
+                       for e in (None, K))
+    assert np.allclose(weighted.remainder, plain.remainder, rtol=1e-12, atol=0)
+    cut, cut_weighted = (jump_oscillation(mesh, scene.body_force, k, lame, 0.0,
+                                          element_korn=e, level_set=scene.load_jump)
+                         for e in (None, K))
+    sub, parent = sub_triangles(mesh, cut.elements, scene.body_force, k, scene.load_jump)
+    ratio = element_korn(sub) / K[cut.elements][parent]
+    n = cut.elements.size
+    low = np.full(n, np.inf)
+    high = np.zeros(n)
+    np.minimum.at(low, parent, ratio)
+    np.maximum.at(high, parent, ratio)
+    moved = cut_weighted.remainder / np.where(cut.remainder > 0, cut.remainder, 1.0)
+    held = cut.remainder > 0
+    assert np.all(moved[held] >= low[held] * (1 - 1e-12))
+    assert np.all(moved[held] <= high[held] * (1 + 1e-12))
+    assert high.max() > 1.5       # some pieces are worse shaped than their element
+    assert np.abs(moved[held] - 1).max() > 0.01   # and the charge follows them
