@@ -16,9 +16,10 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.sparse.linalg import splu
-from skfem import Basis, BilinearForm, ElementTriP2, ElementVector, MeshTri, asm
+from skfem import Basis, ElementTriP2, ElementVector, MeshTri, asm
 from skfem.helpers import ddot, sym_grad
 from skfem.helpers import trace as matrix_trace
+from skfem.models.elasticity import linear_elasticity
 
 from estimators.contact_extension import Extension
 
@@ -75,21 +76,13 @@ def relaxed(fields: tuple[Extension, ...], trace, lame: tuple[float, float],
         fixed = _fixed_dofs(basis, trace, mesh, used, clamped_facets)
         free = np.setdiff1d(np.arange(basis.N), fixed)
         x = np.array([_surface_values(fields[i], trace, basis, used) for i in moving]).T
-        K = asm(_elasticity(*lame), basis)
+        K = asm(linear_elasticity(*lame), basis)
         if free.size:
             x[free] = splu(K[free][:, free].tocsc()).solve(-(K[free][:, fixed] @ x[fixed]))
         for column, i in enumerate(moving):
             energies[i] = zero.copy()
             energies[i][elements] = _element_energies(basis, x[:, column], lame)
     return tuple(StripExtension(d, e) for d, e in zip(fields, energies, strict=True))
-
-
-def _elasticity(lam: float, mu: float) -> BilinearForm:
-    @BilinearForm
-    def form(u, v, _):
-        eps_u, eps_v = sym_grad(u), sym_grad(v)
-        return 2 * mu * ddot(eps_u, eps_v) + lam * matrix_trace(eps_u) * matrix_trace(eps_v)
-    return form
 
 
 def _element_energies(basis, x: np.ndarray, lame: tuple[float, float]) -> np.ndarray:
