@@ -26,7 +26,6 @@ from dataclasses import dataclass
 import numpy as np
 from skfem import ElementTriP1, FacetBasis
 
-from estimators.patch_classes import element_classes
 from estimators.patch_data import Interior
 from estimators.patches import FIXED, FREE, ZERO, PairMatrices, layout, solve_patches
 from estimators.raviart_thomas import ElementTriRTk
@@ -128,7 +127,7 @@ def reconstruct(interior: Interior, fluxes: list[Flux],
     dofs = rt.element_dofs.T[element]
     n_rt, n_dg = interior.rhs.shape[-1], interior.data.shape[-1]
     facet_of_dof = np.concatenate([np.repeat(np.arange(3), k + 1), np.full(k * (k + 1), -1)])
-    status = np.full((patch.size, n_rt), FREE)
+    status = np.full((patch.size, n_rt), FREE, dtype=np.int8)
     status[facet_of_dof[None, :] == _OPPOSITE_FACET[np.tile(np.arange(3), n_el)][:, None]] = ZERO
     fixed = np.zeros((patch.size, n_rt, 2))
     for flux in fluxes:
@@ -139,8 +138,8 @@ def reconstruct(interior: Interior, fluxes: list[Flux],
                 status[p, (k + 1) * flux.local + j] = FIXED
                 fixed[p, (k + 1) * flux.local + j] = flux.values[:, v, :, j]
     balance = boundary_balance(n_v, fluxes)
-    pairs = PairMatrices(mass=interior.mass, divergence=interior.divergence,
-                         element_owner=element_classes(mesh, k),
+    pairs = PairMatrices(mass=interior.class_mass, divergence=interior.class_divergence,
+                         element_class=interior.classes.of,
                          rhs=interior.rhs.reshape(-1, 2, n_rt).transpose(0, 2, 1),
                          data=interior.data.reshape(-1, 2, n_dg).transpose(0, 2, 1), fixed=fixed)
     lay = layout(patch, dofs, status, facet_holders(mesh, rt.element_dofs, k), n_v)
@@ -159,17 +158,21 @@ def reconstruct(interior: Interior, fluxes: list[Flux],
 def facet_holders(mesh, element_dofs: np.ndarray, k: int) -> np.ndarray:
     """For every (pair p = 3 e + i, RT slot j) the flat index p' n_rt + j' of the entry that
     represents the same unknown of patch mesh.t[i, e]: for a DOF on a facet, the entry of the
-    facet's first element (scikit-fem's f2t[0]), which holds the same global DOF and vertex;
-    interior DOFs represent themselves."""
+    facet's first element e' (scikit-fem's f2t[0]), which holds the same vertex at its corner
+    i' and the same global DOF at the same position along the facet (the facet's DOFs are
+    numbered by facet); interior DOFs represent themselves. Entries of a facet opposite the
+    pair's vertex are never read (ZERO) and hold some index."""
     n_rt, n_el = element_dofs.shape
-    pair = np.arange(3 * n_el)
-    element, corner = pair // 3, pair % 3
-    holder = pair[:, None] * n_rt + np.arange(n_rt)[None, :]
-    for j in range(3 * (k + 1)):
-        first = mesh.f2t[0, mesh.t2f[j // (k + 1), element]]
-        moved = np.flatnonzero(first != element)
-        e0, vertex = first[moved], mesh.t[corner[moved], element[moved]]
-        i0 = (mesh.t[:, e0] == vertex[None, :]).argmax(axis=0)
-        j0 = (element_dofs[:, e0] == element_dofs[j, element[moved]][None, :]).argmax(axis=0)
-        holder[moved, j] = (3 * e0 + i0) * n_rt + j0
+    holder = np.arange(3 * n_el * n_rt).reshape(3 * n_el, n_rt)
+    elements = np.arange(n_el)
+    for f in range(3):
+        facet = mesh.t2f[f]
+        moved = np.flatnonzero(mesh.f2t[0, facet] != elements)
+        first = mesh.f2t[0, facet[moved]]
+        f0 = (mesh.t2f[:, first] == facet[moved][None, :]).argmax(axis=0)
+        for corner in range(3):
+            i0 = (mesh.t[:, first] == mesh.t[corner, moved][None, :]).argmax(axis=0)
+            for i in range(k + 1):
+                holder[3 * moved + corner, (k + 1) * f + i] = ((3 * first + i0) * n_rt
+                                                               + (k + 1) * f0 + i)
     return holder

@@ -14,6 +14,7 @@ from skfem.quadrature import get_quadrature
 from skfem.refdom import RefTri
 
 from estimators.averaging import element_areas
+from estimators.patch_classes import Classes, element_classes
 from estimators.rt_reference import ReferenceRT, element_matrices, patch_rhs, scalar_values
 from formulations.elasticity import ELEMENTS
 from formulations.load import body_load
@@ -27,20 +28,31 @@ SCALARS = {**ELEMENTS, 4: ElementTriP4}
 @dataclass(frozen=True, eq=False)
 class Interior:
     """The element data of the patch problems (independent of the boundary data): the RT_k
-    basis, sigma_h at its quadrature points (2, 2, n_el, nq), the element matrices, the pair
-    right-hand sides rhs (n_el, 3, 2, n_rt) and divergence data (n_el, 3, 2, n_dg), per vertex
-    sum_T int_T (sigma_h grad psi_a - psi_a f) (n_vertices, 2), and the degree k and the
-    quadrature order used."""
+    basis, sigma_h at its quadrature points (2, 2, n_el, nq), the element matrices (one per
+    class of elements with equal ones), the pair right-hand sides rhs (n_el, 3, 2, n_rt) and
+    divergence data (n_el, 3, 2, n_dg), per vertex sum_T int_T (sigma_h grad psi_a - psi_a f)
+    (n_vertices, 2), and the degree k and the quadrature order used."""
 
     rt: ReferenceRT
     sigma_h: np.ndarray
-    mass: np.ndarray
-    divergence: np.ndarray
+    classes: Classes            # elements with equal matrices (``element_classes``)
+    class_mass: np.ndarray      # (n_classes, n_rt, n_rt)
+    class_divergence: np.ndarray  # (n_classes, n_dg, n_rt)
     rhs: np.ndarray
     data: np.ndarray
     total: np.ndarray
     k: int
     intorder: int
+
+    @property
+    def mass(self) -> np.ndarray:
+        """The RT_k mass matrices (n_el, n_rt, n_rt) of every element."""
+        return self.class_mass[self.classes.of]
+
+    @property
+    def divergence(self) -> np.ndarray:
+        """The divergence matrices (n_el, n_dg, n_rt) of every element."""
+        return self.class_divergence[self.classes.of]
 
 
 def interior_data(mesh, sigma_h, body_force, k: int, intorder: int) -> Interior:
@@ -49,14 +61,16 @@ def interior_data(mesh, sigma_h, body_force, k: int, intorder: int) -> Interior:
     rt = ReferenceRT.build(mesh, k, intorder)
     X, W = rt.quadrature
     dg = scalar_values(ELEMENTS[k](), X)
-    mass, divergence = element_matrices(mesh, k, X, W, dg)
+    classes = Classes.of_owners(element_classes(mesh, k))  # few on refined meshes: each once
+    mass, divergence = element_matrices(mesh, k, X, W, dg, classes.first)
     stress = sigma_h(rt)
     rhs, data = patch_rhs(mesh, k, X, W, dg, stress, barycentric_gradients(mesh)[0])
     if body_force is not None:
         data = data - load_moments(mesh, body_force, k)
     total = np.array([np.bincount(mesh.t.T.ravel(), data[:, :, r].sum(axis=-1).ravel(),
                                   minlength=mesh.p.shape[1]) for r in (0, 1)]).T
-    return Interior(rt=rt, sigma_h=stress, mass=mass, divergence=divergence, rhs=rhs,
+    return Interior(rt=rt, sigma_h=stress, classes=classes, class_mass=mass,
+                    class_divergence=divergence, rhs=rhs,
                     data=data, total=total, k=k, intorder=intorder)
 
 

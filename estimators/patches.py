@@ -21,6 +21,7 @@ from estimators.patch_classes import Classes, patch_classes
 
 ZERO, FREE, FIXED = 0, 1, 2
 BATCH = 2000  # patches per stacked solve: bounds the memory of the dense systems
+HASH_SEED = 20261202  # the random weights of ``_owners``' hash (any: collisions are checked)
 
 
 def worker_count() -> int:
@@ -41,7 +42,9 @@ class PatchLayout:
     ``n_free`` (n_vertices,), ``rank`` (P,) the pair's position among its patch's elements,
     ``count`` (n_vertices,) elements per patch, ``key_dof`` the global DOF of each distinct
     (patch, DOF) FREE unknown, ``key_of`` (P, n_rt) the key of each FREE DOF, and ``by_patch``
-    the pairs patch by patch, each patch's in rank order, from ``start`` (n_vertices,)."""
+    the pairs patch by patch, each patch's in rank order, from ``start`` (n_vertices,);
+    ``first`` (n_vertices,) the key of each patch's first unknown (a patch's keys are
+    consecutive)."""
 
     patch: np.ndarray
     status: np.ndarray
@@ -53,6 +56,7 @@ class PatchLayout:
     key_of: np.ndarray
     by_patch: np.ndarray
     start: np.ndarray
+    first: np.ndarray
 
     def pairs_of(self, patches: np.ndarray) -> np.ndarray:
         """The pairs of ``patches``, patch by patch in that order."""
@@ -61,46 +65,54 @@ class PatchLayout:
         return self.by_patch[np.repeat(self.start[patches], count) + offset]
 
 
+def index_type(size: int) -> type:
+    """int32 for indices below 2^31 (half the memory traffic of the (pairs, n_rt) arrays)."""
+    return np.int32 if size < 2**31 else np.int64
+
+
 def layout(patch: np.ndarray, dofs: np.ndarray, status: np.ndarray, holder: np.ndarray,
            n_vertices: int) -> PatchLayout:
     """``dofs`` (P, n_rt) global RT DOFs of each pair's element; ``holder`` (P, n_rt) the flat
     index (pair * n_rt + slot) of the entry that represents the same (patch, DOF) unknown (a
     DOF on a facet at the patch's vertex is held by the facet's two elements; either may
     represent it, the layout numbers the representatives patch by patch, without a sort of
-    the keys)."""
+    the keys). A FREE entry's holder is FREE: only FREE entries' keys are read."""
     n_pairs, n_rt = status.shape
+    itype = index_type(n_pairs * n_rt)
     free = status == FREE
-    own = free & (holder == np.arange(n_pairs * n_rt).reshape(n_pairs, n_rt))
+    own = free & (holder == np.arange(n_pairs * n_rt, dtype=itype).reshape(n_pairs, n_rt))
     order = np.argsort(patch, kind="stable")
     count = np.bincount(patch, minlength=n_vertices)
     starts = np.concatenate([[0], np.cumsum(count)[:-1]])
     rank = np.empty(n_pairs, dtype=np.int64)
     rank[order] = np.arange(n_pairs) - starts[patch[order]]
     grouped = np.flatnonzero(own[order].ravel())     # the keys, patch by patch
-    key = np.full(n_pairs * n_rt, -1, dtype=np.int64)
-    key[order[grouped // n_rt] * n_rt + grouped % n_rt] = np.arange(grouped.size)
-    key_of = np.where(free, key[holder], -1)
+    key = np.zeros(n_pairs * n_rt, dtype=itype)
+    key[order[grouped // n_rt] * n_rt + grouped % n_rt] = np.arange(grouped.size, dtype=itype)
+    key_of = key[holder]
+    key_of[~free] = -1
     n_free = np.bincount(np.repeat(patch, n_rt)[own.ravel()], minlength=n_vertices)
     first = np.concatenate([[0], np.cumsum(n_free)[:-1]])
     key_dof = np.empty(int(n_free.sum()), dtype=np.int64)
     key_dof[key_of[own]] = dofs[own]
-    return PatchLayout(patch=patch, status=status,
-                       local=np.where(free, key_of - first[patch][:, None], -1),
-                       n_free=n_free, rank=rank, count=count, key_dof=key_dof, key_of=key_of,
-                       by_patch=order, start=starts)
+    local = key_of - first[patch].astype(itype)[:, None]
+    local[~free] = -1
+    return PatchLayout(patch=patch, status=status, local=local, n_free=n_free, rank=rank,
+                       count=count, key_dof=key_dof, key_of=key_of, by_patch=order,
+                       start=starts, first=first)
 
 
 @dataclass(frozen=True, eq=False)
 class PairMatrices:
-    """Per element (pair p belongs to element p // 3): ``mass`` (n_el, n_rt, n_rt),
-    ``divergence`` (n_el, n_dg, n_rt) and ``element_owner`` (n_el,), an element with the same
-    matrices (``estimators.patch_classes.element_classes``); per pair: ``rhs`` (P, n_rt, 2),
-    ``data`` (P, n_dg, 2) and the prescribed values ``fixed`` (P, n_rt, 2) (zero where not
-    FIXED)."""
+    """Per class of elements with equal matrices (``estimators.patch_classes``): ``mass``
+    (n_classes, n_rt, n_rt) and ``divergence`` (n_classes, n_dg, n_rt), and ``element_class``
+    (n_el,) the class of each element (pair p belongs to element p // 3); per pair: ``rhs``
+    (P, n_rt, 2), ``data`` (P, n_dg, 2) and the prescribed values ``fixed`` (P, n_rt, 2)
+    (zero where not FIXED)."""
 
     mass: np.ndarray
     divergence: np.ndarray
-    element_owner: np.ndarray
+    element_class: np.ndarray
     rhs: np.ndarray
     data: np.ndarray
     fixed: np.ndarray
@@ -118,11 +130,11 @@ def solve_patches(lay: PatchLayout, pairs: PairMatrices, clamped: np.ndarray) ->
     (``estimators.patch_classes``) share one factorisation."""
     rhs, data = pairs.rhs.copy(), pairs.data.copy()
     touched = np.flatnonzero((lay.status == FIXED).any(axis=1))  # pairs on Gamma_N, Gamma_C
-    fixed, element = pairs.fixed[touched], touched // 3
+    fixed, element = pairs.fixed[touched], pairs.element_class[touched // 3]
     rhs[touched] -= np.matmul(pairs.mass[element], fixed)
     data[touched] -= np.matmul(pairs.divergence[element], fixed)
     size = lay.n_free + lay.count * pairs.divergence.shape[1]
-    owner = _owners(lay, pairs.element_owner, clamped, size)
+    owner = _owners(lay, pairs.element_class, clamped, size)
     out = np.zeros((lay.key_dof.size, 2))
     jobs = []
     for n in np.unique(size):
@@ -135,26 +147,41 @@ def solve_patches(lay: PatchLayout, pairs: PairMatrices, clamped: np.ndarray) ->
     return out
 
 
-def _owners(lay: PatchLayout, element_owner: np.ndarray, clamped: np.ndarray,
+def _owners(lay: PatchLayout, element_class: np.ndarray, clamped: np.ndarray,
             size: np.ndarray) -> np.ndarray:
-    """For every patch a patch with the same system: equal size, clamping, and per element
-    rank the same element matrices (``element_owner``: an element with the same) at the same
-    positions."""
+    """For every patch the first patch with the same system: equal size, element count and
+    clamping, and per element rank the same element matrices (the same ``element_class``)
+    at the same positions. Grouped by a hash of these, pair by pair, then every patch is
+    compared with its group's first; one that differs is a class of its own."""
     n_rt = lay.local.shape[1]
-    owner = np.arange(lay.count.size)
-    for n in np.unique(size):
-        members = np.flatnonzero(size == n)
-        count = lay.count[members]
-        keys = np.full((members.size, 2 + count.max() * (1 + n_rt)), -2, dtype=np.int64)
-        keys[:, 0], keys[:, 1] = count, clamped[members]
-        for r in range(count.max()):
-            has = count > r
-            pair = lay.by_patch[lay.start[members[has]] + r]
-            column = 2 + r * (1 + n_rt)
-            keys[has, column] = element_owner[pair // 3]
-            keys[has, column + 1:column + 1 + n_rt] = lay.local[pair]
-        owner[members] = members[patch_classes(keys)]
-    return owner
+    rng = np.random.default_rng(HASH_SEED)
+    weights = rng.integers(1, 2**61, size=n_rt + 1)
+    by_rank = rng.integers(1, 2**61, size=int(lay.count.max(initial=1)))
+    pairs = lay.by_patch
+    with np.errstate(over="ignore"):
+        pair_hash = ((element_class[pairs // 3] * weights[0]
+                      + lay.local[pairs].astype(np.int64) @ weights[1:]) * by_rank[lay.rank[pairs]])
+        patch_hash = np.zeros(lay.count.size, dtype=np.int64)
+        filled = lay.count > 0
+        patch_hash[filled] = np.add.reduceat(pair_hash, lay.start[filled])
+    keys = np.stack([size, lay.count, clamped.astype(np.int64), patch_hash], axis=1)
+    owner = patch_classes(keys)
+    return np.where(_same_pairs(lay, element_class, owner), owner, np.arange(owner.size))
+
+
+def _same_pairs(lay: PatchLayout, element_class: np.ndarray, owner: np.ndarray) -> np.ndarray:
+    """Whether each patch's pairs equal its ``owner``'s, rank by rank: element class and
+    local positions (the hash of ``_owners`` grouped them; this rules out collisions)."""
+    other = np.flatnonzero(owner != np.arange(owner.size))
+    same = np.ones(owner.size, dtype=bool)
+    if other.size == 0:
+        return same
+    mine, theirs = lay.pairs_of(other), lay.pairs_of(owner[other])   # equal counts: in the key
+    differs = ((element_class[mine // 3] != element_class[theirs // 3])
+               | (lay.local[mine] != lay.local[theirs]).any(axis=1))
+    patch = np.repeat(np.arange(other.size), lay.count[other])
+    same[other] = np.bincount(patch, differs, minlength=other.size) == 0
+    return same
 
 
 def _solve_chunk(lay, chunk, n, pairs, right, clamped, owner, out) -> None:
@@ -169,8 +196,9 @@ def _solve_chunk(lay, chunk, n, pairs, right, clamped, owner, out) -> None:
     else:
         x = np.empty_like(b)
         x[classes.order] = classes.products(np.linalg.inv(A), b[classes.order])
-    gf = np.broadcast_to(view.g[:, None], view.free.shape)[view.free]
-    out[lay.key_of[view.sel][view.free]] = x[gf, view.loc[view.free]]
+    rows = np.arange(n)
+    unknown = rows[None, :] < lay.n_free[chunk][:, None]  # a patch's keys are consecutive
+    out[(lay.first[chunk][:, None] + rows)[unknown]] = x[unknown]
 
 
 @dataclass(frozen=True, eq=False)
@@ -202,8 +230,8 @@ class _ChunkPairs:
 def _systems(lay, chunk, n, pairs, clamped) -> np.ndarray:
     """The matrices (len(chunk), n, n) of the patches ``chunk``."""
     view = _ChunkPairs.of(lay, chunk, n, pairs.divergence.shape[1])
-    entries = _Entries(chunk.size, n, 2)
-    element = view.sel // 3
+    entries = _Entries(chunk.size, n)
+    element = pairs.element_class[view.sel // 3]
     free = view.free
     entries.matrix(view.g, view.loc[:, :, None], view.loc[:, None, :], pairs.mass[element],
                    free[:, :, None] & free[:, None, :])
@@ -217,26 +245,28 @@ def _systems(lay, chunk, n, pairs, clamped) -> np.ndarray:
 
 
 def _right_hand_sides(lay, view, n, pairs, right, clamped) -> np.ndarray:
-    """The right-hand sides (patches, n, 2) of the chunk ``view``."""
+    """The right-hand sides (patches, n, 2) of the chunk ``view``: each pair's multiplier
+    rows are its own; a FREE unknown on a facet is shared by the facet's two pairs."""
     rhs, data = right
-    entries = _Entries(view.size, n, 2)
+    b = np.zeros((view.size, n, 2))
     rows = view.div_at[:, None] + np.arange(pairs.divergence.shape[1])
-    for r in (0, 1):
-        entries.vector(view.g, view.loc, rhs[view.sel][..., r], view.free, r)
-        entries.vector(view.g, rows, data[view.sel][..., r], np.ones(rows.shape, bool), r)
-    b = entries.assembled_vector()
+    b[view.g[:, None], rows] = data[view.sel]
+    at = (view.g[:, None] * n + view.loc)[view.free]
+    shared = np.bincount(np.concatenate([2 * at, 2 * at + 1]),
+                         rhs[view.sel][view.free].T.ravel(), minlength=b.size)
+    b += shared.reshape(b.shape)
     k, d = view.dropped(lay, clamped)
     b[k, d] = 0.0
     return b
 
 
 class _Entries:
-    """Accumulates (system, row, column, value) entries of stacked dense systems and sums
+    """Accumulates (system, row, column, value) entries of stacked dense matrices and sums
     them with one ``bincount`` (duplicates add up)."""
 
-    def __init__(self, count: int, n: int, columns: int):
-        self.count, self.n, self.columns = count, n, columns
-        self.a_index, self.a_value, self.b_index, self.b_value = [], [], [], []
+    def __init__(self, count: int, n: int):
+        self.count, self.n = count, n
+        self.a_index, self.a_value = [], []
 
     def matrix(self, g, rows, cols, values, mask) -> None:
         shape = mask.shape
@@ -245,19 +275,9 @@ class _Entries:
         self.a_index.append(flat[mask])
         self.a_value.append(values[mask])
 
-    def vector(self, g, rows, values, mask, column) -> None:
-        flat = (np.broadcast_to(g[:, None], mask.shape) * self.n + rows) * self.columns + column
-        self.b_index.append(flat[mask])
-        self.b_value.append(values[mask])
-
     def assembled_matrix(self) -> np.ndarray:
         return np.bincount(np.concatenate(self.a_index), np.concatenate(self.a_value),
                            minlength=self.count * self.n**2).reshape(self.count, self.n, self.n)
-
-    def assembled_vector(self) -> np.ndarray:
-        return np.bincount(np.concatenate(self.b_index), np.concatenate(self.b_value),
-                           minlength=self.count * self.n * self.columns
-                           ).reshape(self.count, self.n, self.columns)
 
 
 def _constraint(entries: _Entries, g, start, loc, free, block) -> None:

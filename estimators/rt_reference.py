@@ -90,13 +90,15 @@ def orientations(mesh, n_rt: int, k: int) -> np.ndarray:
     return signs
 
 
-def element_matrices(mesh, k: int, X: np.ndarray, W: np.ndarray, dg: np.ndarray):
+def element_matrices(mesh, k: int, X: np.ndarray, W: np.ndarray, dg: np.ndarray,
+                     elements: np.ndarray | None = None):
     """The RT_k mass (n_el, n_rt, n_rt) and divergence (n_el, n_dg, n_rt) matrices for the
-    reference basis ``dg`` (n_dg, nq) at the rule (X, W)."""
+    reference basis ``dg`` (n_dg, nq) at the rule (X, W), of the ``elements`` only if given."""
     mapping = mesh.mapping()
-    J, det = mapping.A, np.abs(mapping.detA)                           # (2, 2, n_el), (n_el,)
+    chosen = slice(None) if elements is None else elements
+    J, det = mapping.A[:, :, chosen], np.abs(mapping.detA)[chosen]     # (2, 2, n), (n,)
     phi, div = reference_rt(k, X)
-    o = orientations(mesh, phi.shape[0], k)
+    o = orientations(mesh, phi.shape[0], k)[chosen]
     gram = np.einsum("ice,ide->cde", J, J)                             # J'J
     mass_ref = np.einsum("jcp,ldp,p->cdjl", phi, phi, W)
     n_rt = phi.shape[0]

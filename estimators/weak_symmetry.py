@@ -176,5 +176,5 @@ def weakly_symmetrised(rec: Reconstruction, interior: Interior, prescribed: np.n
     values = rec.values + correction
     scale = hat_moments(rt, 0.5 * (np.abs(values[0, 1]) + np.abs(values[1, 0])))
     defect = np.abs(skew_moments(rt, values)).max() / max(scale.max(), np.finfo(float).tiny)
-    return replace(rec, dofs=rec.dofs + rt_dofs(rt, interior.mass, correction),
+    return replace(rec, dofs=rec.dofs + rt_dofs(rt, interior, correction),
                    values=values), float(defect)

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from skfem import MeshTri
 
-from estimators import equilibration, patch_classes, patches, symmetrisation
+from estimators import patch_classes, patch_data, patches, symmetrisation
 from estimators.equilibrated import equilibrate
 from estimators.patch_classes import element_classes
 from estimators.rt_reference import ReferenceRT, element_matrices, scalar_values
@@ -72,10 +72,32 @@ def test_shared_systems_give_the_stress_of_one_solve_per_patch(monkeypatch, orde
     shared = equilibrate(scene, solution, symmetrise=row_by_row)[0].dofs
     # the classes repeat: most chunks take the inverses, not an LU per patch
     assert 8 * np.unique(owners[0]).size < owners[0].size
-    monkeypatch.setattr(equilibration, "element_classes",
+    monkeypatch.setattr(patch_data, "element_classes",
                         lambda mesh, k: np.arange(mesh.t.shape[1]))
     alone = equilibrate(scene, solution, symmetrise=row_by_row)[0].dofs
     assert np.abs(shared - alone).max() <= 1e-11 * np.abs(alone).max()
+
+
+def test_patches_whose_hashes_collide_keep_their_own_systems(monkeypatch):
+    """Every patch of equal size, element count and clamping grouped as one (as if all their
+    hashes collided): the pair-by-pair check must split the groups again, so the stress is
+    that of one solve per patch (bound as above)."""
+    scene = get_scene("paper")
+    solution = solve(get_formulation("vi")(scene, locally_refined(scene, 3)), "active-set")
+    monkeypatch.setattr(patch_data, "element_classes", lambda mesh, k: np.arange(mesh.t.shape[1]))
+    alone = equilibrate(scene, solution, symmetrise=row_by_row)[0].dofs
+    monkeypatch.undo()
+    monkeypatch.setattr(patches, "BATCH", 64)
+    shared_hashes, owners = patches.patch_classes, []
+
+    def colliding(keys):
+        owners.append(shared_hashes(keys[:, :3]))
+        return owners[-1]
+
+    monkeypatch.setattr(patches, "patch_classes", colliding)
+    merged = equilibrate(scene, solution, symmetrise=row_by_row)[0].dofs
+    assert np.unique(owners[0]).size <= 10    # 199 distinct systems, grouped as 8
+    assert np.abs(merged - alone).max() <= 1e-11 * np.abs(alone).max()
 
 
 @pytest.mark.parametrize("refine", [3, 0])
