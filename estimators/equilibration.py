@@ -27,7 +27,15 @@ import numpy as np
 from skfem import ElementTriP1, FacetBasis
 
 from estimators.patch_data import Interior
-from estimators.patches import FIXED, FREE, ZERO, PairMatrices, layout, solve_patches
+from estimators.patches import (
+    FIXED,
+    FREE,
+    ZERO,
+    PairMatrices,
+    index_type,
+    layout,
+    solve_patches,
+)
 from estimators.raviart_thomas import ElementTriRTk
 from estimators.rt_reference import ReferenceRT
 
@@ -163,7 +171,7 @@ def facet_holders(mesh, element_dofs: np.ndarray, k: int) -> np.ndarray:
     numbered by facet); interior DOFs represent themselves. Entries of a facet opposite the
     pair's vertex are never read (ZERO) and hold some index."""
     n_rt, n_el = element_dofs.shape
-    holder = np.arange(3 * n_el * n_rt).reshape(3 * n_el, n_rt)
+    holder = np.arange(3 * n_el * n_rt, dtype=index_type(3 * n_el * n_rt)).reshape(3 * n_el, n_rt)
     elements = np.arange(n_el)
     for f in range(3):
         facet = mesh.t2f[f]
