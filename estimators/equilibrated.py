@@ -24,11 +24,11 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from estimators.auxiliary_traction import contact_traction
 from estimators.averaging import compliance_energy
 from estimators.base import BoundTerms, Estimate, planar_only, register_estimator
 from estimators.bounded_shear import auxiliary_shear, l2_excess_term
 from estimators.constants import domain_constants
-from estimators.contact_extension import EXTENSIONS
 from estimators.equilibration import (
     BoundaryData,
     boundary_balance,
@@ -38,21 +38,13 @@ from estimators.equilibration import (
 from estimators.guaranteed_contact import (
     ContactBound,
     ContactBounds,
-    ContactTraction,
-    FacetPolynomial,
-    balanced_traction,
-    contact_bound,
-    projected_pressure,
     traction_at,
-    traction_balance,
 )
 from estimators.guaranteed_friction import friction_bound, raw_shear, shear_at
 from estimators.jump_equilibration import jump_oscillation
-from estimators.nonnegative_traction import nonnegative_pressure
 from estimators.oscillation import oscillation
 from estimators.patch_data import interior_data, rebalanced
-from estimators.residual import stress_tensor
-from estimators.strip_extension import relaxed
+from estimators.residual import stress_at, stress_tensor
 from estimators.symmetrisation import symmetrised
 from formulations import DiscreteSolution
 from formulations.elasticity import stress_from_gradient
@@ -115,23 +107,31 @@ def estimate(scene, solution: DiscreteSolution) -> Estimate:
     compliance = compliance_squares(rec, interior, (lam, mu))
     skew = ((rec.values[0, 1] - rec.values[1, 0]) ** 2 / 2 * rec.basis.dx).sum(axis=1)
     jump = jump_oscillation(rec.basis.mesh, scene.body_force, rec.basis.elem.k, (lam, mu),
-                            constants.korn, level_set=scene.load_jump)
+                            constants.korn, level_set=scene.load_jump,
+                            stress_gap=stress_gap(rec, solution))
     osc = oscillation(scene, rec.basis, boundary, jump)
-    tau_sym, tau_skew = np.zeros_like(osc), np.zeros_like(osc)
-    if jump is not None:  # where f jumps: (r_2, v) through tau (13.2, "Where f jumps")
+    if jump is not None:  # where f jumps: sigma* - tau on the rough elements (13.2)
         if jump.divergence_defect > BALANCE_TOLERANCE:
             raise NotEquilibrated(f"div tau misses r_2 by {jump.divergence_defect:.1e} "
                                   f"(relative) > {BALANCE_TOLERANCE:g}: no bound")
-        tau_sym[jump.elements] = np.sqrt(jump.symmetric)
-        tau_skew[jump.elements] = constants.korn * np.sqrt(jump.skew)
+        compliance[jump.elements], skew[jump.elements] = jump.symmetric, jump.skew
     grad_constant = np.sqrt(1 / (2 * mu) + constants.korn**2)
     volume = (np.sqrt(compliance) + constants.korn * np.sqrt(skew) + grad_constant * osc
-              + tau_sym + tau_skew + constants.friedrichs * np.sqrt(load.squares)) ** 2
+              + constants.friedrichs * np.sqrt(load.squares)) ** 2
     parts = dict(symmetric=np.sqrt(compliance.sum()), skew=constants.korn * np.sqrt(skew.sum()),
-                 oscillation=(grad_constant * np.sqrt((osc**2).sum())
-                              + np.sqrt((tau_sym**2).sum()) + np.sqrt((tau_skew**2).sum())),
+                 oscillation=grad_constant * np.sqrt((osc**2).sum()),
                  load=constants.friedrichs * np.sqrt(load.squares.sum()))
     return smallest(scene, solution, parts, volume, bounds, shear, "equilibrated")
+
+
+def stress_gap(rec, solution: DiscreteSolution):
+    """sigma* - sigma_h (2, 2, n, nq) at points x (2, n, nq) of the elements ``cells``, as a
+    function ``gap(x, cells)`` (``estimators.jump_equilibration``, ``stress_gap``)."""
+    def gap(x: np.ndarray, cells: np.ndarray) -> np.ndarray:
+        sigma_h = stress_at(solution, x.reshape(2, -1), np.repeat(cells, x.shape[2]))
+        return rec.basis.values_at(rec.dofs, x, cells) - sigma_h.reshape(2, 2, *x.shape[1:])
+
+    return gap
 
 
 def compliance_squares(rec, interior, lame: tuple[float, float]) -> np.ndarray:
@@ -255,43 +255,3 @@ def equilibrate(scene, solution: DiscreteSolution, symmetrise=None,
                 [neumann, contact], clamped, shear)
     rec = symmetrised(rec, interior, prescribed, (lam, mu), domain_constants(scene).korn)
     return rec, interior, load, bounds, [neumann, contact], clamped, shear
-
-
-def contact_traction(scene, solution, interior, reaction: np.ndarray, clamped: np.ndarray,
-                     trace_constant: float | None = None
-                     ) -> tuple[ContactTraction, ContactBounds]:
-    """lambda* (docs/theory.md, 13.3): of three tractions that balance u_h on the contact
-    patches, the one with the smallest terms 2 D + C_T ||lambda*_-|| + sqrt(B) (over the
-    extensions d of ``estimators.contact_extension``; no patch problem is solved for any).
-    Each is a pressure, projected onto P_k per facet, plus the P1 correction of what u_h does
-    not balance with it: (i) lambda_h (the mixed method balances it exactly); (ii) zero, so the
-    correction is the L2 representative of u_h's discrete reaction on Gamma_C (for the penalty
-    and Nitsche on coarse contact zones, whose pressure formula peaks between the Gauss points
-    that their own equations see); (iii) a non-negative traction with the reaction's moments
-    where one exists (``estimators.nonnegative_traction``; the correction takes the round-off
-    of its least squares, or what no non-negative traction balances). Returns it with its
-    ``ContactBounds`` for every extension, one-layer and relaxed off Gamma_C (the choice
-    between the tractions is made with the one-layer fields)."""
-    trace, order = solution.trace, solution.elasticity.order
-    pressures = [projected_pressure(solution.pressure, order),
-                 FacetPolynomial(np.zeros((trace.facets.size, order + 1))),
-                 nonnegative_pressure(trace, reaction, clamped, order)]
-    candidates = [balanced_traction(trace, pressure,
-                                    reaction - traction_balance(interior, trace, pressure),
-                                    clamped)
-                  for pressure in pressures]
-    if trace_constant is None:
-        trace_constant = domain_constants(scene).trace
-    fields = [extend(scene, solution, clamped) for extend in EXTENSIONS]
-    bounds = [tuple(contact_bound(scene, solution, traction, d) for d in fields)
-              for traction in candidates]
-    terms = [min(2 * b.extension + trace_constant * b.negative + np.sqrt(b.complementarity)
-                 for b in options) for options in bounds]
-    best = int(np.argmin(terms))
-    dirichlet = scene.dirichlet_facets(solution.elasticity.mesh)
-    strips = relaxed(fields, trace, solution.elasticity.lame, dirichlet)
-    sharp = tuple(replace(bound, extension=float(np.sqrt(strip.energies.sum())),
-                          energy=strip.energies, field=strip)
-                  for bound, strip in zip(bounds[best], strips, strict=True))
-    return candidates[best], ContactBounds(marking=bounds[best], sharp=sharp)
-

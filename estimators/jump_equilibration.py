@@ -44,6 +44,7 @@ from estimators.rt_reference import (
     scalar_values,
     summed_matrix,
 )
+from estimators.weighted_stress import energy_blocks, stress_weight, weighted_moments
 from formulations.elasticity import ELEMENTS, element_diameters
 from formulations.load import MAX_DEPTH, body_load, refined_rule
 
@@ -63,7 +64,8 @@ def sub_depth(levels: int) -> int:
 
 @dataclass(frozen=True, eq=False)
 class JumpOscillation:
-    """Per rough element (``elements``): ||C^-1/2 sym tau||_T^2, ||skw tau||_T^2 and the
+    """Per rough element (``elements``): ||C^-1/2 sym tau||_T^2, ||skw tau||_T^2 (of
+    sigma* - tau - sigma_h if ``combined``) and the
     sub-triangles' Poincare term sum_S ((h_S / pi) ||r_1||_S)^2; ``divergence_defect`` the
     largest |div tau - r_2| moment relative to the largest r_2 moment (round-off)."""
 
@@ -72,6 +74,7 @@ class JumpOscillation:
     skew: np.ndarray
     remainder: np.ndarray
     divergence_defect: float
+    combined: bool = False      # the terms of sigma* - tau - sigma_h, not of tau alone
 
 
 def rough_elements(mesh, body_force, k: int) -> np.ndarray:
@@ -83,8 +86,8 @@ def rough_elements(mesh, body_force, k: int) -> np.ndarray:
 
 
 def jump_oscillation(mesh, body_force, k: int, lame: tuple[float, float], korn: float,
-                     element_korn: np.ndarray | None = None, level_set=None
-                     ) -> JumpOscillation | None:
+                     element_korn: np.ndarray | None = None, level_set=None,
+                     stress_gap=None) -> JumpOscillation | None:
     """The terms of the module docstring on the rough elements of ``mesh`` (None if f is
     smooth on every element); ``korn`` C_K, the weight of the skew part. With
     ``element_korn`` (K_T per element of ``mesh``, ``estimators.local_korn``) the skew part
@@ -92,7 +95,14 @@ def jump_oscillation(mesh, body_force, k: int, lame: tuple[float, float], korn: 
     (docs/theory.md 13.4, "Local Korn constants"), and each sub-triangle's remainder is
     scaled by its own K_S over K_T (1 on similar ones; a cut piece's K_S is larger). With
     ``level_set`` (the scene's
-    ``load_jump``) the sub-triangles are cut along the jump (``estimators.level_set_cut``)."""
+    ``load_jump``) the sub-triangles are cut along the jump (``estimators.level_set_cut``).
+    With ``stress_gap`` (sigma* - sigma_h at points x (2, n, nq) of elements ``cells`` of
+    ``mesh``: ``stress_gap(x, cells)``, not with ``element_korn``) the terms are those of
+    sigma* - tau - sigma_h on the rough elements, tau the minimiser of that weighted norm
+    (``combined``; docs/theory.md 13.2, "Where f jumps")."""
+    if stress_gap is not None and element_korn is not None:
+        raise ValueError("jump_oscillation: stress_gap is given, so element_korn must be None "
+                         "(the combined terms use the global C_K)")
     rough = rough_elements(mesh, body_force, k)
     if rough.size == 0:
         return None
@@ -109,11 +119,16 @@ def jump_oscillation(mesh, body_force, k: int, lame: tuple[float, float], korn: 
     else:
         weights = ((element_korn[rough] - 1) / (2 * lame[1]))[parent]
         means = (_skew_means(sub, rt, parent, rough.size), parent)
-    symmetric = _energy_blocks(sub, k, X, W, stress_weight(lame, 0.0))
-    skew_only = _energy_blocks(sub, k, X, W, stress_weight(lame, 1.0)) - symmetric
+    symmetric = energy_blocks(sub, k, X, W, stress_weight(lame, 0.0))
+    skew_only = energy_blocks(sub, k, X, W, stress_weight(lame, 1.0)) - symmetric
     blocks = symmetric + weights[:, None, None] * skew_only
-    tau, defect = _least_tau(sub, rt, blocks, divergence, r_2, means)
+    gap = (None if stress_gap is None
+           else stress_gap(np.asarray(rt.global_coordinates()), rough[parent]))
+    target = None if gap is None else weighted_moments(rt, stress_weight(lame, korn), gap)
+    tau, defect = _least_tau(sub, rt, blocks, divergence, r_2, means, target)
     values = rt.values(tau)                                  # (2, 2, n_sub, nq)
+    if gap is not None:
+        values = gap - values
     lam, mu = lame
     sym = np.array([values[0, 0], values[1, 1], 0.5 * (values[0, 1] + values[1, 0])])
     dx = rt.dx
@@ -128,7 +143,8 @@ def jump_oscillation(mesh, body_force, k: int, lame: tuple[float, float], korn: 
     per.append(poincare)
     symmetric, skew, remainder = (np.bincount(parent, p, rough.size) for p in per)
     return JumpOscillation(elements=rough, symmetric=symmetric, skew=skew,
-                           remainder=remainder, divergence_defect=defect)
+                           remainder=remainder, divergence_defect=defect,
+                           combined=gap is not None)
 
 
 def sub_triangles(mesh, rough: np.ndarray, body_force, k: int, level_set=None
@@ -182,35 +198,6 @@ def _split_load(mesh, rough, sub, parent, body_force, k, depth: int = sub_depth(
     return r_2, own
 
 
-def stress_weight(lame: tuple[float, float], korn: float) -> np.ndarray:
-    """W (4, 4) with tau : W : tau = sym tau : C^-1 sym tau + C_K^2 |skw tau|^2, entries in
-    the order tau_00, tau_01, tau_10, tau_11 (row, component), in plane strain."""
-    lam, mu = lame
-    kappa = lam / (2 * (lam + mu))
-    W = np.zeros((4, 4))
-    W[0, 0] = W[3, 3] = (1 - kappa) / (2 * mu)
-    W[0, 3] = W[3, 0] = -kappa / (2 * mu)
-    W[1, 1] = W[2, 2] = 1 / (4 * mu) + korn**2 / 2
-    W[1, 2] = W[2, 1] = 1 / (4 * mu) - korn**2 / 2
-    return W
-
-
-def _energy_blocks(sub, k: int, X, W, weight: np.ndarray) -> np.ndarray:
-    """(tau, tau)_W per element on the two rows' RT_k functions, (n_sub, 2 n_rt, 2 n_rt): the
-    Piola components phi_j,c = o_j (J phi^_j)_c / |det J| against ``weight``."""
-    mapping = sub.mapping()
-    J, det = mapping.A, np.abs(mapping.detA)
-    phi, _ = reference_rt(k, X)
-    n_rt = phi.shape[0]
-    o = orientations(sub, n_rt, k)
-    reference = np.einsum("jap,lbp,p->abjl", phi, phi, W)
-    components = np.einsum("cae,dbe,abjl->cdejl", J, J, reference, optimize=True)
-    components *= (o[:, :, None] * o[:, None, :] / det[:, None, None])[None, None]
-    local = np.einsum("rcsd,cdejl->erjsl", weight.reshape(2, 2, 2, 2), components,
-                      optimize=True)
-    return local.reshape(-1, 2 * n_rt, 2 * n_rt)
-
-
 def _skew_means(sub, rt, parent: np.ndarray, n_parents: int) -> sp.csr_matrix:
     """M (n_parents, 2 N): int_T s(tau) = int_T (tau_01 - tau_10) / 2 per rough element T
     for tau's two rows' RT DOFs, from int_S phi_j = o_j J int^ phi^_j (Piola)."""
@@ -227,13 +214,15 @@ def _skew_means(sub, rt, parent: np.ndarray, n_parents: int) -> sp.csr_matrix:
     return sp.hstack([first, second]).tocsr()
 
 
-def _least_tau(sub, rt, blocks, divergence, data, means=None) -> tuple[np.ndarray, float]:
+def _least_tau(sub, rt, blocks, divergence, data, means=None, target=None
+               ) -> tuple[np.ndarray, float]:
     """tau (2, N) in RT_k(sub)^2, tau . n = 0 on the boundary, (div tau_r, q_l)_S = data
     (n_sub, 2, n_dg), of least (tau, tau)_W (``blocks``): [E B'; B 0] with one multiplier per
     row and connected component dropped (its equation follows from the data's zero mean).
     ``means`` (rows int_T s(tau) per parent T, ``_skew_means``): these vanish too, one per
     component dropped (their sum is the torque of the data, which is zero: r_2 is
-    orthogonal to the rigid motions on every T)."""
+    orthogonal to the rigid motions on every T). With ``target`` ((phi_j, g)_W, 2 N) the
+    least ||g - tau||_W^2 instead."""
     n_sub, n_dg, n_rt = divergence.shape
     dofs = np.concatenate([rt.element_dofs, rt.element_dofs + rt.N]).T   # (n_sub, 2 n_rt)
     E = summed_matrix(blocks, dofs, 2 * rt.N)
@@ -260,7 +249,8 @@ def _least_tau(sub, rt, blocks, divergence, data, means=None) -> tuple[np.ndarra
         constraints = sp.vstack([constraints, matrix[held][:, both]])
     K = sp.bmat([[E[both][:, both], constraints.T], [constraints, None]], format="csc")
     flat = data.transpose(0, 2, 1).reshape(-1, 2)                      # (s l, r)
-    rhs = np.concatenate([np.zeros(both.size), flat[kept, 0], flat[kept, 1],
+    linear = np.zeros(both.size) if target is None else target[both]
+    rhs = np.concatenate([linear, flat[kept, 0], flat[kept, 1],
                           np.zeros(constraints.shape[0] - 2 * kept.size)])
     x = splu(K).solve(rhs)
     tau = np.zeros((2, rt.N))

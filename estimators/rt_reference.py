@@ -68,6 +68,19 @@ class ReferenceRT:
         return np.einsum("ice,rcep->riep", mapping.A, reference) / np.abs(
             mapping.detA)[None, None, :, None]
 
+    def values_at(self, dofs: np.ndarray, x: np.ndarray, cells: np.ndarray) -> np.ndarray:
+        """The values (r, 2, n, nq) of fields with RT DOFs ``dofs`` (r, N) at physical points
+        x (2, n, nq), row i of x in element cells[i] (the Piola map of ``values``)."""
+        mapping, k = self.mesh.mapping(), self.elem.k
+        n, nq = x.shape[1:]
+        X = np.asarray(mapping.invF(x, tind=cells)).reshape(2, -1)
+        n_rt = self.element_dofs.shape[0]
+        phi = np.array([self.elem.lbasis(X, j)[0] for j in range(n_rt)]).reshape(n_rt, 2, n, nq)
+        local = dofs[:, self.element_dofs[:, cells]] * orientations(self.mesh, n_rt, k)[cells].T
+        reference = np.einsum("rjn,jcnp->rcnp", local, phi)
+        return np.einsum("icn,rcnp->rinp", mapping.A[:, :, cells], reference) / np.abs(
+            mapping.detA[cells])[None, None, :, None]
+
 
 def reference_rt(k: int, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """RT_k reference values (n_rt, 2, nq) and divergences (n_rt, nq) at the points X."""

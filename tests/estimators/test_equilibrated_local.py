@@ -9,15 +9,14 @@ from bench.measure.discretisation_error import element_energy_errors
 from bench.sequence.loop import LoopConfig, run_sequence
 from estimators import get_estimator, guaranteed_estimators
 from estimators.jump_equilibration import (
-    _energy_blocks,
     _least_tau,
     _skew_means,
     _split_load,
     rough_elements,
-    stress_weight,
     sub_triangles,
 )
 from estimators.rt_reference import ReferenceRT, element_matrices, scalar_values
+from estimators.weighted_stress import energy_blocks, stress_weight
 from formulations import get_formulation, solve
 from formulations.elasticity import ELEMENTS
 from scenes import get_scene
@@ -74,7 +73,7 @@ def test_taus_skew_part_has_zero_mean_on_every_rough_element(k):
     rt = ReferenceRT.build(sub, k, 2 * k + 2)
     X, W = rt.quadrature
     _, divergence = element_matrices(sub, k, X, W, scalar_values(ELEMENTS[k](), X))
-    blocks = _energy_blocks(sub, k, X, W, stress_weight(LAME, 3.0))
+    blocks = energy_blocks(sub, k, X, W, stress_weight(LAME, 3.0))
     means = (_skew_means(sub, rt, parent, rough.size), parent)
     tau, defect = _least_tau(sub, rt, blocks, divergence, r_2, means)
     assert defect < 1e-10

@@ -9,7 +9,7 @@ from estimators import patches
 from estimators.equilibrated import equilibrate
 from estimators.patches import worker_count
 from estimators.raviart_thomas import ElementTriRTk
-from estimators.rt_reference import element_matrices, patch_rhs, scalar_values
+from estimators.rt_reference import ReferenceRT, element_matrices, patch_rhs, scalar_values
 from formulations import get_formulation, solve
 from formulations.elasticity import ELEMENTS
 from formulations.p1_stiffness import barycentric_gradients
@@ -67,3 +67,18 @@ def test_the_reconstruction_does_not_depend_on_the_thread_count(monkeypatch):
         monkeypatch.setattr(patches, "BATCH", 16)   # many chunks on a small mesh
         fields.append(equilibrate(scene, solution)[0].dofs)
     assert np.abs(fields[0] - fields[1]).max() <= 1e-13 * np.abs(fields[0]).max()
+
+
+@pytest.mark.parametrize("k", [1, 2, 3])
+def test_values_at_points_of_chosen_elements_are_scikit_fems(k, skewed_mesh):
+    """``ReferenceRT.values_at`` at points inside some elements (in another order than the
+    mesh's) against scikit-fem's interpolation there (round-off)."""
+    rt = ReferenceRT.build(skewed_mesh, k, 2 * k + 2)
+    dofs = np.random.default_rng(k).standard_normal((2, rt.N))
+    cells = np.arange(skewed_mesh.t.shape[1])[::-3]
+    X = np.array([[0.2, 0.6, 0.1], [0.3, 0.1, 0.7]])
+    x = skewed_mesh.mapping().F(X, tind=cells)                            # (2, n, 3)
+    basis = Basis(skewed_mesh, ElementTriRTk(k), quadrature=(X, np.ones(3)))
+    expected = np.array([np.asarray(basis.interpolate(d))[:, cells] for d in dofs])
+    got = rt.values_at(dofs, x, cells)
+    assert np.abs(got - expected).max() <= 1e-12 * np.abs(expected).max()

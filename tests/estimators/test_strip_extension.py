@@ -4,7 +4,7 @@ saves."""
 import numpy as np
 import pytest
 
-from estimators import equilibrated, get_estimator
+from estimators import auxiliary_traction, get_estimator
 from estimators.contact_extension import EXTENSIONS, fitted_extension
 from estimators.equilibrated import equilibrate
 from estimators.strip_extension import (
@@ -95,7 +95,7 @@ def test_eta_takes_the_relaxed_fields_and_marking_the_one_layer_fields(paper_mix
     def one_layer(fields, trace, lame, *_):
         return tuple(StripExtension(d, d.energy(trace, lame)) for d in fields)
 
-    monkeypatch.setattr(equilibrated, "relaxed", one_layer)
+    monkeypatch.setattr(auxiliary_traction, "relaxed", one_layer)
     plain = estimate(scene, solution)
     assert sharp.eta <= 0.95 * plain.eta
     assert sharp.indicators.sum() == pytest.approx(sharp.eta**2, rel=1e-12)  # scaled to eta^2

@@ -1,0 +1,62 @@
+"""The auxiliary contact traction lambda* of the guaranteed bound, chosen among three that
+balance u_h on the contact patches, with its contact terms (docs/theory.md, section 13.3)."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from estimators.constants import domain_constants
+from estimators.contact_extension import EXTENSIONS
+from estimators.guaranteed_contact import (
+    ContactBounds,
+    ContactTraction,
+    FacetPolynomial,
+    balanced_traction,
+    contact_bound,
+    projected_pressure,
+    traction_balance,
+)
+from estimators.nonnegative_traction import nonnegative_pressure
+from estimators.strip_extension import relaxed
+
+
+def contact_traction(scene, solution, interior, reaction: np.ndarray, clamped: np.ndarray,
+                     trace_constant: float | None = None
+                     ) -> tuple[ContactTraction, ContactBounds]:
+    """lambda* (docs/theory.md, 13.3): of three tractions that balance u_h on the contact
+    patches, the one with the smallest terms 2 D + C_T ||lambda*_-|| + sqrt(B) (over the
+    extensions d of ``estimators.contact_extension``; no patch problem is solved for any).
+    Each is a pressure, projected onto P_k per facet, plus the P1 correction of what u_h does
+    not balance with it: (i) lambda_h (the mixed method balances it exactly); (ii) zero, so the
+    correction is the L2 representative of u_h's discrete reaction on Gamma_C (for the penalty
+    and Nitsche on coarse contact zones, whose pressure formula peaks between the Gauss points
+    that their own equations see); (iii) a non-negative traction with the reaction's moments
+    where one exists (``estimators.nonnegative_traction``; the correction takes the round-off
+    of its least squares, or what no non-negative traction balances). Returns it with its
+    ``ContactBounds`` for every extension, one-layer and relaxed off Gamma_C (the choice
+    between the tractions is made with the one-layer fields)."""
+    trace, order = solution.trace, solution.elasticity.order
+    pressures = [projected_pressure(solution.pressure, order),
+                 FacetPolynomial(np.zeros((trace.facets.size, order + 1))),
+                 nonnegative_pressure(trace, reaction, clamped, order)]
+    candidates = [balanced_traction(trace, pressure,
+                                    reaction - traction_balance(interior, trace, pressure),
+                                    clamped)
+                  for pressure in pressures]
+    if trace_constant is None:
+        trace_constant = domain_constants(scene).trace
+    fields = [extend(scene, solution, clamped) for extend in EXTENSIONS]
+    bounds = [tuple(contact_bound(scene, solution, traction, d) for d in fields)
+              for traction in candidates]
+    terms = [min(2 * b.extension + trace_constant * b.negative + np.sqrt(b.complementarity)
+                 for b in options) for options in bounds]
+    best = int(np.argmin(terms))
+    dirichlet = scene.dirichlet_facets(solution.elasticity.mesh)
+    strips = relaxed(fields, trace, solution.elasticity.lame, dirichlet)
+    sharp = tuple(replace(bound, extension=float(np.sqrt(strip.energies.sum())),
+                          energy=strip.energies, field=strip)
+                  for bound, strip in zip(bounds[best], strips, strict=True))
+    return candidates[best], ContactBounds(marking=bounds[best], sharp=sharp)
+
