@@ -65,9 +65,9 @@ def sub_depth(levels: int) -> int:
 @dataclass(frozen=True, eq=False)
 class JumpOscillation:
     """Per rough element (``elements``): ||C^-1/2 sym tau||_T^2, ||skw tau||_T^2 (of
-    sigma* - tau - sigma_h if ``combined``) and the
-    sub-triangles' Poincare term sum_S ((h_S / pi) ||r_1||_S)^2; ``divergence_defect`` the
-    largest |div tau - r_2| moment relative to the largest r_2 moment (round-off)."""
+    sigma* - tau - sigma_h if ``combined``) and the sub-triangles' Poincare term sum_S
+    ((h_S / pi) ||r_1||_S)^2; ``divergence_defect`` the largest |div tau - r_2| moment
+    relative to the largest r_2 moment (round-off)."""
 
     elements: np.ndarray
     symmetric: np.ndarray
@@ -94,12 +94,12 @@ def jump_oscillation(mesh, body_force, k: int, lame: tuple[float, float], korn: 
     of tau has zero mean on every rough element and weighs (K_T - 1) / (2 mu) there instead
     (docs/theory.md 13.4, "Local Korn constants"), and each sub-triangle's remainder is
     scaled by its own K_S over K_T (1 on similar ones; a cut piece's K_S is larger). With
-    ``level_set`` (the scene's
-    ``load_jump``) the sub-triangles are cut along the jump (``estimators.level_set_cut``).
-    With ``stress_gap`` (sigma* - sigma_h at points x (2, n, nq) of elements ``cells`` of
-    ``mesh``: ``stress_gap(x, cells)``, not with ``element_korn``) the terms are those of
-    sigma* - tau - sigma_h on the rough elements, tau the minimiser of that weighted norm
-    (``combined``; docs/theory.md 13.2, "Where f jumps")."""
+    ``level_set`` (the scene's ``load_jump``) the sub-triangles are cut along the jump
+    (``estimators.level_set_cut``). With ``stress_gap`` (sigma* - sigma_h at points x (2, n,
+    nq) of elements ``cells`` of ``mesh``: ``stress_gap(x, cells)``, not with
+    ``element_korn``) the terms are those of sigma* - tau - sigma_h on the rough elements,
+    tau the minimiser of that weighted norm (``combined``; docs/theory.md 13.2, "tau inside
+    A")."""
     if stress_gap is not None and element_korn is not None:
         raise ValueError("jump_oscillation: stress_gap is given, so element_korn must be None "
                          "(the combined terms use the global C_K)")
@@ -129,15 +129,10 @@ def jump_oscillation(mesh, body_force, k: int, lame: tuple[float, float], korn: 
     values = rt.values(tau)                                  # (2, 2, n_sub, nq)
     if gap is not None:
         values = gap - values
-    lam, mu = lame
     sym = np.array([values[0, 0], values[1, 1], 0.5 * (values[0, 1] + values[1, 0])])
-    dx = rt.dx
-    per = [(compliance_energy(sym, lam, mu) * dx).sum(axis=1),
-           ((values[0, 1] - values[1, 0]) ** 2 / 2 * dx).sum(axis=1)]
-    f = body_force(np.asarray(rt.global_coordinates()))      # (2, n_sub, nq)
-    projected = np.einsum("sml,lp->msp", sub_coefficients, q)
-    r_1 = (((f - projected) ** 2).sum(axis=0) * dx).sum(axis=1)
-    poincare = (element_diameters(sub) / np.pi) ** 2 * r_1
+    per = [(compliance_energy(sym, *lame) * rt.dx).sum(axis=1),
+           ((values[0, 1] - values[1, 0]) ** 2 / 2 * rt.dx).sum(axis=1)]
+    poincare = _remainders(rt, body_force, np.einsum("sml,lp->msp", sub_coefficients, q))
     if element_korn is not None:  # charged with K_T of the parent: K_S / K_T on each piece
         poincare *= korn_per_element(sub) / element_korn[rough][parent]
     per.append(poincare)
@@ -145,6 +140,14 @@ def jump_oscillation(mesh, body_force, k: int, lame: tuple[float, float], korn: 
     return JumpOscillation(elements=rough, symmetric=symmetric, skew=skew,
                            remainder=remainder, divergence_defect=defect,
                            combined=gap is not None)
+
+
+def _remainders(rt, body_force, projected: np.ndarray) -> np.ndarray:
+    """((h_S / pi) ||r_1||_S)^2 per sub-triangle, r_1 = f - Pi_S f (``projected``, at the
+    points of ``rt``, (2, n_sub, nq))."""
+    f = body_force(np.asarray(rt.global_coordinates()))      # (2, n_sub, nq)
+    r_1 = (((f - projected) ** 2).sum(axis=0) * rt.dx).sum(axis=1)
+    return (element_diameters(rt.mesh) / np.pi) ** 2 * r_1
 
 
 def sub_triangles(mesh, rough: np.ndarray, body_force, k: int, level_set=None
