@@ -44,16 +44,6 @@ class Interior:
     k: int
     intorder: int
 
-    @property
-    def mass(self) -> np.ndarray:
-        """The RT_k mass matrices (n_el, n_rt, n_rt) of every element."""
-        return self.class_mass[self.classes.of]
-
-    @property
-    def divergence(self) -> np.ndarray:
-        """The divergence matrices (n_el, n_dg, n_rt) of every element."""
-        return self.class_divergence[self.classes.of]
-
 
 def interior_data(mesh, sigma_h, body_force, k: int, intorder: int) -> Interior:
     """``sigma_h(basis)`` returns sigma(u_h) (2, 2, n_el, nq) at the quadrature points of a

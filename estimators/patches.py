@@ -41,8 +41,8 @@ class PatchLayout:
     (P, n_rt) the position of a FREE DOF of row 0 (row 1 follows after ``n_free``),
     ``n_free`` (n_vertices,), ``rank`` (P,) the pair's position among its patch's elements,
     ``count`` (n_vertices,) elements per patch, ``key_dof`` the global DOF of each distinct
-    (patch, DOF) FREE unknown, ``key_of`` (P, n_rt) the key of each FREE DOF, and ``by_patch``
-    the pairs patch by patch, each patch's in rank order, from ``start`` (n_vertices,);
+    (patch, DOF) FREE unknown, and ``by_patch`` the pairs patch by patch, each patch's in
+    rank order, from ``start`` (n_vertices,);
     ``first`` (n_vertices,) the key of each patch's first unknown (a patch's keys are
     consecutive)."""
 
@@ -53,7 +53,6 @@ class PatchLayout:
     rank: np.ndarray
     count: np.ndarray
     key_dof: np.ndarray
-    key_of: np.ndarray
     by_patch: np.ndarray
     start: np.ndarray
     first: np.ndarray
@@ -89,8 +88,7 @@ def layout(patch: np.ndarray, dofs: np.ndarray, status: np.ndarray, holder: np.n
     grouped = np.flatnonzero(own[order].ravel())     # the keys, patch by patch
     key = np.zeros(n_pairs * n_rt, dtype=itype)
     key[order[grouped // n_rt] * n_rt + grouped % n_rt] = np.arange(grouped.size, dtype=itype)
-    key_of = key[holder]
-    key_of[~free] = -1
+    key_of = key[holder]   # read at FREE entries only
     n_free = np.bincount(np.repeat(patch, n_rt)[own.ravel()], minlength=n_vertices)
     first = np.concatenate([[0], np.cumsum(n_free)[:-1]])
     key_dof = np.empty(int(n_free.sum()), dtype=np.int64)
@@ -98,7 +96,7 @@ def layout(patch: np.ndarray, dofs: np.ndarray, status: np.ndarray, holder: np.n
     local = key_of - first[patch].astype(itype)[:, None]
     local[~free] = -1
     return PatchLayout(patch=patch, status=status, local=local, n_free=n_free, rank=rank,
-                       count=count, key_dof=key_dof, key_of=key_of, by_patch=order,
+                       count=count, key_dof=key_dof, by_patch=order,
                        start=starts, first=first)
 
 

@@ -60,24 +60,30 @@ class ReferenceRT:
     def values(self, dofs: np.ndarray) -> np.ndarray:
         """The values (r, 2, n_el, nq) of fields with RT DOFs ``dofs`` (r, N) at the points:
         o_j J phi^_j / |det J| summed with the element's DOF values."""
-        mapping, k = self.mesh.mapping(), self.elem.k
-        phi, _ = reference_rt(k, self.quadrature[0])
-        n_rt, n_el = self.element_dofs.shape
-        local = dofs[:, self.element_dofs] * orientations(self.mesh, n_rt, k).T[None]
-        reference = np.einsum("rje,jcp->rcep", local, phi, optimize=True)
-        return np.einsum("ice,rcep->riep", mapping.A, reference) / np.abs(
-            mapping.detA)[None, None, :, None]
+        phi, _ = reference_rt(self.elem.k, self.quadrature[0])
+        reference = np.einsum("rje,jcp->rcep", self._signed(dofs, slice(None)), phi,
+                              optimize=True)
+        return self._piola(reference, slice(None))
 
     def values_at(self, dofs: np.ndarray, x: np.ndarray, cells: np.ndarray) -> np.ndarray:
         """The values (r, 2, n, nq) of fields with RT DOFs ``dofs`` (r, N) at physical points
         x (2, n, nq), row i of x in element cells[i] (the Piola map of ``values``)."""
-        mapping, k = self.mesh.mapping(), self.elem.k
         n, nq = x.shape[1:]
-        X = np.asarray(mapping.invF(x, tind=cells)).reshape(2, -1)
+        X = np.asarray(self.mesh.mapping().invF(x, tind=cells)).reshape(2, -1)
         n_rt = self.element_dofs.shape[0]
         phi = np.array([self.elem.lbasis(X, j)[0] for j in range(n_rt)]).reshape(n_rt, 2, n, nq)
-        local = dofs[:, self.element_dofs[:, cells]] * orientations(self.mesh, n_rt, k)[cells].T
-        reference = np.einsum("rjn,jcnp->rcnp", local, phi)
+        reference = np.einsum("rjn,jcnp->rcnp", self._signed(dofs, cells), phi)
+        return self._piola(reference, cells)
+
+    def _signed(self, dofs: np.ndarray, cells) -> np.ndarray:
+        """o_j times the DOF values (r, n_rt, n) of the elements ``cells``."""
+        n_rt = self.element_dofs.shape[0]
+        return (dofs[:, self.element_dofs[:, cells]]
+                * orientations(self.mesh, n_rt, self.elem.k)[cells].T[None])
+
+    def _piola(self, reference: np.ndarray, cells) -> np.ndarray:
+        """J v^ / |det J| of reference vectors (r, 2, n, nq) on the elements ``cells``."""
+        mapping = self.mesh.mapping()
         return np.einsum("icn,rcnp->rinp", mapping.A[:, :, cells], reference) / np.abs(
             mapping.detA[cells])[None, None, :, None]
 
