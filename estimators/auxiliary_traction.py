@@ -1,5 +1,6 @@
 """The auxiliary contact traction lambda* of the guaranteed bound, chosen among three that
-balance u_h on the contact patches, with its contact terms (docs/theory.md, section 13.3)."""
+balance u_h on the contact patches, each with four balancing corrections, with its contact
+terms (docs/theory.md, section 13.3)."""
 
 from __future__ import annotations
 
@@ -8,8 +9,9 @@ from dataclasses import replace
 import numpy as np
 
 from estimators.constants import domain_constants
-from estimators.contact_extension import EXTENSIONS
+from estimators.contact_extension import EXTENSIONS, discrete_gap
 from estimators.guaranteed_contact import (
+    QUADRATURE,
     ContactBounds,
     ContactTraction,
     FacetPolynomial,
@@ -20,6 +22,7 @@ from estimators.guaranteed_contact import (
 )
 from estimators.nonnegative_traction import nonnegative_pressure
 from estimators.strip_extension import relaxed
+from formulations.contact import gauss_legendre
 
 
 def contact_traction(scene, solution, interior, reaction: np.ndarray, clamped: np.ndarray,
@@ -28,13 +31,15 @@ def contact_traction(scene, solution, interior, reaction: np.ndarray, clamped: n
     """lambda* (docs/theory.md, 13.3): of three tractions that balance u_h on the contact
     patches, the one with the smallest terms 2 D + C_T ||lambda*_-|| + sqrt(B) (over the
     extensions d of ``estimators.contact_extension``; no patch problem is solved for any).
-    Each is a pressure, projected onto P_k per facet, plus the P1 correction of what u_h does
-    not balance with it: (i) lambda_h (the mixed method balances it exactly); (ii) zero, so the
-    correction is the L2 representative of u_h's discrete reaction on Gamma_C (for the penalty
-    and Nitsche on coarse contact zones, whose pressure formula peaks between the Gauss points
-    that their own equations see); (iii) a non-negative traction with the reaction's moments
-    where one exists (``estimators.nonnegative_traction``; the correction takes the round-off
-    of its least squares, or what no non-negative traction balances). Returns it with its
+    Each is a pressure, projected onto P_k per facet, plus a correction, linear per facet, of
+    what u_h does not balance with it: (i) lambda_h (the mixed method balances it exactly);
+    (ii) zero, so the correction is the L2 representative of u_h's discrete reaction on
+    Gamma_C (for the penalty and Nitsche on coarse contact zones, whose pressure formula peaks
+    between the Gauss points that their own equations see); (iii) a non-negative traction
+    with the reaction's moments where one exists (``estimators.nonnegative_traction``; the
+    correction takes the round-off of its least squares, or what no non-negative traction
+    balances). Each takes its correction with the facet weights of ``gap_weights`` too.
+    Returns it with its
     ``ContactBounds`` for every extension, one-layer and relaxed off Gamma_C (the choice
     between the tractions is made with the one-layer fields)."""
     trace, order = solution.trace, solution.elasticity.order
@@ -43,8 +48,8 @@ def contact_traction(scene, solution, interior, reaction: np.ndarray, clamped: n
                  nonnegative_pressure(trace, reaction, clamped, order)]
     candidates = [balanced_traction(trace, pressure,
                                     reaction - traction_balance(interior, trace, pressure),
-                                    clamped)
-                  for pressure in pressures]
+                                    clamped, weight=weight)
+                  for pressure in pressures for weight in gap_weights(scene, solution)]
     if trace_constant is None:
         trace_constant = domain_constants(scene).trace
     fields = [extend(scene, solution, clamped) for extend in EXTENSIONS]
@@ -60,3 +65,19 @@ def contact_traction(scene, solution, interior, reaction: np.ndarray, clamped: n
                   for bound, strip in zip(bounds[best], strips, strict=True))
     return candidates[best], ContactBounds(marking=bounds[best], sharp=sharp)
 
+
+
+GAP_SCALES = (1e-1, 1e-2, 1e-3)  # s / max_e X_e of the weights tried besides omega = 1
+
+
+def gap_weights(scene, solution) -> list[np.ndarray | None]:
+    """The facet weights of the balancing correction (docs/theory.md, 13.3): None (the
+    continuous P1 delta), and omega_e = 1 + X_e / s with X_e the mean of (g - u_hn)_+ on facet
+    e and s = GAP_SCALES times its largest value: the correction then keeps off the facets
+    where u_h leaves a gap, where lambda*_+ costs slack in B."""
+    t, w = gauss_legendre(QUADRATURE)
+    gap = np.maximum(discrete_gap(scene, solution, t), 0.0) @ w
+    top = gap.max()
+    if top <= 0:
+        return [None]
+    return [None] + [1.0 + gap / (scale * top) for scale in GAP_SCALES]

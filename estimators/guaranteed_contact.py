@@ -92,10 +92,13 @@ def traction_balance(interior, trace, pressure, direction: np.ndarray | None = N
     return boundary_balance(interior.total.shape[0], boundary_fluxes(interior, [part]))
 
 
-def contact_mass(trace) -> sparse.csr_matrix:
-    """The mass matrix of continuous P1 on Gamma_C over all mesh vertices."""
+def contact_mass(trace, weight: np.ndarray | None = None) -> sparse.csr_matrix:
+    """The mass matrix of continuous P1 on Gamma_C over all mesh vertices; with a ``weight``
+    (n_f,) per facet, each facet's part divided by it."""
     start, end = trace.vertices
     n_v, h = trace.mesh.p.shape[1], trace.length
+    if weight is not None:
+        h = h / weight
     rows = np.concatenate([start, start, end, end])
     cols = np.concatenate([start, end, start, end])
     vals = np.concatenate([h / 3, h / 6, h / 6, h / 3])
@@ -103,15 +106,20 @@ def contact_mass(trace) -> sparse.csr_matrix:
 
 
 def balanced_traction(trace, pressure, defect: np.ndarray, clamped: np.ndarray,
-                      orientation: float = -1.0, directions: np.ndarray | None = None):
+                      orientation: float = -1.0, directions: np.ndarray | None = None,
+                      weight: np.ndarray | None = None):
     """lambda* from lambda_h and the per-vertex imbalance ``defect`` (n_vertices, 2) of the
     auxiliary problem with lambda_h: M delta = -defect . nu on the contact vertices off Gamma_D
     (M the P1 mass matrix of Gamma_C), and the imbalance left in tangential directions. For a
     traction ``orientation`` x value x ``directions`` (vertex vectors, (2, n_vertices)) in
-    general: M delta = orientation defect . directions (a shear: +1 and the vertex tangents)."""
+    general: M delta = orientation defect . directions (a shear: +1 and the vertex tangents).
+    With a ``weight`` omega (n_f,) per facet, delta is the linear function per facet of least
+    sum_e omega_e ||delta||_e^2 with these moments: mu / omega_e on facet e, M_omega mu = the
+    same right-hand side, M_omega the mass matrix with facet e's part divided by omega_e
+    (docs/theory.md, 13.3; omega = 1 is the continuous P1 delta)."""
     start, end = trace.vertices
     n_v = trace.mesh.p.shape[1]
-    M = contact_mass(trace)
+    M = contact_mass(trace, weight)
     nu = vertex_normals(trace) if directions is None else directions
     on = np.unique(np.concatenate([start, end]))
     on = on[~clamped[on]]
@@ -119,7 +127,9 @@ def balanced_traction(trace, pressure, defect: np.ndarray, clamped: np.ndarray,
     if on.size:
         rhs = orientation * (defect[on] * nu[:, on].T).sum(axis=1)
         delta[on] = np.atleast_1d(spsolve(M[on][:, on].tocsc(), rhs))
-    return ContactTraction(pressure=pressure, delta=np.array([delta[start], delta[end]]))
+    scale = 1.0 if weight is None else 1.0 / weight
+    return ContactTraction(pressure=pressure,
+                           delta=np.array([delta[start], delta[end]]) * scale)
 
 
 @dataclass(frozen=True)
