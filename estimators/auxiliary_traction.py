@@ -46,14 +46,17 @@ def contact_traction(scene, solution, interior, reaction: np.ndarray, clamped: n
     pressures = [projected_pressure(solution.pressure, order),
                  FacetPolynomial(np.zeros((trace.facets.size, order + 1))),
                  nonnegative_pressure(trace, reaction, clamped, order)]
-    candidates = [balanced_traction(trace, pressure,
-                                    reaction - traction_balance(interior, trace, pressure),
-                                    clamped, weight=weight)
-                  for pressure in pressures for weight in gap_weights(scene, solution)]
+    defects = [reaction - traction_balance(interior, trace, pressure) for pressure in pressures]
+    weights = gap_weights(scene, solution)
+    candidates = [balanced_traction(trace, pressure, defect, clamped, weight=weight)
+                  for pressure, defect in zip(pressures, defects, strict=True)
+                  for weight in weights]
     if trace_constant is None:
         trace_constant = domain_constants(scene).trace
     fields = [extend(scene, solution, clamped) for extend in EXTENSIONS]
-    bounds = [tuple(contact_bound(scene, solution, traction, d) for d in fields)
+    energies = [d.energy(trace, solution.elasticity.lame) for d in fields]  # once per field
+    bounds = [tuple(contact_bound(scene, solution, traction, d, energy)
+                    for d, energy in zip(fields, energies, strict=True))
               for traction in candidates]
     terms = [min(2 * b.extension + trace_constant * b.negative + np.sqrt(b.complementarity)
                  for b in options) for options in bounds]
@@ -64,7 +67,6 @@ def contact_traction(scene, solution, interior, reaction: np.ndarray, clamped: n
                           energy=strip.energies, field=strip)
                   for bound, strip in zip(bounds[best], strips, strict=True))
     return candidates[best], ContactBounds(marking=bounds[best], sharp=sharp)
-
 
 
 GAP_SCALES = (1e-1, 1e-2, 1e-3)  # s / max_e X_e of the weights tried besides omega = 1

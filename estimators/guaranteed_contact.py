@@ -154,11 +154,13 @@ class ContactBounds:
     sharp: tuple[ContactBound, ...]
 
 
-def contact_bound(scene, solution, traction: ContactTraction,
-                  d: Extension | StripExtension) -> ContactBound:
-    """D, ||lambda*_-|| and B of lambda* = ``traction`` with the extension ``d`` (13.1)."""
+def contact_bound(scene, solution, traction: ContactTraction, d: Extension | StripExtension,
+                  energy: np.ndarray | None = None) -> ContactBound:
+    """D, ||lambda*_-|| and B of lambda* = ``traction`` with the extension ``d`` (13.1);
+    ``energy`` a(d, d) per element if known (it does not depend on the traction)."""
     trace = solution.trace
-    energy = d.energy(trace, solution.elasticity.lame)
+    if energy is None:
+        energy = d.energy(trace, solution.elasticity.lame)
     t, w = gauss_legendre(QUADRATURE)
     d_n = d.along(trace, trace.normal, t)
     lam = traction(t)
