@@ -100,3 +100,15 @@ def test_gap_weights_lower_the_bound_on_a_coarse_contact_zone(hertz_vi_p2, monke
     plain = get_estimator("equilibrated")(scene, solution)
     assert weighted.eta <= 0.85 * plain.eta
     assert weighted.eta_complementarity <= 0.7 * plain.eta_complementarity
+
+
+def test_a_weighted_correction_needs_a_margin_to_be_taken():
+    """Candidates pressure by pressure, four weights each, None first: a weighted one is taken
+    only if its contact terms are below (1 - WEIGHTED_MARGIN) of the best unweighted one's."""
+    margin = auxiliary.WEIGHTED_MARGIN
+    terms = np.array([1.0, 0.95, 2.0, 2.0, 0.9, 2.0, 2.0, 2.0])
+    assert auxiliary._chosen(terms, 4) == 4             # the best unweighted: 0.9 (pressure 2)
+    terms[6] = 0.9 * (1 - margin) * 0.999
+    assert auxiliary._chosen(terms, 4) == 6
+    terms[6] = 0.9 * (1 - margin) * 1.001
+    assert auxiliary._chosen(terms, 4) == 4
