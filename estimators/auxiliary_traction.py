@@ -38,10 +38,10 @@ def contact_traction(scene, solution, interior, reaction: np.ndarray, clamped: n
     between the Gauss points that their own equations see); (iii) a non-negative traction
     with the reaction's moments where one exists (``estimators.nonnegative_traction``; the
     correction takes the round-off of its least squares, or what no non-negative traction
-    balances). Each takes its correction with the facet weights of ``gap_weights`` too.
-    Returns it with its
-    ``ContactBounds`` for every extension, one-layer and relaxed off Gamma_C (the choice
-    between the tractions is made with the one-layer fields)."""
+    balances). Each takes its correction with the facet weights of ``gap_weights`` too
+    (``_chosen``). Returns it with its ``ContactBounds`` for every extension, one-layer and
+    relaxed off Gamma_C (the choice between the tractions is made with the one-layer
+    fields)."""
     trace, order = solution.trace, solution.elasticity.order
     pressures = [projected_pressure(solution.pressure, order),
                  FacetPolynomial(np.zeros((trace.facets.size, order + 1))),

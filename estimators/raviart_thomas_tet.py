@@ -66,8 +66,8 @@ def sorted_tetrahedra(mesh: MeshTet) -> MeshTet:
 
 
 class ElementTetRTk(ElementHdiv):
-    """RT_k on tetrahedra (module docstring); ``ElementTetRTk(1)`` spans what scikit-fem's
-    ``ElementTetRT1`` spans."""
+    """RT_k on tetrahedra (module docstring); ``ElementTetRTk(1)`` has 15 functions
+    (scikit-fem's ``ElementTetRT0`` and ``ElementTetRT1`` are the lowest order, with 4)."""
 
     refdom = RefTet
 
