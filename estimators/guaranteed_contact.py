@@ -155,12 +155,11 @@ class ContactBounds:
 
 
 def contact_bound(scene, solution, traction: ContactTraction, d: Extension | StripExtension,
-                  energy: np.ndarray | None = None) -> ContactBound:
+                  energy: np.ndarray) -> ContactBound:
     """D, ||lambda*_-|| and B of lambda* = ``traction`` with the extension ``d`` (13.1);
-    ``energy`` a(d, d) per element if known (it does not depend on the traction)."""
+    ``energy`` is a(d, d) per element (``d.energy``; it does not depend on the traction, so
+    the caller computes it once for all tractions)."""
     trace = solution.trace
-    if energy is None:
-        energy = d.energy(trace, solution.elasticity.lame)
     t, w = gauss_legendre(QUADRATURE)
     d_n = d.along(trace, trace.normal, t)
     lam = traction(t)
