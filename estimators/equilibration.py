@@ -24,7 +24,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from skfem import ElementTriP1, FacetBasis
+from skfem import FacetBasis
 
 from estimators.patch_data import Interior
 from estimators.patches import (
@@ -36,19 +36,23 @@ from estimators.patches import (
     layout,
     solve_patches,
 )
-from estimators.raviart_thomas import ElementTriRTk
-from estimators.rt_reference import ReferenceRT
+from estimators.rt_reference import (
+    HATS,
+    OPPOSITE_FACET,
+    ReferenceRT,
+    facet_dof_count,
+    rt_element,
+)
 
-# local facets of scikit-fem's triangles: 0 = (v0, v1), 1 = (v1, v2), 2 = (v0, v2); the k + 1
-# RT_k DOFs of local facet f are (k + 1) f .. (k + 1) f + k, the interior ones follow.
-_OPPOSITE_FACET = np.array([1, 2, 0])
+# the m RT_k DOFs of local facet f (m = facet_dof_count) are m f .. m f + m - 1, the interior
+# ones follow.
 
 
 @dataclass(frozen=True, eq=False)
 class Reconstruction:
     """sigma* row by row as RT DOF vectors on ``basis`` (an ``estimators.rt_reference.
-    ReferenceRT``; shape (2, basis.N)), the element values
-    of sigma* (2, 2, n_elements, n_points) at the quadrature points of ``basis``, and how far
+    ReferenceRT``; shape (d, basis.N)), the element values
+    of sigma* (d, d, n_elements, n_points) at the quadrature points of ``basis``, and how far
     the patch data were from balance (max over patches, relative to the largest patch datum)."""
 
     basis: ReferenceRT
@@ -59,8 +63,8 @@ class Reconstruction:
 
 @dataclass(frozen=True)
 class BoundaryData:
-    """Neumann data t on boundary ``facets``: ``traction(x)`` gives t (2, n_f, nq) at the points
-    x (2, n_f, nq) of those facets (in that order)."""
+    """Neumann data t on boundary ``facets``: ``traction(x)`` gives t (d, n_f, nq) at the points
+    x (d, n_f, nq) of those facets (in that order)."""
 
     facets: np.ndarray
     traction: object
@@ -68,9 +72,9 @@ class BoundaryData:
 
 @dataclass(frozen=True, eq=False)
 class Flux:
-    """Pi_k (psi_a t) on boundary facets for both facet vertices a: the prescribed RT_k DOF
-    values (n_f, 2 vertices, 2 rows, k + 1 facet DOFs), the integrals of psi_a t (n_f, 2, 2),
-    the vertices (2, n_f), the elements (n_f,) and their local facet (n_f,)."""
+    """Pi_k (psi_a t) on boundary facets for every facet vertex a: the prescribed RT_k DOF
+    values (n_f, d vertices, d rows, m facet DOFs), the integrals of psi_a t (n_f, d, d), the
+    vertices (d, n_f), the elements (n_f,) and their local facet (n_f,)."""
 
     values: np.ndarray
     integrals: np.ndarray
@@ -81,18 +85,19 @@ class Flux:
 
 def boundary_flux(interior: Interior, part: BoundaryData) -> Flux:
     """The ``Flux`` of ``part`` at the RT degree and quadrature of ``interior``."""
-    mesh, k, facets = interior.rt.mesh, interior.k, part.facets
+    mesh, k, facets, d = interior.rt.mesh, interior.k, part.facets, interior.rt.mesh.dim()
     # no DOF locations: mapping them would cost a pass over every element of the mesh
-    fb = FacetBasis(mesh, ElementTriRTk(k), facets=facets, intorder=interior.intorder,
+    fb = FacetBasis(mesh, rt_element(k, d), facets=facets, intorder=interior.intorder,
                     disable_doflocs=True)
-    hats = FacetBasis(mesh, ElementTriP1(), facets=facets, quadrature=fb.quadrature,
+    hats = FacetBasis(mesh, HATS[d](), facets=facets, quadrature=fb.quadrature,
                       disable_doflocs=True)
     local = _local_facet(mesh, facets, fb.tind)
     rows = np.arange(facets.size)
     normal_trace = np.array([np.einsum("ifp,ifp->fp", np.asarray(b[0]), fb.normals)
-                             for b in fb.basis])            # (8, n_f, nq)
-    own = (k + 1) * local[None, :] + np.arange(k + 1)[:, None]         # (k + 1, n_f)
-    trace = normal_trace[own, rows[None, :]]                           # (k + 1, n_f, nq)
+                             for b in fb.basis])            # (n_rt, n_f, nq)
+    m = facet_dof_count(k, d)
+    own = m * local[None, :] + np.arange(m)[:, None]                   # (m, n_f)
+    trace = normal_trace[own, rows[None, :]]                           # (m, n_f, nq)
     gram = np.einsum("jfp,lfp,fp->fjl", trace, trace, fb.dx)
     x = np.asarray(fb.global_coordinates())
     t = part.traction(x)
@@ -114,11 +119,11 @@ def boundary_fluxes(interior: Interior, boundary: list[BoundaryData]) -> list[Fl
     return [boundary_flux(interior, part) for part in boundary if part.facets.size]
 
 
-def boundary_balance(n_vertices: int, fluxes: list[Flux]) -> np.ndarray:
-    """int psi_a t (n_vertices, 2) over the boundary."""
-    balance = np.zeros((n_vertices, 2))
+def boundary_balance(n_vertices: int, fluxes: list[Flux], dim: int = 2) -> np.ndarray:
+    """int psi_a t (n_vertices, dim) over the boundary."""
+    balance = np.zeros((n_vertices, dim))
     for flux in fluxes:
-        for v in (0, 1):
+        for v in range(flux.ends.shape[0]):
             np.add.at(balance, flux.ends[v], flux.integrals[:, v])
     return balance
 
@@ -129,31 +134,34 @@ def reconstruct(interior: Interior, fluxes: list[Flux],
     (n_vertices,) marks the vertices on Gamma_D (their patches have no balance condition)."""
     rt, k = interior.rt, interior.k
     mesh = rt.mesh
-    n_el, n_v = mesh.t.shape[1], mesh.p.shape[1]
-    patch = mesh.t.T.ravel()                     # pair p = 3 e + i
-    element = np.repeat(np.arange(n_el), 3)
+    (corners, n_el), n_v, d = mesh.t.shape, mesh.p.shape[1], mesh.dim()
+    patch = mesh.t.T.ravel()                     # pair p = (d + 1) e + i
+    element = np.repeat(np.arange(n_el), corners)
     dofs = rt.element_dofs.T[element]
-    n_rt, n_dg = interior.rhs.shape[-1], interior.data.shape[-1]
-    facet_of_dof = np.concatenate([np.repeat(np.arange(3), k + 1), np.full(k * (k + 1), -1)])
+    n_rt, n_dg, m = interior.rhs.shape[-1], interior.data.shape[-1], facet_dof_count(k, d)
+    facet_of_dof = np.concatenate([np.repeat(np.arange(corners), m),
+                                   np.full(n_rt - corners * m, -1)])
     status = np.full((patch.size, n_rt), FREE, dtype=np.int8)
-    status[facet_of_dof[None, :] == _OPPOSITE_FACET[np.tile(np.arange(3), n_el)][:, None]] = ZERO
-    fixed = np.zeros((patch.size, n_rt, 2))
+    status[facet_of_dof[None, :]
+           == OPPOSITE_FACET[d][np.tile(np.arange(corners), n_el)][:, None]] = ZERO
+    fixed = np.zeros((patch.size, n_rt, d))
     for flux in fluxes:
-        for v in (0, 1):
-            p = 3 * flux.elements + (mesh.t[:, flux.elements]
-                                     == flux.ends[v][None, :]).argmax(axis=0)
-            for j in range(k + 1):
-                status[p, (k + 1) * flux.local + j] = FIXED
-                fixed[p, (k + 1) * flux.local + j] = flux.values[:, v, :, j]
-    balance = boundary_balance(n_v, fluxes)
+        for v in range(d):
+            p = corners * flux.elements + (mesh.t[:, flux.elements]
+                                           == flux.ends[v][None, :]).argmax(axis=0)
+            for j in range(m):
+                status[p, m * flux.local + j] = FIXED
+                fixed[p, m * flux.local + j] = flux.values[:, v, :, j]
+    balance = boundary_balance(n_v, fluxes, d)
     pairs = PairMatrices(mass=interior.class_mass, divergence=interior.class_divergence,
                          element_class=interior.classes.of,
-                         rhs=interior.rhs.reshape(-1, 2, n_rt).transpose(0, 2, 1),
-                         data=interior.data.reshape(-1, 2, n_dg).transpose(0, 2, 1), fixed=fixed)
+                         rhs=interior.rhs.reshape(-1, d, n_rt).transpose(0, 2, 1),
+                         data=interior.data.reshape(-1, d, n_dg).transpose(0, 2, 1), fixed=fixed,
+                         corners=corners)
     lay = layout(patch, dofs, status, facet_holders(mesh, rt.element_dofs, k), n_v)
     free_values = solve_patches(lay, pairs, clamped)
-    sigma = np.zeros((2, rt.N))
-    for r in (0, 1):
+    sigma = np.zeros((d, rt.N))
+    for r in range(d):
         np.add.at(sigma[r], lay.key_dof, free_values[:, r])
         np.add.at(sigma[r], dofs[status == FIXED], fixed[..., r][status == FIXED])
     values = rt.values(sigma)
@@ -164,23 +172,23 @@ def reconstruct(interior: Interior, fluxes: list[Flux],
 
 
 def facet_holders(mesh, element_dofs: np.ndarray, k: int) -> np.ndarray:
-    """For every (pair p = 3 e + i, RT slot j) the flat index p' n_rt + j' of the entry that
+    """For every (pair p = (d + 1) e + i, RT slot j) the flat index p' n_rt + j' of the entry that
     represents the same unknown of patch mesh.t[i, e]: for a DOF on a facet, the entry of the
     facet's first element e' (scikit-fem's f2t[0]), which holds the same vertex at its corner
     i' and the same global DOF at the same position along the facet (the facet's DOFs are
     numbered by facet); interior DOFs represent themselves. Entries of a facet opposite the
     pair's vertex are never read (ZERO) and hold some index."""
     n_rt, n_el = element_dofs.shape
-    holder = np.arange(3 * n_el * n_rt, dtype=index_type(3 * n_el * n_rt)).reshape(3 * n_el, n_rt)
+    c, m = mesh.t.shape[0], facet_dof_count(k, mesh.dim())     # corners, DOFs per facet
+    holder = np.arange(c * n_el * n_rt, dtype=index_type(c * n_el * n_rt)).reshape(c * n_el, n_rt)
     elements = np.arange(n_el)
-    for f in range(3):
+    for f in range(c):
         facet = mesh.t2f[f]
         moved = np.flatnonzero(mesh.f2t[0, facet] != elements)
         first = mesh.f2t[0, facet[moved]]
         f0 = (mesh.t2f[:, first] == facet[moved][None, :]).argmax(axis=0)
-        for corner in range(3):
+        for corner in range(c):
             i0 = (mesh.t[:, first] == mesh.t[corner, moved][None, :]).argmax(axis=0)
-            for i in range(k + 1):
-                holder[3 * moved + corner, (k + 1) * f + i] = ((3 * first + i0) * n_rt
-                                                               + (k + 1) * f0 + i)
+            for i in range(m):
+                holder[c * moved + corner, m * f + i] = (c * first + i0) * n_rt + m * f0 + i
     return holder

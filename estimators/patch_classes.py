@@ -21,19 +21,20 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from estimators.rt_reference import orientations
+from estimators.rt_reference import facet_dof_count, orientations
 
 ELEMENT_TOLERANCE = 1e-12  # relative: equal up to the round-off of computing J from the mesh
 _SEED = 20261129
 
 
 def element_classes(mesh, k: int) -> np.ndarray:
-    """For every triangle the index of a triangle with the same RT_k mass and divergence
+    """For every element the index of an element with the same RT_k mass and divergence
     matrices: the same J'J / |det J| and facet orientations, all that
     ``estimators.rt_reference.element_matrices`` makes them of."""
-    mapping = mesh.mapping()
-    metric = np.einsum("ice,ide->ecd", mapping.A, mapping.A).reshape(-1, 4)
-    signs = orientations(mesh, 3 * (k + 1), k)[:, ::k + 1]
+    mapping, d = mesh.mapping(), mesh.dim()
+    metric = np.einsum("ice,ide->ecd", mapping.A, mapping.A).reshape(-1, d * d)
+    per_facet = facet_dof_count(k, d)
+    signs = orientations(mesh, (d + 1) * per_facet, k)[:, ::per_facet]
     return equal_rows([metric / np.abs(mapping.detA)[:, None], signs])
 
 

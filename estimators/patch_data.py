@@ -9,14 +9,20 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 import numpy as np
-from skfem import Basis, ElementDG, ElementTriP1, ElementTriP4, ElementVector
+from skfem import Basis, ElementDG, ElementTriP4, ElementVector
 from skfem.quadrature import get_quadrature
-from skfem.refdom import RefTri
 
-from estimators.averaging import element_areas
+from estimators.lagrange_tet import ElementTetDGP3
 from estimators.patch_classes import Classes, element_classes
-from estimators.rt_reference import ReferenceRT, element_matrices, patch_rhs, scalar_values
-from formulations.elasticity import ELEMENTS
+from estimators.rt_reference import (
+    HATS,
+    REFERENCE,
+    ReferenceRT,
+    element_matrices,
+    patch_rhs,
+    scalar_values,
+)
+from formulations.elasticity import ELEMENTS, scalar_elements
 from formulations.load import body_load
 from formulations.p1_stiffness import barycentric_gradients
 
@@ -25,13 +31,35 @@ from formulations.p1_stiffness import barycentric_gradients
 SCALARS = {**ELEMENTS, 4: ElementTriP4}
 
 
+def scalar_lagrange(degree: int, dim: int):
+    """The scalar Lagrange element of ``degree`` on triangles (to P4) or tetrahedra (to P3;
+    P3 discontinuous, ``estimators.lagrange_tet``)."""
+    elements = SCALARS if dim == 2 else {**scalar_elements(dim), 3: ElementTetDGP3}
+    if degree not in elements:
+        raise ValueError(f"degree={degree} has no Lagrange element on {dim}D simplices here "
+                         f"(allowed: {sorted(elements)})")
+    return elements[degree]()
+
+
+def simplex_gradients(mesh) -> tuple[np.ndarray, np.ndarray]:
+    """The gradients (d + 1, d, n_el) of the barycentric coordinates and the measures (n_el,)
+    of a triangle mesh (``formulations.p1_stiffness``, cached) or a tetrahedron mesh (the rows
+    of J^-1 are the gradients of the reference coordinates 1..d)."""
+    if mesh.dim() == 2:
+        return barycentric_gradients(mesh)
+    mapping = mesh.mapping()
+    inverse = mapping.invA
+    g = np.concatenate([-inverse.sum(axis=0, keepdims=True), inverse], axis=0)
+    return g, np.abs(mapping.detA) / 6
+
+
 @dataclass(frozen=True, eq=False)
 class Interior:
     """The element data of the patch problems (independent of the boundary data): the RT_k
-    basis, sigma_h at its quadrature points (2, 2, n_el, nq), the element matrices (one per
-    class of elements with equal ones), the pair right-hand sides rhs (n_el, 3, 2, n_rt) and
-    divergence data (n_el, 3, 2, n_dg), per vertex sum_T int_T (sigma_h grad psi_a - psi_a f)
-    (n_vertices, 2), and the degree k and the quadrature order used."""
+    basis, sigma_h at its quadrature points (d, d, n_el, nq), the element matrices (one per
+    class of elements with equal ones), the pair right-hand sides rhs (n_el, d + 1, d, n_rt)
+    and divergence data (n_el, d + 1, d, n_dg), per vertex sum_T int_T (sigma_h grad psi_a -
+    psi_a f) (n_vertices, d), and the degree k and the quadrature order used."""
 
     rt: ReferenceRT
     sigma_h: np.ndarray
@@ -46,19 +74,22 @@ class Interior:
 
 
 def interior_data(mesh, sigma_h, body_force, k: int, intorder: int) -> Interior:
-    """``sigma_h(basis)`` returns sigma(u_h) (2, 2, n_el, nq) at the quadrature points of a
-    basis; ``body_force`` f (2, ...) at points, or None; k the RT degree."""
+    """``sigma_h(basis)`` returns sigma(u_h) (d, d, n_el, nq) at the quadrature points of a
+    basis; ``body_force`` f (d, ...) at points, or None; k the RT degree. On tetrahedra
+    ``mesh`` lists every element's vertices in increasing order (``estimators.raviart_thomas_
+    tet.sorted_tetrahedra``)."""
     rt = ReferenceRT.build(mesh, k, intorder)
     X, W = rt.quadrature
-    dg = scalar_values(ELEMENTS[k](), X)
+    d = mesh.dim()
+    dg = scalar_values(scalar_lagrange(k, d), X)
     classes = Classes.of_owners(element_classes(mesh, k))  # few on refined meshes: each once
     mass, divergence = element_matrices(mesh, k, X, W, dg, classes.first)
     stress = sigma_h(rt)
-    rhs, data = patch_rhs(mesh, k, X, W, dg, stress, barycentric_gradients(mesh)[0])
+    rhs, data = patch_rhs(mesh, k, X, W, dg, stress, simplex_gradients(mesh)[0])
     if body_force is not None:
         data = data - load_moments(mesh, body_force, k)
     total = np.array([np.bincount(mesh.t.T.ravel(), data[:, :, r].sum(axis=-1).ravel(),
-                                  minlength=mesh.p.shape[1]) for r in (0, 1)]).T
+                                  minlength=mesh.p.shape[1]) for r in range(d)]).T
     return Interior(rt=rt, sigma_h=stress, classes=classes, class_mass=mass,
                     class_divergence=divergence, rhs=rhs,
                     data=data, total=total, k=k, intorder=intorder)
@@ -66,21 +97,22 @@ def interior_data(mesh, sigma_h, body_force, k: int, intorder: int) -> Interior:
 
 def load_moments(mesh, body_force, k: int) -> np.ndarray:
     """int_T f_r psi_a q_l per element, local vertex a, row r and P_k DG function q_l
-    (n_el, 3, 2, n_dg), with the load rule of ``formulations.load`` (refined where f is rough,
+    (n_el, d + 1, d, n_dg), with the load rule of ``formulations.load`` (refined where f is rough,
     as for the load vector of the discrete problem): psi_a q_l is P_(k+1), so these are
     combinations of the P_(k+1) DG load entries with its values at the P_(k+1) nodes."""
-    fine = SCALARS[k + 1]()
+    d = mesh.dim()
+    fine = scalar_lagrange(k + 1, d)
     basis = Basis(mesh, ElementVector(ElementDG(fine)), intorder=2 * k)
-    F = body_load(body_force, basis)[basis.element_dofs]                  # (2 n_fine, n_el)
-    per_node = F.reshape(-1, 2, mesh.t.shape[1])                           # node m, row r
+    F = body_load(body_force, basis)[basis.element_dofs]                  # (d n_fine, n_el)
+    per_node = F.reshape(-1, d, mesh.t.shape[1])                           # node m, row r
     nodes = fine.doflocs.T
-    hats, q = scalar_values(ElementTriP1(), nodes), scalar_values(ELEMENTS[k](), nodes)
+    hats, q = scalar_values(HATS[d](), nodes), scalar_values(scalar_lagrange(k, d), nodes)
     return np.einsum("mre,am,lm->earl", per_node, hats, q)
 
 
 @dataclass(frozen=True, eq=False)
 class BalancingLoad:
-    """rho = sum_a nodal_a psi_a (``nodal`` (n_vertices, 2)) and ||rho||_{0,T}^2 per element."""
+    """rho = sum_a nodal_a psi_a (``nodal`` (n_vertices, d)) and ||rho||_{0,T}^2 per element."""
 
     nodal: np.ndarray
     squares: np.ndarray
@@ -92,19 +124,24 @@ def rebalanced(interior: Interior, defect: np.ndarray,
     added, so that every patch balances, and rho (docs/theory.md, 13.2): sum_T int_T (data)
     then equals the boundary fluxes for every vertex."""
     mesh = interior.rt.mesh
-    area = element_areas(mesh)
-    weight = np.bincount(mesh.t.ravel(), np.tile(area / 3, 3), minlength=mesh.p.shape[1])
-    c = np.where(clamped[:, None], 0.0, defect / weight[:, None])      # (n_vertices, 2)
-    local = c[mesh.t]                                                  # (3, n_el, 2)
-    data = interior.data - np.einsum("ier,il,e->eirl", local, _hat_moments(interior.k), area)
-    norm2 = area / 12 * ((local**2).sum(axis=0) + local.sum(axis=0) ** 2).sum(axis=-1)
+    area = simplex_gradients(mesh)[1]
+    corners = mesh.t.shape[0]
+    weight = np.bincount(mesh.t.ravel(), np.tile(area / corners, corners),
+                         minlength=mesh.p.shape[1])
+    c = np.where(clamped[:, None], 0.0, defect / weight[:, None])      # (n_vertices, d)
+    local = c[mesh.t]                                                  # (d + 1, n_el, d)
+    data = interior.data - np.einsum("ier,il,e->eirl", local,
+                                     _hat_moments(interior.k, mesh.dim()), area)
+    # int_T (sum_i c_i lambda_i)^2 = |T| (sum c_i^2 + (sum c_i)^2) / ((d + 1)(d + 2))
+    norm2 = area / (corners * (corners + 1)) * ((local**2).sum(axis=0)
+                                                + local.sum(axis=0) ** 2).sum(axis=-1)
     total = interior.total - np.where(clamped[:, None], 0.0, defect)
     return replace(interior, data=data, total=total), BalancingLoad(c, norm2)
 
 
-def _hat_moments(k: int) -> np.ndarray:
-    """int_T lambda_i q_l / |T| for the barycentric lambda_i and the P_k DG basis q_l, (3, n_dg)
-    (the same on every triangle)."""
-    X, W = get_quadrature(RefTri, k + 1)
-    q, hats = scalar_values(ELEMENTS[k](), X), scalar_values(ElementTriP1(), X)
+def _hat_moments(k: int, dim: int) -> np.ndarray:
+    """int_T lambda_i q_l / |T| for the barycentric lambda_i and the P_k DG basis q_l,
+    (d + 1, n_dg) (the same on every simplex)."""
+    X, W = get_quadrature(REFERENCE[dim], k + 1)
+    q, hats = scalar_values(scalar_lagrange(k, dim), X), scalar_values(HATS[dim](), X)
     return np.einsum("ap,lp,p->al", hats, q, W) / W.sum()

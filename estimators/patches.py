@@ -3,8 +3,9 @@
 Every (element, local vertex) pair contributes its element's RT mass and divergence matrices
 to the patch of that vertex. A patch's unknowns are the RT DOFs of its elements that are
 neither on the facets opposite its vertex (zero flux) nor prescribed (Neumann and contact
-data), then per element the P_k DG multipliers of the divergence constraint; the two rows of
-the stress share the matrix and are its two right-hand sides. Patches of the same system size
+data), then per element the P_k DG multipliers of the divergence constraint; the rows of
+the stress (two on triangles, three on tetrahedra) share the matrix and are its right-hand
+sides. Patches of the same system size
 are stacked; a chunk of them is solved by one batched dense LU, or, where patches share their
 system (``estimators.patch_classes``), by the inverses of the chunk's distinct systems.
 """
@@ -104,8 +105,9 @@ def layout(patch: np.ndarray, dofs: np.ndarray, status: np.ndarray, holder: np.n
 class PairMatrices:
     """Per class of elements with equal matrices (``estimators.patch_classes``): ``mass``
     (n_classes, n_rt, n_rt) and ``divergence`` (n_classes, n_dg, n_rt), and ``element_class``
-    (n_el,) the class of each element (pair p belongs to element p // 3); per pair: ``rhs``
-    (P, n_rt, 2), ``data`` (P, n_dg, 2) and the prescribed values ``fixed`` (P, n_rt, 2)
+    (n_el,) the class of each element (pair p belongs to element p // corners, ``corners`` = 3
+    on triangles, 4 on tetrahedra); per pair, with one column per row of the stress (d):
+    ``rhs`` (P, n_rt, d), ``data`` (P, n_dg, d) and the prescribed values ``fixed`` (P, n_rt, d)
     (zero where not FIXED)."""
 
     mass: np.ndarray
@@ -114,26 +116,31 @@ class PairMatrices:
     rhs: np.ndarray
     data: np.ndarray
     fixed: np.ndarray
+    corners: int
+
+    def class_of(self, pairs: np.ndarray) -> np.ndarray:
+        """The class of the element of each pair."""
+        return self.element_class[pairs // self.corners]
 
 
 def solve_patches(lay: PatchLayout, pairs: PairMatrices, clamped: np.ndarray) -> np.ndarray:
-    """The FREE unknowns (n_keys, 2) of every patch problem
+    """The FREE unknowns (n_keys, d) of every patch problem
 
         [M  B'] [x]   [rhs ]
         [B  0 ] [y] = [data]   (minus the prescribed DOFs' share),
 
-    one system per patch with the two rows of the stress as right-hand sides. Off Gamma_D
+    one system per patch with the rows of the stress as right-hand sides. Off Gamma_D
     (``clamped`` False) the first multiplier is dropped: the data balance, so its equation
     follows from the others (docs/theory.md, 13.2). Patches with equal systems
     (``estimators.patch_classes``) share one factorisation."""
     rhs, data = pairs.rhs.copy(), pairs.data.copy()
     touched = np.flatnonzero((lay.status == FIXED).any(axis=1))  # pairs on Gamma_N, Gamma_C
-    fixed, element = pairs.fixed[touched], pairs.element_class[touched // 3]
+    fixed, element = pairs.fixed[touched], pairs.class_of(touched)
     rhs[touched] -= np.matmul(pairs.mass[element], fixed)
     data[touched] -= np.matmul(pairs.divergence[element], fixed)
     size = lay.n_free + lay.count * pairs.divergence.shape[1]
-    owner = _owners(lay, pairs.element_class, clamped, size)
-    out = np.zeros((lay.key_dof.size, 2))
+    owner = _owners(lay, pairs, clamped, size)
+    out = np.zeros((lay.key_dof.size, rhs.shape[-1]))
     jobs = []
     for n in np.unique(size):
         members = np.flatnonzero(size == n)
@@ -145,7 +152,7 @@ def solve_patches(lay: PatchLayout, pairs: PairMatrices, clamped: np.ndarray) ->
     return out
 
 
-def _owners(lay: PatchLayout, element_class: np.ndarray, clamped: np.ndarray,
+def _owners(lay: PatchLayout, pairs: PairMatrices, clamped: np.ndarray,
             size: np.ndarray) -> np.ndarray:
     """For every patch the first patch with the same system: equal size, element count and
     clamping, and per element rank the same element matrices (the same ``element_class``)
@@ -155,19 +162,20 @@ def _owners(lay: PatchLayout, element_class: np.ndarray, clamped: np.ndarray,
     rng = np.random.default_rng(HASH_SEED)
     weights = rng.integers(1, 2**61, size=n_rt + 1)
     by_rank = rng.integers(1, 2**61, size=int(lay.count.max(initial=1)))
-    pairs = lay.by_patch
+    ordered = lay.by_patch
     with np.errstate(over="ignore"):
-        pair_hash = ((element_class[pairs // 3] * weights[0]
-                      + lay.local[pairs].astype(np.int64) @ weights[1:]) * by_rank[lay.rank[pairs]])
+        pair_hash = ((pairs.class_of(ordered) * weights[0]
+                      + lay.local[ordered].astype(np.int64) @ weights[1:])
+                     * by_rank[lay.rank[ordered]])
         patch_hash = np.zeros(lay.count.size, dtype=np.int64)
         filled = lay.count > 0
         patch_hash[filled] = np.add.reduceat(pair_hash, lay.start[filled])
     keys = np.stack([size, lay.count, clamped.astype(np.int64), patch_hash], axis=1)
     owner = patch_classes(keys)
-    return np.where(_same_pairs(lay, element_class, owner), owner, np.arange(owner.size))
+    return np.where(_same_pairs(lay, pairs, owner), owner, np.arange(owner.size))
 
 
-def _same_pairs(lay: PatchLayout, element_class: np.ndarray, owner: np.ndarray) -> np.ndarray:
+def _same_pairs(lay: PatchLayout, pairs: PairMatrices, owner: np.ndarray) -> np.ndarray:
     """Whether each patch's pairs equal its ``owner``'s, rank by rank: element class and
     local positions (the hash of ``_owners`` grouped them; this rules out collisions)."""
     other = np.flatnonzero(owner != np.arange(owner.size))
@@ -175,7 +183,7 @@ def _same_pairs(lay: PatchLayout, element_class: np.ndarray, owner: np.ndarray) 
     if other.size == 0:
         return same
     mine, theirs = lay.pairs_of(other), lay.pairs_of(owner[other])   # equal counts: in the key
-    differs = ((element_class[mine // 3] != element_class[theirs // 3])
+    differs = ((pairs.class_of(mine) != pairs.class_of(theirs))
                | (lay.local[mine] != lay.local[theirs]).any(axis=1))
     patch = np.repeat(np.arange(other.size), lay.count[other])
     same[other] = np.bincount(patch, differs, minlength=other.size) == 0
@@ -229,7 +237,7 @@ def _systems(lay, chunk, n, pairs, clamped) -> np.ndarray:
     """The matrices (len(chunk), n, n) of the patches ``chunk``."""
     view = _ChunkPairs.of(lay, chunk, n, pairs.divergence.shape[1])
     entries = _Entries(chunk.size, n)
-    element = pairs.element_class[view.sel // 3]
+    element = pairs.class_of(view.sel)
     free = view.free
     entries.matrix(view.g, view.loc[:, :, None], view.loc[:, None, :], pairs.mass[element],
                    free[:, :, None] & free[:, None, :])
@@ -243,14 +251,15 @@ def _systems(lay, chunk, n, pairs, clamped) -> np.ndarray:
 
 
 def _right_hand_sides(lay, view, n, pairs, right, clamped) -> np.ndarray:
-    """The right-hand sides (patches, n, 2) of the chunk ``view``: each pair's multiplier
+    """The right-hand sides (patches, n, d) of the chunk ``view``: each pair's multiplier
     rows are its own; a FREE unknown on a facet is shared by the facet's two pairs."""
     rhs, data = right
-    b = np.zeros((view.size, n, 2))
+    d = rhs.shape[-1]
+    b = np.zeros((view.size, n, d))
     rows = view.div_at[:, None] + np.arange(pairs.divergence.shape[1])
     b[view.g[:, None], rows] = data[view.sel]
     at = (view.g[:, None] * n + view.loc)[view.free]
-    shared = np.bincount(np.concatenate([2 * at, 2 * at + 1]),
+    shared = np.bincount(np.concatenate([d * at + r for r in range(d)]),
                          rhs[view.sel][view.free].T.ravel(), minlength=b.size)
     b += shared.reshape(b.shape)
     k, d = view.dropped(lay, clamped)
