@@ -8,6 +8,7 @@ line here.
 from estimators import (  # noqa: F401  (register themselves)
     averaging,
     equilibrated,
+    equilibrated_3d,
     equilibrated_local,
     nitsche_residual,
     quad_residual,

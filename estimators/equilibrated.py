@@ -59,20 +59,22 @@ class NotEquilibrated(RuntimeError):
     """The discrete solution does not balance the auxiliary problem's hat functions."""
 
 
-def tresca_only_for(name: str):
+def tresca_only_for(name: str, solid: bool = False):
     """The ``applies`` check of estimator ``name``: Coulomb is refused (not a minimisation: no
-    bound, docs/theory.md 17.5); 3D too."""
+    bound, docs/theory.md 17.5); 3D too unless ``solid`` (a tetrahedral variant exists)."""
     def check(scene=None, **context) -> str | None:
         if scene is not None and scene.friction.kind == "coulomb":
             return (f"estimator '{name}' bounds the error under Tresca friction only "
                     f"(the scene's law is {scene.friction.label}: Coulomb's is not a "
                     "minimisation)")
+        if solid:
+            return None
         return planar_only(name, "the Raviart-Thomas patch equilibration is built on "
                                  "triangles")(scene=scene, **context)
     return check
 
 
-tresca_only = tresca_only_for("equilibrated")
+tresca_only = tresca_only_for("equilibrated", solid=True)
 
 
 @dataclass(frozen=True)
@@ -115,13 +117,22 @@ def estimate(scene, solution: DiscreteSolution) -> Estimate:
             raise NotEquilibrated(f"div tau misses r_2 by {jump.divergence_defect:.1e} "
                                   f"(relative) > {BALANCE_TOLERANCE:g}: no bound")
         compliance[jump.elements], skew[jump.elements] = jump.symmetric, jump.skew
+    parts, volume = volume_parts(compliance, skew, osc, load.squares, constants, mu)
+    return smallest(scene, solution, parts, volume, bounds, shear, "equilibrated")
+
+
+def volume_parts(compliance: np.ndarray, skew: np.ndarray, osc: np.ndarray,
+                 load_squares: np.ndarray, constants, mu: float) -> tuple[dict, np.ndarray]:
+    """The parts of A (``BoundTerms``' volume fields) and A_T^2 per element from the squares
+    per element of ||C^{-1/2}(sym sigma* - sigma_h)||, ||skw sigma*|| and ||rho||, and osc_T
+    (docs/theory.md, 13.2): A = S + C_K K + C_G osc + C_F ||rho||, C_G^2 = 1/(2 mu) + C_K^2."""
     grad_constant = np.sqrt(1 / (2 * mu) + constants.korn**2)
     volume = (np.sqrt(compliance) + constants.korn * np.sqrt(skew) + grad_constant * osc
-              + constants.friedrichs * np.sqrt(load.squares)) ** 2
+              + constants.friedrichs * np.sqrt(load_squares)) ** 2
     parts = dict(symmetric=np.sqrt(compliance.sum()), skew=constants.korn * np.sqrt(skew.sum()),
                  oscillation=grad_constant * np.sqrt((osc**2).sum()),
-                 load=constants.friedrichs * np.sqrt(load.squares.sum()))
-    return smallest(scene, solution, parts, volume, bounds, shear, "equilibrated")
+                 load=constants.friedrichs * np.sqrt(load_squares.sum()))
+    return parts, volume
 
 
 def stress_gap(rec, solution: DiscreteSolution):

@@ -164,7 +164,14 @@ def contact_bound(scene, solution, traction: ContactTraction, d: Extension | Str
     d_n = d.along(trace, trace.normal, t)
     lam = traction(t)
     slack = trace.integrate(np.maximum(lam, 0.0) * (discrete_gap(scene, solution, t) - d_n), w)
-    negative = trace.integrate(np.minimum(lam, 0.0) ** 2, w)
+    return bound_of(trace, lam, trace.integrate(np.minimum(lam, 0.0) ** 2, w), slack, d, energy)
+
+
+def bound_of(trace, lam: np.ndarray, negative: np.ndarray, slack: np.ndarray, d,
+             energy: np.ndarray) -> ContactBound:
+    """The ``ContactBound`` of lambda* at the quadrature points (``lam``, (n_f, nq)), with
+    ||lambda*_-||^2 (``negative``) and (lambda*_+, g - u_hn - d . n) (``slack``) per contact
+    facet, the extension ``d`` and a(d, d) per element."""
     n_el = trace.mesh.t.shape[1]
     return ContactBound(extension=float(np.sqrt(energy.sum())),
                         negative=float(np.sqrt(negative.sum())),

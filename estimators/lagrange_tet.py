@@ -19,9 +19,13 @@ _EXPONENTS = [(a, b, c) for a in range(4) for b in range(4 - a) for c in range(4
 
 def _monomials(X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The 20 monomials at X (3, ...) and their gradients (20, 3, ...)."""
+    ones = np.ones_like(X[0])
+    powers = [[ones, x, x * x, x * x * x] for x in X]       # powers[d][p] = X_d^p
+
     def power(e):
-        return np.prod([x**p if p >= 0 else 0.0 * x for x, p in zip(X, e, strict=True)],
-                       axis=0)
+        if min(e) < 0:
+            return 0.0 * ones
+        return powers[0][e[0]] * powers[1][e[1]] * powers[2][e[2]]
 
     values = np.array([power(e) for e in _EXPONENTS])
     grads = np.array([[e[d] * power(tuple(p - (i == d) for i, p in enumerate(e)))
@@ -41,8 +45,17 @@ class ElementTetDGP3(ElementH1):
     def __init__(self):
         values, _ = _monomials(self.doflocs.T)          # (monomial, point)
         self._coefficients = np.linalg.inv(values).T    # column i: basis function i
+        self._last = None
+
+    def _monomials_at(self, X: np.ndarray):
+        """``_monomials(X)``, kept for the next call: scikit-fem asks for the 20 functions one
+        by one at the same points."""
+        last = self._last
+        if last is None or last[0].shape != X.shape or not np.array_equal(last[0], X):
+            last = self._last = (X.copy(), _monomials(X))
+        return last[1]
 
     def lbasis(self, X, i):
-        values, grads = _monomials(np.asarray(X))
+        values, grads = self._monomials_at(np.asarray(X))
         c = self._coefficients[:, i]
         return np.tensordot(c, values, axes=(0, 0)), np.tensordot(c, grads, axes=(0, 0))

@@ -7,21 +7,23 @@ from __future__ import annotations
 import numpy as np
 from skfem import Basis, ElementDG, FacetBasis
 
-from estimators.averaging import element_areas
 from estimators.equilibration import BoundaryData
 from estimators.jump_equilibration import JumpOscillation
-from formulations.elasticity import ELEMENTS, element_diameters
+from estimators.patch_data import scalar_lagrange, simplex_gradients
+from formulations.elasticity import element_diameters
+from scenes.base import simplex_measures
 
 
 def oscillation(scene, rt: Basis, boundary: list[BoundaryData],
                 jump: JumpOscillation | None = None) -> np.ndarray:
     """Per element, (h_T / pi) ||f - Pi_k f||_T + sum_e C_e ||t - Pi_k t||_e over its facets
-    with Neumann data, C_e^2 = |e| h_T^2 / |T| (1/pi^2 + 1/pi) (docs/theory.md, 13.3); on the
-    elements of ``jump`` the sub-triangles' term of f instead (13.2, "Where f jumps")."""
-    mesh, k = rt.mesh, rt.elem.k
+    with Neumann data, C_e^2 = |e| h_T^2 / |T| (1/pi^2 + 2/(d pi)) in d dimensions
+    (docs/theory.md, 13.2); on the elements of ``jump`` the sub-triangles' term of f instead
+    (13.2, "Where f jumps")."""
+    mesh, k, d = rt.mesh, rt.elem.k, rt.mesh.dim()
     out = np.zeros(mesh.t.shape[1])
     if scene.body_force is not None:
-        dg = Basis(mesh, ElementDG(ELEMENTS[k]()), quadrature=rt.quadrature)
+        dg = Basis(mesh, ElementDG(scalar_lagrange(k, d)), quadrature=rt.quadrature)
         f = scene.body_force(np.asarray(rt.global_coordinates()))
         out += element_diameters(mesh) / np.pi * np.sqrt(projection_error(dg, f))
         if jump is not None:
@@ -29,21 +31,20 @@ def oscillation(scene, rt: Basis, boundary: list[BoundaryData],
     for part in boundary:
         if part.facets.size == 0:
             continue
-        fb = FacetBasis(mesh, ELEMENTS[k](), facets=part.facets, intorder=8,
+        fb = FacetBasis(mesh, scalar_lagrange(k, d), facets=part.facets, intorder=8,
                         disable_doflocs=True)   # a pass over every element saved
         t = part.traction(np.asarray(fb.global_coordinates()))
         err = projection_error(fb, t)
-        length = np.linalg.norm(mesh.p[:, mesh.facets[0, part.facets]]
-                                - mesh.p[:, mesh.facets[1, part.facets]], axis=0)
+        measure = simplex_measures(mesh.p[:, mesh.facets[:, part.facets]])
         element = fb.tind
-        c_e = np.sqrt(length * element_diameters(mesh)[element] ** 2
-                      / element_areas(mesh)[element] * (1 / np.pi**2 + 1 / np.pi))
+        c_e = np.sqrt(measure * element_diameters(mesh)[element] ** 2
+                      / simplex_gradients(mesh)[1][element] * (1 / np.pi**2 + 2 / (d * np.pi)))
         out += np.bincount(element, c_e * np.sqrt(err), mesh.t.shape[1])
     return out
 
 
 def projection_error(basis, values: np.ndarray) -> np.ndarray:
-    """||v - Pi v||^2 per element or facet of ``basis`` for v (2, n, nq), Pi the L2 projection
+    """||v - Pi v||^2 per element or facet of ``basis`` for v (d, n, nq), Pi the L2 projection
     onto the span of the basis's local functions (on a facet the P_k functions of the triangle
     span P_k(e) with repetitions: the pseudo-inverse of their Gram matrix)."""
     phi = np.array([np.asarray(b[0]) for b in basis.basis])           # (m, n, nq)

@@ -6,8 +6,9 @@ import pytest
 
 from bench.matrix.task import why_skipped
 from bench.measure.discretisation_error import exact_errors
-from estimators import estimator_names, get_estimator
+from estimators import estimator_names
 from estimators.averaging import compliance_energy
+from estimators.base import estimator_on
 from formulations import get_formulation, solve
 from formulations.elasticity import stress_tensor_from_gradient
 from scenes import get_scene
@@ -15,9 +16,11 @@ from scenes import get_scene
 SCENE = get_scene("free-boundary-3d")
 # measured on these levels (vi, P1 and P2, 300 .. 13 872 DOFs): residual 4.8 .. 7.2 (its
 # constants are not computed), averaging 0.72 .. 0.84 (a recovery, asymptotically exact where
-# the stress is smooth), nitsche-residual as residual; the bands are a factor ~2 around them
+# the stress is smooth), nitsche-residual as residual; the bands are a factor ~2 around them.
+# equilibrated is a guaranteed bound: above 1 is its claim; its ceiling a factor ~2 above the
+# measured 5.2 .. 10.1 (docs/theory.md, 14.5)
 EFFECTIVITY = {"residual": (2.5, 15.0), "nitsche-residual": (2.5, 15.0),
-               "averaging": (0.4, 1.6)}
+               "averaging": (0.4, 1.6), "equilibrated": (1.0, 20.0)}
 
 
 def test_3d_compliance_energy_inverts_the_elasticity_tensor():
@@ -38,7 +41,7 @@ def test_every_3d_estimator_has_a_bounded_effectivity(estimator, order):
     for refinements in (0, 1):
         sol = solve(get_formulation(formulation)(SCENE, SCENE.mesh.refined(refinements),
                                                  order=order), "active-set")
-        estimate = get_estimator(estimator)(SCENE, sol)
+        estimate = estimator_on(estimator, "tet")(SCENE, sol)
         assert estimate.indicators.shape == (sol.elasticity.mesh.t.shape[1],)
         assert estimate.eta**2 == pytest.approx(estimate.indicators.sum(), rel=1e-10)
         ratio = estimate.eta / exact_errors(SCENE, sol).energy_error

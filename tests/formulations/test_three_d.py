@@ -86,11 +86,12 @@ def test_3d_formulations_agree_with_the_reference_solver(formulation, order):
     assert fast.contact_force() > 0
 
 
-def test_p3_and_equilibrated_are_skipped_in_3d_with_their_reasons():
+def test_p3_and_equilibrated_local_are_skipped_in_3d_with_their_reasons():
     scene = get_scene("free-boundary-3d")
     assert why_skipped(scene, "mixed", "active-set", "residual") is None
     assert "tetrahedra" in why_skipped(scene, "vi", "active-set", "residual", order=3)
-    assert "triangles only" in why_skipped(scene, "vi", "active-set", "equilibrated")
+    assert "triangles only" in why_skipped(scene, "vi", "active-set", "equilibrated-local")
+    assert why_skipped(scene, "vi", "active-set", "equilibrated") is None  # its tet variant
     assert why_skipped(scene, "vi", "active-set", "residual") is None
 
 

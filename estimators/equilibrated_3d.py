@@ -1,0 +1,94 @@
+"""``equilibrated`` on tetrahedra (docs/theory.md, section 14.5, "`equilibrated` on
+tetrahedra"): the bound of 13.1 with the stress of 13.2 built on tetrahedral vertex patches.
+
+sigma* has rows in RT_k on the tetrahedra (``estimators.raviart_thomas_tet``; the mesh with
+each element's vertices sorted, which keeps its facets and their numbering), from the same
+batched patch problems as on triangles (``estimators.equilibration``), with Neumann data q and
+-lambda* n on the contact triangles (``estimators.guaranteed_contact_3d``). It is not
+symmetrised: A = ||C^{-1/2}(sym sigma* - sigma_h)|| + C_K ||skw sigma*|| + C_G osc + C_F
+||rho||, with the constants of ``estimators.constants`` on the 3D domain and the oscillation
+of ``estimators.oscillation``. Frictionless contact only.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from estimators.averaging import compliance_energy
+from estimators.base import Estimate, register_cell_variant
+from estimators.constants import domain_constants
+from estimators.equilibrated import (
+    BALANCE_TOLERANCE,
+    NotEquilibrated,
+    smallest,
+    volume_parts,
+)
+from estimators.equilibration import (
+    BoundaryData,
+    boundary_balance,
+    boundary_fluxes,
+    reconstruct,
+)
+from estimators.guaranteed_contact import ContactBounds
+from estimators.guaranteed_contact_3d import surface_traction
+from estimators.oscillation import oscillation
+from estimators.patch_data import interior_data, rebalanced
+from estimators.raviart_thomas_tet import sorted_tetrahedra
+from estimators.residual_3d import stress_at
+from formulations import DiscreteSolution
+
+# exact for the squares of RT_k and of sigma_h, with positive weights (scikit-fem's tetrahedron
+# rules of degree 3, 4 and 8 have a negative one: a norm could come out negative)
+INTORDER = {1: 5, 2: 6}
+
+
+@register_cell_variant("equilibrated", "tet")
+def estimate(scene, solution: DiscreteSolution) -> Estimate:
+    rec, interior, load, bound, boundary = equilibrate(scene, solution)
+    lam, mu = solution.elasticity.lame
+    constants = domain_constants(scene)  # on the 3D domain (docs/theory.md, 13.4)
+    diff = rec.values - interior.sigma_h
+    sym = 0.5 * (diff + diff.transpose(1, 0, 2, 3))
+    compliance = (compliance_energy(sym.reshape(9, *sym.shape[2:]), lam, mu)
+                  * rec.basis.dx).sum(axis=1)
+    skew = ((0.5 * (rec.values - rec.values.transpose(1, 0, 2, 3))) ** 2).sum(axis=(0, 1))
+    skew = (skew * rec.basis.dx).sum(axis=1)
+    osc = oscillation(scene, rec.basis, boundary)
+    parts, volume = volume_parts(compliance, skew, osc, load.squares, constants, mu)
+    bounds = ContactBounds(marking=(bound,), sharp=(bound,))
+    return smallest(scene, solution, parts, volume, bounds, None, "equilibrated")
+
+
+def equilibrate(scene, solution: DiscreteSolution):
+    """sigma* (a ``Reconstruction`` on the sorted mesh), the patch data, rho, the contact terms
+    of lambda* and the Neumann data of the auxiliary problem (docs/theory.md, 13.2, 14.5)."""
+    elasticity = solution.elasticity
+    mesh, order = sorted_tetrahedra(elasticity.mesh), elasticity.order
+    if not np.array_equal(mesh.facets, elasticity.mesh.facets):
+        raise NotEquilibrated("sorting the tetrahedra renumbered the facets: no bound")
+    n_v = mesh.p.shape[1]
+
+    def stress(rt):
+        x = np.asarray(rt.global_coordinates())                         # (3, n_el, nq)
+        cells = np.repeat(np.arange(x.shape[1]), x.shape[2])
+        return stress_at(solution, x.reshape(3, -1), cells).reshape(3, 3, *x.shape[1:])
+
+    clamped = np.zeros(n_v, dtype=bool)
+    clamped[mesh.facets[:, scene.dirichlet_facets(mesh)].ravel()] = True
+    interior = interior_data(mesh, stress, scene.body_force, order, INTORDER[order])
+    neumann = BoundaryData(scene.neumann_facets(mesh), scene.traction or (lambda x: 0.0 * x))
+    neumann_flux = boundary_fluxes(interior, [neumann])
+    reaction = interior.total - boundary_balance(n_v, neumann_flux, 3)
+    trace = solution.trace
+    lam_star, bound = surface_traction(scene, solution, interior, reaction, clamped,
+                                       domain_constants(scene).trace)
+    contact = BoundaryData(trace.facets, lambda x: -lam_star.at(trace, x)[None]
+                           * trace.normal[:, :, None])
+    fluxes = neumann_flux + boundary_fluxes(interior, [contact])
+    interior, load = rebalanced(interior, interior.total - boundary_balance(n_v, fluxes, 3),
+                                clamped)
+    rec = reconstruct(interior, fluxes, clamped)
+    if rec.imbalance > BALANCE_TOLERANCE:
+        raise NotEquilibrated(f"the patch data do not balance (relative imbalance "
+                              f"{rec.imbalance:.1e} > {BALANCE_TOLERANCE:g}): no bound")
+    return rec, interior, load, bound, [neumann, contact]
