@@ -35,6 +35,7 @@ from estimators.oscillation import oscillation
 from estimators.patch_data import interior_data, rebalanced
 from estimators.raviart_thomas_tet import sorted_tetrahedra
 from estimators.residual_3d import stress_at
+from estimators.symmetrisation_3d import symmetrised
 from formulations import DiscreteSolution
 
 # exact for the squares of RT_k and of sigma_h, with positive weights (scikit-fem's tetrahedron
@@ -91,4 +92,6 @@ def equilibrate(scene, solution: DiscreteSolution):
     if rec.imbalance > BALANCE_TOLERANCE:
         raise NotEquilibrated(f"the patch data do not balance (relative imbalance "
                               f"{rec.imbalance:.1e} > {BALANCE_TOLERANCE:g}): no bound")
+    prescribed = np.concatenate([neumann.facets, contact.facets])
+    rec = symmetrised(rec, interior, prescribed, elasticity.lame, domain_constants(scene).korn)
     return rec, interior, load, bound, [neumann, contact]

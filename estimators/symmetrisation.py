@@ -218,16 +218,17 @@ def curl_values(rt: ReferenceRT, phi: np.ndarray) -> np.ndarray:
 
 
 def rt_dofs(rt: ReferenceRT, interior: Interior, values: np.ndarray) -> np.ndarray:
-    """The RT_k DOFs (2, N) of fields (2, 2, n_el, nq) that lie in RT_k row by row: the
+    """The RT_k DOFs (d, N) of fields (d, d, n_el, nq) that lie in RT_k row by row: the
     element-wise L2 projection with ``interior``'s mass matrices, one inverse per class of
     elements, exact for such fields (neighbours agree on a shared facet's DOFs to round-off)."""
     X, W = rt.quadrature
+    d = values.shape[0]
     moments = rt_moments(rt.mesh, rt.elem.k, X, W, values, np.ones((1, W.size)))[:, 0]
     classes = interior.classes
-    local = np.empty((moments.shape[0], moments.shape[2], 2))         # (n_el, n_rt, 2)
+    local = np.empty((moments.shape[0], moments.shape[2], d))         # (n_el, n_rt, d)
     local[classes.order] = classes.products(np.linalg.inv(interior.class_mass),
                                             moments[classes.order].transpose(0, 2, 1))
-    out = np.zeros((2, rt.N))
+    out = np.zeros((d, rt.N))
     out[:, rt.element_dofs.T] = local.transpose(2, 0, 1)
     return out
 

@@ -112,3 +112,89 @@ def folder_bytes(folder) -> dict:
 
     return {str(p.relative_to(folder)): p.read_bytes() for p in sorted(Path(folder).rglob("*"))
             if p.is_file() and p.name != ".lock"}
+
+
+# ---- linear elasticity on the unit cube, solved by scikit-fem alone (tetrahedral patch tests)
+
+CUBE_LAME = (1.0, 1.0)
+CUBE_STRAIN = np.array([[0.3, 0.1, -0.2], [0.05, -0.1, 0.2], [0.1, 0.3, 0.15]])  # u = G x
+
+
+def cube_problem(n, order, body_force, traction):
+    """P_order elasticity on the unit cube (x = 0 clamped at u = CUBE_STRAIN x, t on the other
+    faces), solved by scikit-fem alone, on a mesh whose tetrahedra list their vertices in
+    random order; the sorted mesh's patch data (``estimators.patch_data``), the boundary flux,
+    the clamped vertices, the free faces and rho."""
+    from skfem import (
+        Basis,
+        ElementTetP1,
+        ElementTetP2,
+        ElementVector,
+        FacetBasis,
+        LinearForm,
+        MeshTet,
+        asm,
+        condense,
+        solve,
+    )
+    from skfem.helpers import dot
+    from skfem.models.elasticity import linear_elasticity
+
+    from estimators.equilibrated_3d import INTORDER
+    from estimators.equilibration import BoundaryData, boundary_balance, boundary_fluxes
+    from estimators.patch_data import interior_data, rebalanced
+    from estimators.raviart_thomas_tet import sorted_tetrahedra
+    from formulations.elasticity import stress_tensor_from_gradient
+    from formulations.evaluation import gradients_at
+
+    cube = MeshTet.init_tensor(*[np.linspace(0, 1, n + 1)] * 3)
+    rng = np.random.default_rng(3)
+    mesh = MeshTet(cube.p, np.ascontiguousarray(
+        np.array([rng.permutation(c) for c in cube.t.T]).T))
+    basis = Basis(mesh, ElementVector(ElementTetP1() if order == 1 else ElementTetP2()))
+
+    def clamped_side(x):
+        return x[0] < 1e-12
+
+    def free_sides(m):
+        return np.setdiff1d(m.boundary_facets(),
+                            m.facets_satisfying(clamped_side, boundaries_only=True))
+
+    @LinearForm
+    def load(v, w):
+        return dot(body_force(np.asarray(w.x)), v)
+
+    @LinearForm
+    def surface(v, w):
+        return dot(traction(np.asarray(w.x)), v)
+
+    F = asm(load, basis) + asm(surface, FacetBasis(mesh, basis.elem, facets=free_sides(mesh)))
+    fixed = basis.get_dofs(mesh.facets_satisfying(clamped_side, boundaries_only=True)).all()
+    exact = (CUBE_STRAIN @ basis.doflocs)[np.arange(basis.N) % 3, np.arange(basis.N)]
+    u = solve(*condense(asm(linear_elasticity(*CUBE_LAME), basis), F, x=exact, D=fixed))
+
+    def sigma_h(rt):
+        x = np.asarray(rt.global_coordinates())
+        cells = np.repeat(np.arange(mesh.t.shape[1]), x.shape[2])
+        grad = gradients_at(basis, u, x.reshape(3, -1), cells)
+        return stress_tensor_from_gradient(grad, *CUBE_LAME).reshape(3, 3, *x.shape[1:])
+
+    sorted_mesh = sorted_tetrahedra(mesh)
+    interior = interior_data(sorted_mesh, sigma_h, body_force, order, INTORDER[order])
+    facets = free_sides(sorted_mesh)
+    clamped = np.zeros(sorted_mesh.p.shape[1], dtype=bool)
+    clamped[sorted_mesh.facets[:, sorted_mesh.facets_satisfying(
+        clamped_side, boundaries_only=True)].ravel()] = True
+    fluxes = boundary_fluxes(interior, [BoundaryData(facets, traction)])
+    balance = boundary_balance(sorted_mesh.p.shape[1], fluxes, 3)
+    interior, rho = rebalanced(interior, interior.total - balance, clamped)
+    return interior, fluxes, clamped, facets, rho
+
+
+def faces_normal(x):
+    """The outer normal of the unit cube at points x (3, ...) on its faces."""
+    n = np.zeros_like(x)
+    for i in range(3):
+        n[i][np.abs(x[i] - 1) < 1e-12] = 1.0
+        n[i][np.abs(x[i]) < 1e-12] = -1.0
+    return n

@@ -4,33 +4,12 @@ elements), and on tetrahedra the stress itself."""
 
 import numpy as np
 import pytest
-from skfem import (
-    Basis,
-    ElementTetP1,
-    ElementTetP2,
-    ElementVector,
-    FacetBasis,
-    LinearForm,
-    MeshTet,
-    asm,
-    condense,
-    solve,
-)
-from skfem.helpers import dot
-from skfem.models.elasticity import linear_elasticity
+from skfem import FacetBasis
 
-from estimators.equilibration import (
-    BoundaryData,
-    boundary_balance,
-    boundary_fluxes,
-    facet_holders,
-    reconstruct,
-)
-from estimators.patch_data import interior_data, rebalanced
-from estimators.raviart_thomas_tet import ElementTetRTk, sorted_tetrahedra
+from conftest import CUBE_LAME, CUBE_STRAIN, cube_problem, faces_normal
+from estimators.equilibration import facet_holders, reconstruct
+from estimators.raviart_thomas_tet import ElementTetRTk
 from estimators.rt_reference import OPPOSITE_FACET, ReferenceRT
-from formulations.elasticity import stress_tensor_from_gradient
-from formulations.evaluation import gradients_at
 from scenes import get_scene
 
 
@@ -67,76 +46,13 @@ def test_every_read_holder_holds_the_same_dof_and_vertex_in_the_facets_first_ele
     assert np.array_equal(holder[inside], (pair * n_rt + slot)[inside])
 
 
-# ---- tetrahedra: the same patch problems on a sorted tetrahedral mesh ----
-
-LAME = (1.0, 1.0)
-STRAIN = np.array([[0.3, 0.1, -0.2], [0.05, -0.1, 0.2], [0.1, 0.3, 0.15]])  # an affine u = G x
-
-
-def _cube_problem(n, order, body_force, traction):
-    """P_order elasticity on the unit cube (x = 0 clamped, t on the other faces), solved by
-    scikit-fem alone, on a mesh whose tetrahedra list their vertices in random order; the
-    sorted mesh's patch data, boundary flux and clamped vertices."""
-    cube = MeshTet.init_tensor(*[np.linspace(0, 1, n + 1)] * 3)
-    rng = np.random.default_rng(3)
-    mesh = MeshTet(cube.p, np.ascontiguousarray(
-        np.array([rng.permutation(c) for c in cube.t.T]).T))
-    basis = Basis(mesh, ElementVector(ElementTetP1() if order == 1 else ElementTetP2()))
-
-    def clamped_side(x):
-        return x[0] < 1e-12
-
-    def free_sides(m):
-        return np.setdiff1d(m.boundary_facets(),
-                            m.facets_satisfying(clamped_side, boundaries_only=True))
-
-    @LinearForm
-    def load(v, w):
-        x = np.asarray(w.x)
-        return dot(body_force(x), v)
-
-    @LinearForm
-    def surface(v, w):
-        return dot(traction(np.asarray(w.x)), v)
-
-    F = asm(load, basis) + asm(surface, FacetBasis(mesh, basis.elem, facets=free_sides(mesh)))
-    fixed = basis.get_dofs(mesh.facets_satisfying(clamped_side, boundaries_only=True)).all()
-    exact = (STRAIN @ basis.doflocs)[np.arange(basis.N) % 3, np.arange(basis.N)]
-    u = solve(*condense(asm(linear_elasticity(*LAME), basis), F, x=exact, D=fixed))
-
-    def sigma_h(rt):
-        x = np.asarray(rt.global_coordinates())
-        cells = np.repeat(np.arange(mesh.t.shape[1]), x.shape[2])
-        grad = gradients_at(basis, u, x.reshape(3, -1), cells)
-        return stress_tensor_from_gradient(grad, *LAME).reshape(3, 3, *x.shape[1:])
-
-    sorted_mesh = sorted_tetrahedra(mesh)
-    interior = interior_data(sorted_mesh, sigma_h, body_force, order, 2 * order + 2)
-    facets = free_sides(sorted_mesh)
-    clamped = np.zeros(sorted_mesh.p.shape[1], dtype=bool)
-    clamped[sorted_mesh.facets[:, sorted_mesh.facets_satisfying(
-        clamped_side, boundaries_only=True)].ravel()] = True
-    fluxes = boundary_fluxes(interior, [BoundaryData(facets, traction)])
-    balance = boundary_balance(sorted_mesh.p.shape[1], fluxes, 3)
-    interior, rho = rebalanced(interior, interior.total - balance, clamped)
-    return interior, fluxes, clamped, facets, rho
-
-
-def _faces_normal(x):
-    """The outer normal of the unit cube at points x (3, ...) on its faces."""
-    n = np.zeros_like(x)
-    for i in range(3):
-        n[i][np.abs(x[i] - 1) < 1e-12] = 1.0
-        n[i][np.abs(x[i]) < 1e-12] = -1.0
-    return n
-
-
 def test_tetrahedra_reproduce_an_affine_stress():
     """u = G x is the P1 solution (no load, t = S n): every patch's minimiser is psi_a S, so
     sigma* = S exactly (round-off: 1e-12 relative)."""
-    stress = LAME[1] * (STRAIN + STRAIN.T) + LAME[0] * np.trace(STRAIN) * np.eye(3)
-    interior, fluxes, clamped, _, rho = _cube_problem(
-        3, 1, lambda x: 0.0 * x, lambda x: np.einsum("ij,j...->i...", stress, _faces_normal(x)))
+    lam, mu = CUBE_LAME
+    stress = mu * (CUBE_STRAIN + CUBE_STRAIN.T) + lam * np.trace(CUBE_STRAIN) * np.eye(3)
+    interior, fluxes, clamped, _, rho = cube_problem(
+        3, 1, lambda x: 0.0 * x, lambda x: np.einsum("ij,j...->i...", stress, faces_normal(x)))
     np.testing.assert_allclose(interior.sigma_h[..., 0, 0], stress, atol=1e-12)
     assert np.abs(rho.nodal).max() < 1e-12   # u_h balances every patch
     rec = reconstruct(interior, fluxes, clamped)
@@ -157,7 +73,7 @@ def test_tetrahedra_equilibrate_the_load_and_the_tractions(order):
     def traction(x):
         return np.array([x[1], 0.2 + 0.0 * x[0], x[0] - x[2]])
 
-    interior, fluxes, clamped, facets, rho = _cube_problem(2, order, body_force, traction)
+    interior, fluxes, clamped, facets, rho = cube_problem(2, order, body_force, traction)
     rec = reconstruct(interior, fluxes, clamped)
     assert rec.imbalance < 1e-10
     basis = interior.rt.basis()
