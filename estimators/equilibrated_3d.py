@@ -45,7 +45,7 @@ INTORDER = {1: 5, 2: 6}
 
 @register_cell_variant("equilibrated", "tet")
 def estimate(scene, solution: DiscreteSolution) -> Estimate:
-    rec, interior, load, bound, boundary = equilibrate(scene, solution)
+    rec, interior, load, bounds, boundary = equilibrate(scene, solution)
     lam, mu = solution.elasticity.lame
     constants = domain_constants(scene)  # on the 3D domain (docs/theory.md, 13.4)
     diff = rec.values - interior.sigma_h
@@ -56,13 +56,14 @@ def estimate(scene, solution: DiscreteSolution) -> Estimate:
     skew = (skew * rec.basis.dx).sum(axis=1)
     osc = oscillation(scene, rec.basis, boundary)
     parts, volume = volume_parts(compliance, skew, osc, load.squares, constants, mu)
-    bounds = ContactBounds(marking=(bound,), sharp=(bound,))
-    return smallest(scene, solution, parts, volume, bounds, None, "equilibrated")
+    return smallest(scene, solution, parts, volume, ContactBounds(marking=bounds, sharp=bounds),
+                    None, "equilibrated")
 
 
 def equilibrate(scene, solution: DiscreteSolution):
     """sigma* (a ``Reconstruction`` on the sorted mesh), the patch data, rho, the contact terms
-    of lambda* and the Neumann data of the auxiliary problem (docs/theory.md, 13.2, 14.5)."""
+    of lambda* with every extension d and the Neumann data of the auxiliary problem
+    (docs/theory.md, 13.2, 14.5)."""
     elasticity = solution.elasticity
     mesh, order = sorted_tetrahedra(elasticity.mesh), elasticity.order
     if not np.array_equal(mesh.facets, elasticity.mesh.facets):
@@ -81,8 +82,8 @@ def equilibrate(scene, solution: DiscreteSolution):
     neumann_flux = boundary_fluxes(interior, [neumann])
     reaction = interior.total - boundary_balance(n_v, neumann_flux, 3)
     trace = solution.trace
-    lam_star, bound = surface_traction(scene, solution, interior, reaction, clamped,
-                                       domain_constants(scene).trace)
+    lam_star, bounds = surface_traction(scene, solution, interior, reaction, clamped,
+                                        domain_constants(scene).trace)
     contact = BoundaryData(trace.facets, lambda x: -lam_star.at(trace, x)[None]
                            * trace.normal[:, :, None])
     fluxes = neumann_flux + boundary_fluxes(interior, [contact])
@@ -94,4 +95,4 @@ def equilibrate(scene, solution: DiscreteSolution):
                               f"{rec.imbalance:.1e} > {BALANCE_TOLERANCE:g}): no bound")
     prescribed = np.concatenate([neumann.facets, contact.facets])
     rec = symmetrised(rec, interior, prescribed, elasticity.lame, domain_constants(scene).korn)
-    return rec, interior, load, bound, [neumann, contact]
+    return rec, interior, load, bounds, [neumann, contact]

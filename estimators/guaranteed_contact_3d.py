@@ -6,10 +6,10 @@
   on the contact vertices off Gamma_D (M the P1 mass matrix of Gamma_C, R the vertex reactions
   of u_h left by the pressure, nu the vertex normals), so that u_h balances every contact
   patch in the normal direction; of the two, the one with the smaller contact terms
-  2 D + C_T ||lambda*_-|| + sqrt(B) (as ``estimators.auxiliary_traction`` does on segments).
-* d = sum_a c_a psi_a nu_a, c_a the largest value with c_a (nu_a . n_e) <= min w over every
-  contact triangle e at a (w = (g - u_hn)_- sampled on a lattice), so d . n, a convex
-  combination of its vertex values on a triangle, stays below min w there; c_a = 0 on Gamma_D.
+  2 D + C_T ||lambda*_-|| + sqrt(B) over the extensions (as ``estimators.auxiliary_traction``
+  does on segments).
+* the extensions d of ``estimators.contact_extension_3d``: with each the terms D, ||lambda*_-||
+  and B (13.1).
 """
 
 from __future__ import annotations
@@ -21,28 +21,20 @@ from scipy import sparse
 from scipy.sparse.linalg import spsolve
 
 from estimators.contact_extension import discrete_gap
+from estimators.contact_extension_3d import (
+    EXTENSIONS_3D,
+    SurfaceExtension,
+    corner_weights,
+    vertex_normals,
+)
 from estimators.equilibration import BoundaryData, boundary_balance, boundary_fluxes
 from estimators.guaranteed_contact import ContactBound, bound_of
-from estimators.patch_data import simplex_gradients
 from formulations.contact_surface import triangle_rule
-from formulations.elasticity import stress_tensor_from_gradient
 
 QUADRATURE_DEGREE = 8  # the rule on each contact triangle for lambda*_+ and the slack (kinked)
 PROJECTION_DEGREE = 8  # the rule for projecting lambda_h onto P1 per triangle
-SAMPLE_DIVISIONS = 8   # d . n <= w is imposed on this lattice per contact triangle
 # the P1 mass matrix of a triangle of area 1, in its corners' order
 _MASS = (np.ones((3, 3)) + np.eye(3)) / 12.0
-
-
-def lattice(divisions: int) -> np.ndarray:
-    """The points (i, j) / m, i + j <= m, of the reference triangle, (2, n)."""
-    return np.array([(i / divisions, j / divisions) for i in range(divisions + 1)
-                     for j in range(divisions + 1 - i)]).T
-
-
-def corner_weights(t: np.ndarray) -> np.ndarray:
-    """The P1 basis (3, nq) of the reference triangle at local coordinates t (2, nq)."""
-    return np.array([1.0 - t[0] - t[1], t[0], t[1]])
 
 
 @dataclass(frozen=True, eq=False)
@@ -66,17 +58,6 @@ class SurfaceTraction:
         t0, t1 = (g22 * r1 - g12 * r2) / det, (g11 * r2 - g12 * r1) / det
         return (self.corners[0][:, None] * (1 - t0 - t1) + self.corners[1][:, None] * t0
                 + self.corners[2][:, None] * t1)
-
-
-def vertex_normals(surface) -> np.ndarray:
-    """Area-weighted mean outer normals at the contact vertices, unit (3, n_vertices)."""
-    n_v = surface.mesh.p.shape[1]
-    nu = np.zeros((3, n_v))
-    for v in surface.vertices:
-        for i in range(3):
-            nu[i] += np.bincount(v, surface.normal[i] * surface.measure, minlength=n_v)
-    norm = np.linalg.norm(nu, axis=0)
-    return nu / np.where(norm > 0, norm, 1.0)
 
 
 def surface_mass(surface) -> sparse.csr_matrix:
@@ -115,40 +96,7 @@ def balanced(surface, traction: SurfaceTraction, defect: np.ndarray,
     return SurfaceTraction(traction.corners + delta[surface.vertices])
 
 
-@dataclass(frozen=True, eq=False)
-class VertexExtension:
-    """d = sum_a nodal[:, a] psi_a, continuous P1 on the tetrahedra."""
-
-    nodal: np.ndarray   # (3, n_vertices)
-
-    def normal_part(self, surface, t: np.ndarray) -> np.ndarray:
-        """d . n (n_f, nq) at local coordinates t of the contact triangles."""
-        corner = np.array([np.einsum("if,if->f", self.nodal[:, v], surface.normal)
-                           for v in surface.vertices])                # (3, n_f)
-        return corner.T @ corner_weights(t)
-
-    def energy(self, mesh, lame: tuple[float, float]) -> np.ndarray:
-        """a(d, d) per element."""
-        gradients, volume = simplex_gradients(mesh)                   # (4, 3, n_el)
-        grad = np.einsum("iae,ake->ike", self.nodal[:, mesh.t], gradients)
-        sigma = stress_tensor_from_gradient(grad, *lame)
-        return volume * np.einsum("ije,ije->e", sigma, grad)
-
-
-def vertex_extension(scene, solution, clamped: np.ndarray) -> VertexExtension:
-    """The floor of the module docstring."""
-    surface = solution.trace
-    w = np.minimum(discrete_gap(scene, solution, lattice(SAMPLE_DIVISIONS)), 0.0)
-    floor = w.min(axis=1)                                             # (n_f,)
-    nu = vertex_normals(surface)
-    c = np.zeros(surface.mesh.p.shape[1])
-    for v in surface.vertices:
-        np.minimum.at(c, v, floor / np.einsum("if,if->f", nu[:, v], surface.normal))
-    c[clamped] = 0.0  # d must vanish on Gamma_D
-    return VertexExtension(c * nu)
-
-
-def surface_bound(scene, solution, traction: SurfaceTraction, d: VertexExtension,
+def surface_bound(scene, solution, traction: SurfaceTraction, d: SurfaceExtension,
                   energy: np.ndarray) -> ContactBound:
     """D, ||lambda*_-|| and B (docs/theory.md, 13.1) of lambda* = ``traction`` and ``d``."""
     surface = solution.trace
@@ -161,20 +109,22 @@ def surface_bound(scene, solution, traction: SurfaceTraction, d: VertexExtension
 
 
 def surface_traction(scene, solution, interior, reaction: np.ndarray, clamped: np.ndarray,
-                     trace_constant: float) -> tuple[SurfaceTraction, ContactBound]:
-    """lambda* of the module docstring and its contact terms."""
+                     trace_constant: float) -> tuple[SurfaceTraction, tuple[ContactBound, ...]]:
+    """lambda* of the module docstring and its contact terms with every extension of
+    ``estimators.contact_extension_3d``."""
     surface = solution.trace
     pressures = [projected_pressure(surface, solution.pressure),
                  SurfaceTraction(np.zeros((3, surface.size)))]
-    d = vertex_extension(scene, solution, clamped)
-    energy = d.energy(surface.mesh, solution.elasticity.lame)
+    fields = [extend(scene, solution, clamped) for extend in EXTENSIONS_3D]
+    energies = [d.energy(surface.mesh, solution.elasticity.lame, surface) for d in fields]
     best = None
     for pressure in pressures:
         defect = reaction - traction_balance(interior, surface, pressure)
         traction = balanced(surface, pressure, defect, clamped)
-        bound = surface_bound(scene, solution, traction, d, energy)
-        terms = 2 * bound.extension + trace_constant * bound.negative + np.sqrt(
-            bound.complementarity)
+        bounds = tuple(surface_bound(scene, solution, traction, d, energy)
+                       for d, energy in zip(fields, energies, strict=True))
+        terms = min(2 * b.extension + trace_constant * b.negative + np.sqrt(b.complementarity)
+                    for b in bounds)
         if best is None or terms < best[0]:
-            best = (terms, traction, bound)
+            best = (terms, traction, bounds)
     return best[1], best[2]

@@ -18,7 +18,7 @@ SCENE = get_scene("free-boundary-3d")
 # constants are not computed), averaging 0.72 .. 0.84 (a recovery, asymptotically exact where
 # the stress is smooth), nitsche-residual as residual; the bands are a factor ~2 around them.
 # equilibrated is a guaranteed bound: above 1 is its claim; its ceiling a factor ~2 above the
-# measured 4.07 .. 9.41 (docs/theory.md, 14.5)
+# measured 4.06 .. 9.38 (docs/theory.md, 14.5)
 EFFECTIVITY = {"residual": (2.5, 15.0), "nitsche-residual": (2.5, 15.0),
                "averaging": (0.4, 1.6), "equilibrated": (1.0, 20.0)}
 
