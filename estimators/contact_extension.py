@@ -73,19 +73,21 @@ def discrete_gap(scene, solution, t: np.ndarray) -> np.ndarray:
 
 
 def vertex_normals(trace) -> np.ndarray:
-    """Length-weighted mean outer normals at the contact vertices, unit (2, n_vertices)."""
-    n_v = trace.mesh.p.shape[1]
-    nu = np.zeros((2, n_v))
+    """Measure-weighted mean outer normals at the contact vertices, unit (d, n_vertices), on
+    segments (2D) or triangles (3D)."""
+    d, n_v = trace.normal.shape[0], trace.mesh.p.shape[1]
+    nu = np.zeros((d, n_v))
     for v in trace.vertices:
-        for i in (0, 1):
-            nu[i] += np.bincount(v, trace.normal[i] * trace.length, minlength=n_v)
+        for i in range(d):
+            nu[i] += np.bincount(v, trace.normal[i] * trace.measure, minlength=n_v)
     norm = np.linalg.norm(nu, axis=0)
     return nu / np.where(norm > 0, norm, 1.0)
 
 
-def _vertex_field(trace, levels: list[np.ndarray], clamped: np.ndarray) -> np.ndarray:
+def vertex_field(trace, levels, clamped: np.ndarray) -> np.ndarray:
     """c_a nu_a with c_a the largest value whose normal component on every facet at a is at
-    most that facet's level there (``levels``: (n_f,) at the start and at the end)."""
+    most that facet's level there (``levels``: (n_f,) at each of the facet's vertices, in
+    ``trace.vertices`` order); c_a = 0 on Gamma_D."""
     nu = vertex_normals(trace)
     c = np.zeros(trace.mesh.p.shape[1])
     for v, level in zip(trace.vertices, levels, strict=True):
@@ -100,7 +102,7 @@ def vertex_extension(scene, solution, clamped: np.ndarray) -> Extension:
     trace = solution.trace
     w = np.minimum(discrete_gap(scene, solution, np.linspace(0.0, 1.0, SAMPLES)), 0.0)
     floor = w.min(axis=1)
-    return Extension(_vertex_field(trace, [floor, floor], clamped), np.zeros(trace.size))
+    return Extension(vertex_field(trace, [floor, floor], clamped), np.zeros(trace.size))
 
 
 def fitted_extension(scene, solution, clamped: np.ndarray) -> Extension:
@@ -109,7 +111,7 @@ def fitted_extension(scene, solution, clamped: np.ndarray) -> Extension:
     trace = solution.trace
     s = np.linspace(0.0, 1.0, SAMPLES)
     w = np.minimum(discrete_gap(scene, solution, s), 0.0)
-    linear = Extension(_vertex_field(trace, [w[:, 0], w[:, -1]], clamped), np.zeros(trace.size))
+    linear = Extension(vertex_field(trace, [w[:, 0], w[:, -1]], clamped), np.zeros(trace.size))
     inner = s[1:-1]
     room = (w - linear.along(trace, trace.normal, s))[:, 1:-1] / (4 * inner * (1 - inner))
     return Extension(linear.nodal, room.min(axis=1))

@@ -25,7 +25,7 @@ import numpy as np
 from skfem.quadrature import get_quadrature
 from skfem.refdom import RefTet
 
-from estimators.contact_extension import discrete_gap
+from estimators.contact_extension import discrete_gap, vertex_field
 from estimators.patch_data import simplex_gradients
 from formulations.elasticity import stress_tensor_from_gradient
 
@@ -42,17 +42,6 @@ def lattice(divisions: int) -> np.ndarray:
 def corner_weights(t: np.ndarray) -> np.ndarray:
     """The P1 basis (3, nq) of the reference triangle at local coordinates t (2, nq)."""
     return np.array([1.0 - t[0] - t[1], t[0], t[1]])
-
-
-def vertex_normals(surface) -> np.ndarray:
-    """Area-weighted mean outer normals at the contact vertices, unit (3, n_vertices)."""
-    n_v = surface.mesh.p.shape[1]
-    nu = np.zeros((3, n_v))
-    for v in surface.vertices:
-        for i in range(3):
-            nu[i] += np.bincount(v, surface.normal[i] * surface.measure, minlength=n_v)
-    norm = np.linalg.norm(nu, axis=0)
-    return nu / np.where(norm > 0, norm, 1.0)
 
 
 @dataclass(frozen=True, eq=False)
@@ -92,23 +81,12 @@ class SurfaceExtension:
         return energy
 
 
-def _vertex_values(surface, levels: np.ndarray, clamped: np.ndarray) -> np.ndarray:
-    """c_a nu_a, c_a the largest value with c_a (nu_a . n_e) <= levels[i, e] on every
-    triangle e at a (a its corner i); 0 on Gamma_D."""
-    nu = vertex_normals(surface)
-    c = np.zeros(surface.mesh.p.shape[1])
-    for v, level in zip(surface.vertices, levels, strict=True):
-        np.minimum.at(c, v, level / np.einsum("if,if->f", nu[:, v], surface.normal))
-    c[clamped] = 0.0  # d must vanish on Gamma_D
-    return c * nu
-
-
 def floor_extension(scene, solution, clamped: np.ndarray) -> SurfaceExtension:
     """The floor of the module docstring."""
     surface = solution.trace
     w = np.minimum(discrete_gap(scene, solution, lattice(SAMPLE_DIVISIONS)), 0.0)
     floor = np.broadcast_to(w.min(axis=1), (3, surface.size))
-    return SurfaceExtension(_vertex_values(surface, floor, clamped), np.zeros(surface.size))
+    return SurfaceExtension(vertex_field(surface, floor, clamped), np.zeros(surface.size))
 
 
 def fitted_extension(scene, solution, clamped: np.ndarray) -> SurfaceExtension:
@@ -120,7 +98,7 @@ def fitted_extension(scene, solution, clamped: np.ndarray) -> SurfaceExtension:
     on_edge = np.isclose(weights, 0.0)                       # on the edge opposite corner i
     levels = np.array([w[:, on_edge[(i + 1) % 3] | on_edge[(i + 2) % 3]].min(axis=1)
                        for i in range(3)])                    # min of w on corner i's edges
-    linear = SurfaceExtension(_vertex_values(surface, levels, clamped), np.zeros(surface.size))
+    linear = SurfaceExtension(vertex_field(surface, levels, clamped), np.zeros(surface.size))
     inside = weights.prod(axis=0) > 1e-12
     room = (w - linear.normal_part(surface, t))[:, inside] / (27 * weights.prod(axis=0)[inside])
     return SurfaceExtension(linear.nodal, room.min(axis=1))

@@ -93,15 +93,16 @@ def traction_balance(interior, trace, pressure, direction: np.ndarray | None = N
 
 
 def contact_mass(trace, weight: np.ndarray | None = None) -> sparse.csr_matrix:
-    """The mass matrix of continuous P1 on Gamma_C over all mesh vertices; with a ``weight``
+    """The mass matrix of continuous P1 on Gamma_C (segments or triangles) over all mesh
+    vertices: |e| (1 + delta_ij) / (m (m + 1)) on a facet e of m vertices; with a ``weight``
     (n_f,) per facet, each facet's part divided by it."""
-    start, end = trace.vertices
-    n_v, h = trace.mesh.p.shape[1], trace.length
+    m, n_v, size = trace.vertices.shape[0], trace.mesh.p.shape[1], trace.measure
     if weight is not None:
-        h = h / weight
-    rows = np.concatenate([start, start, end, end])
-    cols = np.concatenate([start, end, start, end])
-    vals = np.concatenate([h / 3, h / 6, h / 6, h / 3])
+        size = size / weight
+    pairs = [(i, j) for i in range(m) for j in range(m)]
+    rows = np.concatenate([trace.vertices[i] for i, _ in pairs])
+    cols = np.concatenate([trace.vertices[j] for _, j in pairs])
+    vals = np.concatenate([size / (m * (m + 1) / (1 + (i == j))) for i, j in pairs])
     return sparse.coo_matrix((vals, (rows, cols)), shape=(n_v, n_v)).tocsr()
 
 

@@ -17,18 +17,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import sparse
 from scipy.sparse.linalg import spsolve
 
-from estimators.contact_extension import discrete_gap
-from estimators.contact_extension_3d import (
-    EXTENSIONS_3D,
-    SurfaceExtension,
-    corner_weights,
-    vertex_normals,
-)
+from estimators.contact_extension import discrete_gap, vertex_normals
+from estimators.contact_extension_3d import EXTENSIONS_3D, SurfaceExtension, corner_weights
 from estimators.equilibration import BoundaryData, boundary_balance, boundary_fluxes
-from estimators.guaranteed_contact import ContactBound, bound_of
+from estimators.guaranteed_contact import ContactBound, bound_of, contact_mass
 from formulations.contact_surface import triangle_rule
 
 QUADRATURE_DEGREE = 8  # the rule on each contact triangle for lambda*_+ and the slack (kinked)
@@ -60,15 +54,6 @@ class SurfaceTraction:
                 + self.corners[2][:, None] * t1)
 
 
-def surface_mass(surface) -> sparse.csr_matrix:
-    """The mass matrix of continuous P1 on Gamma_C over all mesh vertices."""
-    n_v = surface.mesh.p.shape[1]
-    rows = np.concatenate([surface.vertices[i] for i in range(3) for _ in range(3)])
-    cols = np.concatenate([surface.vertices[j] for _ in range(3) for j in range(3)])
-    vals = np.concatenate([_MASS[i, j] * surface.measure for i in range(3) for j in range(3)])
-    return sparse.coo_matrix((vals, (rows, cols)), shape=(n_v, n_v)).tocsr()
-
-
 def projected_pressure(surface, pressure) -> SurfaceTraction:
     """The L2 projection of ``pressure(t)`` (n_f, nq) onto P1 per contact triangle."""
     t, w = triangle_rule(PROJECTION_DEGREE)
@@ -92,18 +77,17 @@ def balanced(surface, traction: SurfaceTraction, defect: np.ndarray,
     delta = np.zeros(surface.mesh.p.shape[1])
     if on.size:
         rhs = -(defect[on] * nu[:, on].T).sum(axis=1)
-        delta[on] = np.atleast_1d(spsolve(surface_mass(surface)[on][:, on].tocsc(), rhs))
+        delta[on] = np.atleast_1d(spsolve(contact_mass(surface)[on][:, on].tocsc(), rhs))
     return SurfaceTraction(traction.corners + delta[surface.vertices])
 
 
-def surface_bound(scene, solution, traction: SurfaceTraction, d: SurfaceExtension,
-                  energy: np.ndarray) -> ContactBound:
-    """D, ||lambda*_-|| and B (docs/theory.md, 13.1) of lambda* = ``traction`` and ``d``."""
-    surface = solution.trace
+def surface_bound(surface, traction: SurfaceTraction, d: SurfaceExtension, energy: np.ndarray,
+                  room: np.ndarray) -> ContactBound:
+    """D, ||lambda*_-|| and B (docs/theory.md, 13.1) of lambda* = ``traction`` and ``d``, with
+    ``room`` = g - u_hn - d . n at the points of the rule of QUADRATURE_DEGREE."""
     t, w = triangle_rule(QUADRATURE_DEGREE)
     lam = traction(t)
-    slack = surface.integrate(np.maximum(lam, 0.0)
-                              * (discrete_gap(scene, solution, t) - d.normal_part(surface, t)), w)
+    slack = surface.integrate(np.maximum(lam, 0.0) * room, w)
     return bound_of(surface, lam, surface.integrate(np.minimum(lam, 0.0) ** 2, w), slack, d,
                     energy)
 
@@ -117,12 +101,15 @@ def surface_traction(scene, solution, interior, reaction: np.ndarray, clamped: n
                  SurfaceTraction(np.zeros((3, surface.size)))]
     fields = [extend(scene, solution, clamped) for extend in EXTENSIONS_3D]
     energies = [d.energy(surface.mesh, solution.elasticity.lame, surface) for d in fields]
+    t, _ = triangle_rule(QUADRATURE_DEGREE)
+    gap = discrete_gap(scene, solution, t)           # once: every traction and field shares it
+    rooms = [gap - d.normal_part(surface, t) for d in fields]
     best = None
     for pressure in pressures:
         defect = reaction - traction_balance(interior, surface, pressure)
         traction = balanced(surface, pressure, defect, clamped)
-        bounds = tuple(surface_bound(scene, solution, traction, d, energy)
-                       for d, energy in zip(fields, energies, strict=True))
+        bounds = tuple(surface_bound(surface, traction, d, energy, room)
+                       for d, energy, room in zip(fields, energies, rooms, strict=True))
         terms = min(2 * b.extension + trace_constant * b.negative + np.sqrt(b.complementarity)
                     for b in bounds)
         if best is None or terms < best[0]:
