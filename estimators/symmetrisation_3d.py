@@ -83,7 +83,7 @@ def element_system(rt: ReferenceRT, Q: np.ndarray, residual: np.ndarray,
 def potential(rt: ReferenceRT, residual: np.ndarray, prescribed: np.ndarray,
               lame: tuple[float, float], korn: float) -> np.ndarray:
     """psi (3 rows, 3 components, dim P2) of the module docstring, by conjugate gradients
-    with the diagonal as preconditioner, to RTOL."""
+    preconditioned by the inverse node blocks of ``node_blocks``, to RTOL."""
     dofs = Dofs(rt.mesh, ElementTetP2())
     n = dofs.N
     # an element matrix depends on the element only through |det J|^(1/2) H: translation
