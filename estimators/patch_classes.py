@@ -75,12 +75,13 @@ class Classes:
                        bounds=np.searchsorted(of[order], np.arange(first.size + 1)))
 
     def products(self, matrices: np.ndarray, local: np.ndarray) -> np.ndarray:
-        """matrices[of[e]] @ local[e] for the class matrices (n_classes, m, m) and ``local``
-        (n_el, m, ...) given class by class (element ``order[i]`` in row i): one matrix
+        """matrices[of[e]] @ local[e] for the class matrices (n_classes, m, n) and ``local``
+        (n_el, n, ...) given class by class (element ``order[i]`` in row i): one matrix
         product per class where classes repeat, else one per element."""
         if 8 * self.first.size > self.of.size:
             return np.einsum("eij,ej...->ei...", matrices[self.of[self.order]], local)
-        out = np.empty(local.shape, dtype=np.result_type(matrices, local))
+        out = np.empty(local.shape[:1] + matrices.shape[1:2] + local.shape[2:],
+                       dtype=np.result_type(matrices, local))
         for c, (lo, hi) in enumerate(zip(self.bounds[:-1], self.bounds[1:], strict=True)):
             out[lo:hi] = np.einsum("ij,ej...->ei...", matrices[c], local[lo:hi], optimize=True)
         return out

@@ -5,10 +5,10 @@ to the patch of that vertex. A patch's unknowns are the RT DOFs of its elements 
 neither on the facets opposite its vertex (zero flux) nor prescribed (Neumann and contact
 data), then per element the P_k DG multipliers of the divergence constraint; the rows of
 the stress (two on triangles, three on tetrahedra) share the matrix and are its right-hand
-sides. Patches of the same system size
-are stacked; a chunk of them is solved by one batched dense LU, or, where patches share their
-system (``estimators.patch_classes``), by the inverses of the chunk's distinct systems.
-"""
+sides. Patches of the same system size are stacked; a chunk of them is solved by one batched
+dense LU, or, where patches share their system (``estimators.patch_classes``), by the
+inverses of the chunk's distinct systems (on tetrahedra after ``estimators.
+patch_condensation`` has eliminated the element-interior unknowns)."""
 
 from __future__ import annotations
 
@@ -43,9 +43,8 @@ class PatchLayout:
     ``n_free`` (n_vertices,), ``rank`` (P,) the pair's position among its patch's elements,
     ``count`` (n_vertices,) elements per patch, ``key_dof`` the global DOF of each distinct
     (patch, DOF) FREE unknown, and ``by_patch`` the pairs patch by patch, each patch's in
-    rank order, from ``start`` (n_vertices,);
-    ``first`` (n_vertices,) the key of each patch's first unknown (a patch's keys are
-    consecutive)."""
+    rank order, from ``start`` (n_vertices,); ``first`` (n_vertices,) the key of each patch's
+    first unknown (a patch's keys are consecutive)."""
 
     patch: np.ndarray
     status: np.ndarray
@@ -133,11 +132,7 @@ def solve_patches(lay: PatchLayout, pairs: PairMatrices, clamped: np.ndarray) ->
     (``clamped`` False) the first multiplier is dropped: the data balance, so its equation
     follows from the others (docs/theory.md, 13.2). Patches with equal systems
     (``estimators.patch_classes``) share one factorisation."""
-    rhs, data = pairs.rhs.copy(), pairs.data.copy()
-    touched = np.flatnonzero((lay.status == FIXED).any(axis=1))  # pairs on Gamma_N, Gamma_C
-    fixed, element = pairs.fixed[touched], pairs.class_of(touched)
-    rhs[touched] -= np.matmul(pairs.mass[element], fixed)
-    data[touched] -= np.matmul(pairs.divergence[element], fixed)
+    rhs, data = moved_prescribed(lay.status, pairs)
     size = lay.n_free + lay.count * pairs.divergence.shape[1]
     owner = _owners(lay, pairs, clamped, size)
     out = np.zeros((lay.key_dof.size, rhs.shape[-1]))
@@ -150,6 +145,16 @@ def solve_patches(lay: PatchLayout, pairs: PairMatrices, clamped: np.ndarray) ->
         list(pool.map(lambda job: _solve_chunk(lay, job[0], job[1], pairs, (rhs, data),
                                                clamped, owner, out), jobs))
     return out
+
+
+def moved_prescribed(status: np.ndarray, pairs: PairMatrices) -> tuple[np.ndarray, np.ndarray]:
+    """The pairs' ``rhs`` and ``data`` less the prescribed DOFs' share (status FIXED)."""
+    rhs, data = pairs.rhs.copy(), pairs.data.copy()
+    touched = np.flatnonzero((status == FIXED).any(axis=1))  # pairs on Gamma_N, Gamma_C
+    fixed, element = pairs.fixed[touched], pairs.class_of(touched)
+    rhs[touched] -= np.matmul(pairs.mass[element], fixed)
+    data[touched] -= np.matmul(pairs.divergence[element], fixed)
+    return rhs, data
 
 
 def _owners(lay: PatchLayout, pairs: PairMatrices, clamped: np.ndarray,
