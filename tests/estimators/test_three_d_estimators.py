@@ -57,3 +57,17 @@ def test_3d_face_jumps_do_not_depend_on_the_block_size(monkeypatch):
     # the same sums in another order: equal to round-off
     np.testing.assert_allclose(residual_3d.interior_jumps_3d(sol), whole, rtol=1e-12)
     assert whole.min() > 0  # every tetrahedron has an interior face with a jump
+
+
+def test_get_estimator_runs_the_variant_of_the_solution_cells():
+    """A direct caller of ``get_estimator`` gets the tetrahedral bound on a 3D solution (the
+    triangle function would fail on it), equal to the variant's own to the run-to-run spread
+    of the domain constants' random start (1e-8)."""
+    from estimators import get_estimator
+
+    sol = solve(get_formulation("vi")(SCENE, SCENE.mesh, order=1), "active-set")
+    direct = get_estimator("equilibrated")(SCENE, sol).eta
+    assert direct == pytest.approx(estimator_on("equilibrated", "tet")(SCENE, sol).eta,
+                                   rel=1e-8)
+    with pytest.raises(KeyError, match="unknown estimator 'nope'"):
+        get_estimator("nope")
