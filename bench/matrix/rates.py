@@ -72,6 +72,7 @@ def rates_table(table: pd.DataFrame, levels: int = RATE_LEVELS) -> pd.DataFrame:
         judged = judged_levels(ok)
         rows.append({
             **dict(zip(KEYS, key, strict=True)),
+            "dim": int(group["dim"].iloc[0]) if "dim" in group else 2,
             "levels": len(group), "fit_levels": len(tail),
             "ndofs_last": int(group["ndofs"].iloc[-1]),
             "error_rate": slope(group, "energy_error", levels),

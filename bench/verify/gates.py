@@ -49,8 +49,12 @@ def run_gate_matrices(expected: dict, out: str | Path, on_level=None,
     return pd.concat(tables, ignore_index=True)
 
 
+MATCHED = [*KEYS, "dim"]  # a gate's keys that select rows (glob patterns; dim: 2 or 3)
+
+
 def _matches(row: pd.Series, gate: dict) -> bool:
-    return all(fnmatch.fnmatch(str(row[k]), str(gate.get(k, "*"))) for k in KEYS if k in row)
+    return all(fnmatch.fnmatch(str(row[k]), str(gate.get(k, "*"))) for k in MATCHED
+               if k in row)
 
 
 def gate_names(expected: dict, quick: bool = False) -> list[str]:

@@ -36,3 +36,18 @@ def test_every_gate_says_where_its_numbers_come_from():
     for gate in load_expected()["gate"]:
         assert len(gate["source"]) > 20, gate["name"]
         assert "min" in gate or "max" in gate, gate["name"]
+
+
+def test_a_gate_with_a_dimension_selects_only_that_dimension():
+    import pandas as pd
+
+    from bench.verify.gates import check_gates
+
+    rates = pd.DataFrame({"scene": ["paper", "paper-3d"], "estimator": ["equilibrated"] * 2,
+                          "dim": [2, 3], "effectivity_max": [1.5, 2.5]})
+    gate = {"name": "g", "quantity": "effectivity_max", "estimator": "equilibrated",
+            "max": 2.0, "source": "a test"}
+    both = check_gates({"gate": [gate]}, [rates])
+    assert [v.passed for v in both] == [True, False]
+    planar = check_gates({"gate": [{**gate, "dim": 2}]}, [rates])
+    assert [(v.combination, v.passed) for v in planar] == [("paper/equilibrated", True)]
