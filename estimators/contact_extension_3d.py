@@ -26,8 +26,8 @@ from skfem.quadrature import get_quadrature
 from skfem.refdom import RefTet
 
 from estimators.contact_extension import discrete_gap, vertex_field
-from estimators.patch_data import simplex_gradients
 from formulations.elasticity import stress_tensor_from_gradient
+from formulations.p1_stiffness import barycentric_gradients
 
 SAMPLE_DIVISIONS = 8   # d . n <= w is imposed on this lattice per contact triangle
 ENERGY_ORDER = 5       # the bubble's energy density is quartic; this rule's weights are positive
@@ -60,7 +60,7 @@ class SurfaceExtension:
 
     def energy(self, mesh, lame: tuple[float, float], surface) -> np.ndarray:
         """a(d, d) per element (the bubbles' tetrahedra on a rule of ENERGY_ORDER)."""
-        gradients, volume = simplex_gradients(mesh)                   # (4, 3, n_el)
+        gradients, volume = barycentric_gradients(mesh)                   # (4, 3, n_el)
         grad = np.einsum("iae,ake->ike", self.nodal[:, mesh.t], gradients)
         energy = volume * np.einsum("ije,ije->e", stress_tensor_from_gradient(grad, *lame), grad)
         if not np.any(self.bubble):

@@ -9,8 +9,9 @@ from skfem import Basis, ElementDG, FacetBasis
 
 from estimators.equilibration import BoundaryData
 from estimators.jump_equilibration import JumpOscillation
-from estimators.patch_data import scalar_lagrange, simplex_gradients
+from estimators.patch_data import scalar_lagrange
 from formulations.elasticity import element_diameters
+from formulations.p1_stiffness import barycentric_gradients
 from scenes.base import simplex_measures
 
 
@@ -38,7 +39,7 @@ def oscillation(scene, rt: Basis, boundary: list[BoundaryData],
         measure = simplex_measures(mesh.p[:, mesh.facets[:, part.facets]])
         element = fb.tind
         c_e = np.sqrt(measure * element_diameters(mesh)[element] ** 2
-                      / simplex_gradients(mesh)[1][element] * (1 / np.pi**2 + 2 / (d * np.pi)))
+                      / barycentric_gradients(mesh)[1][element] * (1 / np.pi**2 + 2 / (d * np.pi)))
         out += np.bincount(element, c_e * np.sqrt(err), mesh.t.shape[1])
     return out
 

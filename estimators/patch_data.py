@@ -41,18 +41,6 @@ def scalar_lagrange(degree: int, dim: int):
     return elements[degree]()
 
 
-def simplex_gradients(mesh) -> tuple[np.ndarray, np.ndarray]:
-    """The gradients (d + 1, d, n_el) of the barycentric coordinates and the measures (n_el,)
-    of a triangle mesh (``formulations.p1_stiffness``, cached) or a tetrahedron mesh (the rows
-    of J^-1 are the gradients of the reference coordinates 1..d)."""
-    if mesh.dim() == 2:
-        return barycentric_gradients(mesh)
-    mapping = mesh.mapping()
-    inverse = mapping.invA
-    g = np.concatenate([-inverse.sum(axis=0, keepdims=True), inverse], axis=0)
-    return g, np.abs(mapping.detA) / 6
-
-
 @dataclass(frozen=True, eq=False)
 class Interior:
     """The element data of the patch problems (independent of the boundary data): the RT_k
@@ -85,7 +73,7 @@ def interior_data(mesh, sigma_h, body_force, k: int, intorder: int) -> Interior:
     classes = Classes.of_owners(element_classes(mesh, k))  # few on refined meshes: each once
     mass, divergence = element_matrices(mesh, k, X, W, dg, classes.first)
     stress = sigma_h(rt)
-    rhs, data = patch_rhs(mesh, k, X, W, dg, stress, simplex_gradients(mesh)[0])
+    rhs, data = patch_rhs(mesh, k, X, W, dg, stress, barycentric_gradients(mesh)[0])
     if body_force is not None:
         data = data - load_moments(mesh, body_force, k)
     total = np.array([np.bincount(mesh.t.T.ravel(), data[:, :, r].sum(axis=-1).ravel(),
@@ -124,7 +112,7 @@ def rebalanced(interior: Interior, defect: np.ndarray,
     added, so that every patch balances, and rho (docs/theory.md, 13.2): sum_T int_T (data)
     then equals the boundary fluxes for every vertex."""
     mesh = interior.rt.mesh
-    area = simplex_gradients(mesh)[1]
+    area = barycentric_gradients(mesh)[1]
     corners = mesh.t.shape[0]
     weight = np.bincount(mesh.t.ravel(), np.tile(area / corners, corners),
                          minlength=mesh.p.shape[1])

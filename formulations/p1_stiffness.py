@@ -15,16 +15,17 @@ from __future__ import annotations
 
 import numpy as np
 from scipy import sparse
-from skfem import MeshTri
+from skfem import MeshTet, MeshTri
 from skfem.mapping import MappingAffine
 
 from scenes.topology import TRIANGLE_EDGES, ensure_topology
 
 
-def barycentric_gradients(mesh: MeshTri) -> tuple[np.ndarray, np.ndarray]:
-    """The gradients g (3 vertices, 2 components, n_elements) and the areas (n_elements),
-    computed once per mesh (assembly, estimators and errors all ask; a mesh's arrays are never
-    changed in place, so the read-only copies stored on it stay right)."""
+def barycentric_gradients(mesh: MeshTri | MeshTet) -> tuple[np.ndarray, np.ndarray]:
+    """The gradients g (d + 1 vertices, d components, n_elements) and the measures
+    (n_elements) of a triangle or tetrahedron mesh, computed once per mesh (assembly,
+    estimators and errors all ask; a mesh's arrays are never changed in place, so the
+    read-only copies stored on it stay right)."""
     cached = getattr(mesh, "_barycentric_gradients", None)
     if cached is None:
         cached = _barycentric_gradients(mesh)
@@ -34,8 +35,12 @@ def barycentric_gradients(mesh: MeshTri) -> tuple[np.ndarray, np.ndarray]:
     return cached
 
 
-def _barycentric_gradients(mesh: MeshTri) -> tuple[np.ndarray, np.ndarray]:
+def _barycentric_gradients(mesh: MeshTri | MeshTet) -> tuple[np.ndarray, np.ndarray]:
     mapping = mesh.mapping()  # scikit-fem's, cached on the mesh: every basis on it uses it
+    if mesh.dim() == 3:  # the rows of J^-1 are the gradients of the reference coordinates
+        inverse = mapping.invA
+        g = np.concatenate([-inverse.sum(axis=0, keepdims=True), inverse], axis=0)
+        return g, np.abs(mapping.detA) / 6
     if isinstance(mapping, MappingAffine) and mapping.tind is None:
         # the rows of the inverse map are the gradients of vertices 1 and 2's coordinates; the
         # same products and quotients as below, so the same numbers to the bit

@@ -48,3 +48,24 @@ def test_p2_equals_scikit_fem(name, lam, mu):
     # (measured 1.7e-16 .. 4.2e-16)
     assert abs(mine - theirs).max() <= 1e-14 * abs(theirs).max()
     assert abs(mine - mine.T).max() == 0.0  # mirrored blocks are transposes: exactly symmetric
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_barycentric_gradients_are_those_of_scikit_fems_p1_basis(dim):
+    """Against the gradients of scikit-fem's P1 basis functions and the sum of its
+    quadrature weights (the measure), on a distorted mesh: round-off, 1e-12."""
+    from skfem import ElementTetP1, ElementTriP1, MeshTet
+
+    from formulations.p1_stiffness import barycentric_gradients
+
+    mesh_type, element = (MeshTri, ElementTriP1) if dim == 2 else (MeshTet, ElementTetP1)
+    mesh = mesh_type.init_tensor(*[np.linspace(0, 1, 3)] * dim)
+    rng = np.random.default_rng(4)
+    mesh = mesh_type(mesh.p + 0.1 * rng.uniform(-1, 1, mesh.p.shape), mesh.t)
+    basis = Basis(mesh, element(), intorder=1)
+    g, measure = barycentric_gradients(mesh)
+    assert g.shape == (dim + 1, dim, mesh.t.shape[1])
+    for i in range(dim + 1):
+        np.testing.assert_allclose(g[i], np.asarray(basis.basis[i][0].grad)[:, :, 0],
+                                   atol=1e-12)
+    np.testing.assert_allclose(measure, basis.dx.sum(axis=1), rtol=1e-12)
