@@ -72,6 +72,18 @@ def integrals(body_force, mapping, cells, corners, rule) -> np.ndarray:
     return (body_force(physical(mapping, cells, X)) * (W * det[:, None])).sum(axis=-1)
 
 
+def shared_integrals(body_force, mapping, cells, corners, rule) -> np.ndarray:
+    """int f over the same sub-simplices ``corners`` (m, d + 1, d) of every element of
+    ``cells``: (d, n m), sub-simplex j of element i at column m i + j (``integrals`` with the
+    rule mapped once, not once per element)."""
+    X, W = mapped_rule(corners, rule)                                   # (d, m, nq), (m, nq)
+    det = np.abs(mapping.detDF(np.zeros((X.shape[0], 1)), tind=cells))[:, 0]
+    A, b = mapping.A[:, :, cells], mapping.b[:, cells]
+    x = np.einsum("ijn,jq->inq", A, X.reshape(X.shape[0], -1)) + b[:, :, None]
+    values = body_force(x).reshape(X.shape[0], cells.size, *W.shape)
+    return (values * (W[None] * det[:, None, None])).sum(axis=-1).reshape(X.shape[0], -1)
+
+
 def physical(mapping, cells, X: np.ndarray) -> np.ndarray:
     """Physical points (d, n, nq) of reference points X (d, n, nq), row i in element cells[i]."""
     A, b = mapping.A[:, :, cells], mapping.b[:, cells]
@@ -90,13 +102,19 @@ def refined_rule(body_force, basis: Basis, max_depth: int | None = None):
     k, volume = 2**d, 1.0 / (2 if d == 2 else 6)  # children per simplex; reference measure
     cells, corners = np.arange(n), np.broadcast_to(_REFERENCE[d], (n, d + 1, d))
     scale = np.abs(body_force(np.asarray(basis.global_coordinates()))).max()
-    whole = integrals(body_force, mapping, cells, corners, rule)
+    whole = shared_integrals(body_force, mapping, cells, _REFERENCE[d][None], rule)
     kept, rough = [], None
     for depth in range(max_depth + 1):
         if cells.size == 0:
             break
-        sub = children(corners)
-        parts = integrals(body_force, mapping, np.repeat(cells, k), sub, rule)
+        if depth == 0:   # every element's children are the reference's: one mapped rule
+            reference = children(_REFERENCE[d][None])
+            sub = np.broadcast_to(reference, (n, k, d + 1, d))
+            parts = shared_integrals(body_force, mapping, cells, reference, rule)
+        else:
+            sub = children(corners)
+            parts = integrals(body_force, mapping, np.repeat(cells, k), sub, rule)
+            sub = sub.reshape(-1, k, d + 1, d)
         area = np.abs(mapping.detDF(np.zeros((d, 1)), tind=cells))[:, 0] * volume / k**depth
         split = (np.abs(whole - parts.reshape(d, -1, k).sum(axis=-1)).max(axis=0)
                  > ROUGH_TOLERANCE * scale * area)
@@ -104,11 +122,11 @@ def refined_rule(body_force, basis: Basis, max_depth: int | None = None):
             rough = cells[split]
         if depth == max_depth:
             split[:] = False
-        kept.append((cells[~split], corners[~split]))
+        kept.append((cells[~split], corners[~split]) if depth else None)  # depth 0: skfem's
         cells = np.repeat(cells[split], k)
-        corners = sub.reshape(-1, k, d + 1, d)[split].reshape(-1, d + 1, d)
+        corners = sub[split].reshape(-1, d + 1, d)
         whole = parts.reshape(d, -1, k)[:, split].reshape(d, -1)  # the children's own integrals
-    kept = kept[1:] if len(kept) > 1 else []  # depth 0 unsplit elements keep skfem's rule
+    kept = kept[1:]
     return rough, kept
 
 
