@@ -1,5 +1,5 @@
 """Static condensation of the element-interior unknowns of the vertex-patch problems
-(docs/theory.md, section 13.2).
+(docs/theory.md, section 14.5).
 
 On an element, the RT_k DOFs inside it (I) and the multipliers of its divergence constraint
 against the P_k DG functions q_1 .. q_(n-1) (L) couple to nothing outside it: the patch's other
