@@ -13,6 +13,8 @@ component c, the order of scikit-fem's ``ElementVector(ElementTriP1)``.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from scipy import sparse
 from skfem import MeshTet, MeshTri
@@ -37,17 +39,14 @@ def barycentric_gradients(mesh: MeshTri | MeshTet) -> tuple[np.ndarray, np.ndarr
 
 def _barycentric_gradients(mesh: MeshTri | MeshTet) -> tuple[np.ndarray, np.ndarray]:
     mapping = mesh.mapping()  # scikit-fem's, cached on the mesh: every basis on it uses it
-    if mesh.dim() == 3:  # the rows of J^-1 are the gradients of the reference coordinates
-        inverse = mapping.invA
-        g = np.concatenate([-inverse.sum(axis=0, keepdims=True), inverse], axis=0)
-        return g, np.abs(mapping.detA) / 6
     if isinstance(mapping, MappingAffine) and mapping.tind is None:
-        # the rows of the inverse map are the gradients of vertices 1 and 2's coordinates; the
-        # same products and quotients as below, so the same numbers to the bit
-        g = np.empty((3, 2, mesh.t.shape[1]))
+        # the rows of the inverse map are the gradients of the reference coordinates 1 .. d;
+        # on triangles the same products and quotients as below, so the same numbers to the bit
+        d = mesh.dim()
+        g = np.empty((d + 1, d, mesh.t.shape[1]))
         g[1:] = mapping.invA
-        g[0] = -g[1] - g[2]
-        return g, 0.5 * np.abs(mapping.detA)
+        g[0] = -g[1:].sum(axis=0)
+        return g, np.abs(mapping.detA) / math.factorial(d)
     x = mesh.p[:, mesh.t]  # (2, 3, n)
     d1, d2 = x[:, 1] - x[:, 0], x[:, 2] - x[:, 0]
     det = d1[0] * d2[1] - d1[1] * d2[0]
