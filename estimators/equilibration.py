@@ -21,7 +21,7 @@ in batches of equal size (no loop over patches).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from skfem import FacetBasis
@@ -131,18 +131,17 @@ def boundary_balance(n_vertices: int, fluxes: list[Flux], dim: int = 2) -> np.nd
 
 
 def reconstruct(interior: Interior, fluxes: list[Flux], clamped: np.ndarray,
-                condense: bool | None = None) -> Reconstruction:
+                condense: bool = False) -> Reconstruction:
     """sigma* of the module docstring for the boundary data ``fluxes``; ``clamped``
     (n_vertices,) marks the vertices on Gamma_D (their patches have no balance condition).
     With ``condense`` the element-interior unknowns are eliminated first
-    (``estimators.patch_condensation``; the same sigma* to round-off). By default on
-    tetrahedra only: there it took the patch problems of a 52 634-tetrahedron `hertz-3d`
-    mesh from 22 s to 6.5 s, while on triangles, whose patch systems repeat and share one
-    factorisation per class, it took `paper`'s 5e5-DOF level from 5.2 s to 7.0 s."""
+    (``estimators.patch_condensation``; the same sigma* to round-off): what the tetrahedral
+    bound asks, where it took the patch problems of a 52 634-tetrahedron `hertz-3d` mesh from
+    22 s to 6.5 s; on triangles, whose patch systems repeat and share one factorisation per
+    class, it took `paper`'s 5e5-DOF level from 5.2 s to 7.0 s."""
     rt, k = interior.rt, interior.k
     mesh = rt.mesh
     (corners, n_el), n_v, d = mesh.t.shape, mesh.p.shape[1], mesh.dim()
-    condense = d == 3 if condense is None else condense
     patch = mesh.t.T.ravel()                     # pair p = (d + 1) e + i
     dofs = rt.element_dofs.T[np.repeat(np.arange(n_el), corners)]
     status, fixed = pair_status(interior, fluxes)
@@ -151,12 +150,13 @@ def reconstruct(interior: Interior, fluxes: list[Flux], clamped: np.ndarray,
                          rhs=interior.rhs.reshape(-1, d, dofs.shape[1]).transpose(0, 2, 1),
                          data=interior.data.reshape(-1, d, interior.data.shape[-1]).transpose(
                              0, 2, 1), fixed=fixed, corners=corners)
+    rhs, data = moved_prescribed(status, pairs)
+    pairs = replace(pairs, rhs=rhs, data=data)
     holder = facet_holders(mesh, rt.element_dofs, k)
     sigma = np.zeros((d, rt.N))
     if condense:
         n_s = corners * facet_dof_count(k, d)
-        reduced, elimination = condensed(pairs, *moved_prescribed(status, pairs),
-                                         interior.classes, dofs.shape[1] - n_s)
+        reduced, elimination = condensed(pairs, interior.classes, dofs.shape[1] - n_s)
         lay = layout(patch, dofs[:, :n_s], status[:, :n_s],
                      (holder // dofs.shape[1] * n_s + holder % dofs.shape[1])[:, :n_s], n_v)
         free_values = solve_patches(lay, reduced, clamped)

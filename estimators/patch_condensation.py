@@ -64,13 +64,13 @@ def per_element(classes: Classes, matrices: np.ndarray, right: np.ndarray,
         n_pairs, matrices.shape[1], d)
 
 
-def condensed(pairs: PairMatrices, rhs: np.ndarray, data: np.ndarray, classes: Classes,
+def condensed(pairs: PairMatrices, classes: Classes,
               n_interior: int) -> tuple[PairMatrices, Elimination]:
     """The patch data of the facet DOFs (the first n_rt - ``n_interior`` slots) and the
-    constant multipliers, and the elimination that recovers the rest; ``rhs`` (P, n_rt, d)
-    and ``data`` (P, n_dg, d) with the prescribed values already moved to the right."""
+    constant multipliers, and the elimination that recovers the rest; ``pairs`` with the
+    prescribed values already moved to the right (``estimators.patches.moved_prescribed``)."""
     n_rt, n_s = pairs.mass.shape[1], pairs.mass.shape[1] - n_interior
-    M, B = pairs.mass, pairs.divergence
+    M, B, rhs, data = pairs.mass, pairs.divergence, pairs.rhs, pairs.data
     interior = slice(n_s, n_rt)
     constant = B.sum(axis=1, keepdims=True)
     constant[:, :, interior] = 0.0          # int_T div phi_I = 0: round-off removed
@@ -87,6 +87,5 @@ def condensed(pairs: PairMatrices, rhs: np.ndarray, data: np.ndarray, classes: C
                                              pairs.corners)
     reduced = PairMatrices(mass=0.5 * (schur + schur.transpose(0, 2, 1)), divergence=constant[
         :, :, :n_s], element_class=pairs.element_class, rhs=reduced_rhs,
-        data=data.sum(axis=1, keepdims=True), fixed=np.zeros_like(reduced_rhs),
-        corners=pairs.corners)
+        data=data.sum(axis=1, keepdims=True), fixed=pairs.fixed[:, :n_s], corners=pairs.corners)
     return reduced, elimination

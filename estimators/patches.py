@@ -126,24 +126,24 @@ def solve_patches(lay: PatchLayout, pairs: PairMatrices, clamped: np.ndarray) ->
     """The FREE unknowns (n_keys, d) of every patch problem
 
         [M  B'] [x]   [rhs ]
-        [B  0 ] [y] = [data]   (minus the prescribed DOFs' share),
+        [B  0 ] [y] = [data]
 
+    (``pairs``' rhs and data already less the prescribed DOFs' share: ``moved_prescribed``),
     one system per patch with the rows of the stress as right-hand sides. Off Gamma_D
     (``clamped`` False) the first multiplier is dropped: the data balance, so its equation
     follows from the others (docs/theory.md, 13.2). Patches with equal systems
     (``estimators.patch_classes``) share one factorisation."""
-    rhs, data = moved_prescribed(lay.status, pairs)
     size = lay.n_free + lay.count * pairs.divergence.shape[1]
     owner = _owners(lay, pairs, clamped, size)
-    out = np.zeros((lay.key_dof.size, rhs.shape[-1]))
+    out = np.zeros((lay.key_dof.size, pairs.rhs.shape[-1]))
     jobs = []
     for n in np.unique(size):
         members = np.flatnonzero(size == n)
         members = members[np.argsort(owner[members], kind="stable")]   # classes together
         jobs += [(chunk, int(n)) for chunk in np.array_split(members, -(-members.size // BATCH))]
     with ThreadPoolExecutor(max_workers=worker_count()) as pool:
-        list(pool.map(lambda job: _solve_chunk(lay, job[0], job[1], pairs, (rhs, data),
-                                               clamped, owner, out), jobs))
+        list(pool.map(lambda job: _solve_chunk(lay, job[0], job[1], pairs, clamped, owner, out),
+                      jobs))
     return out
 
 
@@ -195,13 +195,13 @@ def _same_pairs(lay: PatchLayout, pairs: PairMatrices, owner: np.ndarray) -> np.
     return same
 
 
-def _solve_chunk(lay, chunk, n, pairs, right, clamped, owner, out) -> None:
+def _solve_chunk(lay, chunk, n, pairs, clamped, owner, out) -> None:
     """The patches ``chunk`` (of system size n): one system per class in the chunk, then
     either one LU per patch or, where classes repeat, the classes' inverses."""
     classes = Classes.of_owners(owner[chunk])
     A = _systems(lay, classes.first, n, pairs, clamped)
     view = _ChunkPairs.of(lay, chunk, n, pairs.divergence.shape[1])
-    b = _right_hand_sides(lay, view, n, pairs, right, clamped)
+    b = _right_hand_sides(lay, view, n, pairs, clamped)
     if 4 * classes.first.size > chunk.size:     # few repeats: an LU per patch is cheaper
         x = np.linalg.solve(A[classes.of], b)
     else:
@@ -255,10 +255,10 @@ def _systems(lay, chunk, n, pairs, clamped) -> np.ndarray:
     return A
 
 
-def _right_hand_sides(lay, view, n, pairs, right, clamped) -> np.ndarray:
+def _right_hand_sides(lay, view, n, pairs, clamped) -> np.ndarray:
     """The right-hand sides (patches, n, d) of the chunk ``view``: each pair's multiplier
     rows are its own; a FREE unknown on a facet is shared by the facet's two pairs."""
-    rhs, data = right
+    rhs, data = pairs.rhs, pairs.data
     d = rhs.shape[-1]
     b = np.zeros((view.size, n, d))
     rows = view.div_at[:, None] + np.arange(pairs.divergence.shape[1])
