@@ -135,12 +135,14 @@ def volume_parts(compliance: np.ndarray, skew: np.ndarray, osc: np.ndarray,
     return parts, volume
 
 
-def stress_gap(rec, solution: DiscreteSolution):
-    """sigma* - sigma_h (2, 2, n, nq) at points x (2, n, nq) of the elements ``cells``, as a
-    function ``gap(x, cells)`` (``estimators.jump_equilibration``, ``stress_gap``)."""
+def stress_gap(rec, solution: DiscreteSolution, stress=stress_at):
+    """sigma* - sigma_h (d, d, n, nq) at points x (d, n, nq) of the elements ``cells``, as a
+    function ``gap(x, cells)`` (``estimators.jump_equilibration``, ``stress_gap``), sigma_h
+    from ``stress(solution, x (d, m), cells (m,))``."""
     def gap(x: np.ndarray, cells: np.ndarray) -> np.ndarray:
-        sigma_h = stress_at(solution, x.reshape(2, -1), np.repeat(cells, x.shape[2]))
-        return rec.basis.values_at(rec.dofs, x, cells) - sigma_h.reshape(2, 2, *x.shape[1:])
+        d = x.shape[0]
+        sigma_h = stress(solution, x.reshape(d, -1), np.repeat(cells, x.shape[2]))
+        return rec.basis.values_at(rec.dofs, x, cells) - sigma_h.reshape(d, d, *x.shape[1:])
 
     return gap
 

@@ -4,10 +4,13 @@ tetrahedra"): the bound of 13.1 with the stress of 13.2 built on tetrahedral ver
 sigma* has rows in RT_k on the tetrahedra (``estimators.raviart_thomas_tet``; the mesh with
 each element's vertices sorted, which keeps its facets and their numbering), from the same
 batched patch problems as on triangles (``estimators.equilibration``), with Neumann data q and
--lambda* n on the contact triangles (``estimators.guaranteed_contact_3d``). It is not
-symmetrised: A = ||C^{-1/2}(sym sigma* - sigma_h)|| + C_K ||skw sigma*|| + C_G osc + C_F
-||rho||, with the constants of ``estimators.constants`` on the 3D domain and the oscillation
-of ``estimators.oscillation``. Frictionless contact only.
+-lambda* n on the contact triangles (``estimators.guaranteed_contact_3d``), made weakly
+symmetric by the curl of a potential (``estimators.symmetrisation_3d``): A = ||C^{-1/2}(sym
+sigma* - sigma_h)|| + C_K ||skw sigma*|| + C_G osc + C_F ||rho||, with the constants of
+``estimators.constants`` on the 3D domain and the oscillation of ``estimators.oscillation``;
+where f jumps inside elements, an RT_0 flux on sub-tetrahedra takes most of it into sigma*
+(``estimators.jump_flux``; 13.2, "Where f jumps, element by element"). Frictionless contact
+only.
 """
 
 from __future__ import annotations
@@ -21,6 +24,7 @@ from estimators.equilibrated import (
     BALANCE_TOLERANCE,
     NotEquilibrated,
     smallest,
+    stress_gap,
     volume_parts,
 )
 from estimators.equilibration import (
@@ -31,6 +35,7 @@ from estimators.equilibration import (
 )
 from estimators.guaranteed_contact import ContactBounds
 from estimators.guaranteed_contact_3d import surface_traction
+from estimators.jump_flux import flux_oscillation
 from estimators.oscillation import oscillation
 from estimators.patch_data import interior_data, rebalanced
 from estimators.raviart_thomas_tet import sorted_tetrahedra
@@ -54,7 +59,15 @@ def estimate(scene, solution: DiscreteSolution) -> Estimate:
                   * rec.basis.dx).sum(axis=1)
     skew = ((0.5 * (rec.values - rec.values.transpose(1, 0, 2, 3))) ** 2).sum(axis=(0, 1))
     skew = (skew * rec.basis.dx).sum(axis=1)
-    osc = oscillation(scene, rec.basis, boundary)
+    jump = flux_oscillation(rec.basis.mesh, scene.body_force, rec.basis.elem.k,
+                            gap=stress_gap(rec, solution, stress_at), lame=(lam, mu))
+    if jump is not None:  # where f jumps: sigma* - tau on the rough elements (13.2)
+        if jump.divergence_defect > BALANCE_TOLERANCE:
+            raise NotEquilibrated(f"the moments of f - Pi_k f miss zero by "
+                                  f"{jump.divergence_defect:.1e} (relative) > "
+                                  f"{BALANCE_TOLERANCE:g}: no bound")
+        compliance[jump.elements], skew[jump.elements] = jump.symmetric, jump.skew
+    osc = oscillation(scene, rec.basis, boundary, jump)
     parts, volume = volume_parts(compliance, skew, osc, load.squares, constants, mu)
     return smallest(scene, solution, parts, volume, ContactBounds(marking=bounds, sharp=bounds),
                     None, "equilibrated")

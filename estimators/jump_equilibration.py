@@ -35,6 +35,7 @@ from skfem.assembly import Dofs
 from estimators.averaging import compliance_energy
 from estimators.level_set_cut import cut_along
 from estimators.local_korn import element_korn as korn_per_element
+from estimators.patch_data import scalar_lagrange
 from estimators.raviart_thomas import ElementTriRTk
 from estimators.rt_reference import (
     ReferenceRT,
@@ -76,12 +77,18 @@ class JumpOscillation:
     divergence_defect: float
     combined: bool = False      # the terms of sigma* - tau - sigma_h, not of tau alone
 
+    @property
+    def osc_squares(self) -> np.ndarray:
+        """osc_T^2 per rough element: the sub-triangles' Poincare term (tau's are A's)."""
+        return self.remainder
+
 
 def rough_elements(mesh, body_force, k: int) -> np.ndarray:
-    """The elements on which the load rule refines (f jumps inside them)."""
+    """The elements on which the load rule refines (f jumps inside them), on triangles or
+    tetrahedra."""
     if body_force is None:
         return np.zeros(0, dtype=np.int64)
-    basis = Basis(mesh, ElementDG(ELEMENTS[k]()), intorder=2 * k)
+    basis = Basis(mesh, ElementDG(scalar_lagrange(k, mesh.dim())), intorder=2 * k)
     return refined_rule(body_force, basis, max_depth=0)[0]
 
 
