@@ -23,6 +23,8 @@ import numpy as np
 
 from estimators.rt_reference import facet_dof_count, orientations
 
+HASH_SEED = 20261202  # the random weights of ``patch_owners``' hash (any: collisions are checked)
+
 ELEMENT_TOLERANCE = 1e-12  # relative: equal up to the round-off of computing J from the mesh
 _SEED = 20261129
 
@@ -111,3 +113,42 @@ def key_hash(keys: np.ndarray) -> np.ndarray:
 def _first_with_hash(h: np.ndarray) -> np.ndarray:
     _, first, inverse = np.unique(h, return_index=True, return_inverse=True)
     return first[inverse.ravel()]
+
+
+def patch_owners(lay, pairs, clamped: np.ndarray, size: np.ndarray) -> np.ndarray:
+    """For every patch of ``lay`` (an ``estimators.patches.PatchLayout``, its element
+    matrices ``pairs``, ``PairMatrices``; ``size`` the system sizes) the first patch with the
+    same system: equal size, element count and
+    clamping, and per element rank the same element matrices (the same ``element_class``)
+    at the same positions. Grouped by a hash of these, pair by pair, then every patch is
+    compared with its group's first; one that differs is a class of its own."""
+    n_rt = lay.local.shape[1]
+    rng = np.random.default_rng(HASH_SEED)
+    weights = rng.integers(1, 2**61, size=n_rt + 1)
+    by_rank = rng.integers(1, 2**61, size=int(lay.count.max(initial=1)))
+    ordered = lay.by_patch
+    with np.errstate(over="ignore"):
+        pair_hash = ((pairs.class_of(ordered) * weights[0]
+                      + lay.local[ordered].astype(np.int64) @ weights[1:])
+                     * by_rank[lay.rank[ordered]])
+        patch_hash = np.zeros(lay.count.size, dtype=np.int64)
+        filled = lay.count > 0
+        patch_hash[filled] = np.add.reduceat(pair_hash, lay.start[filled])
+    keys = np.stack([size, lay.count, clamped.astype(np.int64), patch_hash], axis=1)
+    owner = patch_classes(keys)
+    return np.where(_same_pairs(lay, pairs, owner), owner, np.arange(owner.size))
+
+
+def _same_pairs(lay, pairs, owner: np.ndarray) -> np.ndarray:
+    """Whether each patch's pairs equal its ``owner``'s, rank by rank: element class and
+    local positions (the hash of ``patch_owners`` grouped them; this rules out collisions)."""
+    other = np.flatnonzero(owner != np.arange(owner.size))
+    same = np.ones(owner.size, dtype=bool)
+    if other.size == 0:
+        return same
+    mine, theirs = lay.pairs_of(other), lay.pairs_of(owner[other])   # equal counts: in the key
+    differs = ((pairs.class_of(mine) != pairs.class_of(theirs))
+               | (lay.local[mine] != lay.local[theirs]).any(axis=1))
+    patch = np.repeat(np.arange(other.size), lay.count[other])
+    same[other] = np.bincount(patch, differs, minlength=other.size) == 0
+    return same

@@ -18,11 +18,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from estimators.patch_classes import Classes, patch_classes
+from estimators.patch_classes import Classes, patch_owners
 
 ZERO, FREE, FIXED = 0, 1, 2
 BATCH = 2000  # patches per stacked solve: bounds the memory of the dense systems
-HASH_SEED = 20261202  # the random weights of ``_owners``' hash (any: collisions are checked)
 
 
 def worker_count() -> int:
@@ -134,7 +133,7 @@ def solve_patches(lay: PatchLayout, pairs: PairMatrices, clamped: np.ndarray) ->
     follows from the others (docs/theory.md, 13.2). Patches with equal systems
     (``estimators.patch_classes``) share one factorisation."""
     size = lay.n_free + lay.count * pairs.divergence.shape[1]
-    owner = _owners(lay, pairs, clamped, size)
+    owner = patch_owners(lay, pairs, clamped, size)
     out = np.zeros((lay.key_dof.size, pairs.rhs.shape[-1]))
     jobs = []
     for n in np.unique(size):
@@ -155,44 +154,6 @@ def moved_prescribed(status: np.ndarray, pairs: PairMatrices) -> tuple[np.ndarra
     rhs[touched] -= np.matmul(pairs.mass[element], fixed)
     data[touched] -= np.matmul(pairs.divergence[element], fixed)
     return rhs, data
-
-
-def _owners(lay: PatchLayout, pairs: PairMatrices, clamped: np.ndarray,
-            size: np.ndarray) -> np.ndarray:
-    """For every patch the first patch with the same system: equal size, element count and
-    clamping, and per element rank the same element matrices (the same ``element_class``)
-    at the same positions. Grouped by a hash of these, pair by pair, then every patch is
-    compared with its group's first; one that differs is a class of its own."""
-    n_rt = lay.local.shape[1]
-    rng = np.random.default_rng(HASH_SEED)
-    weights = rng.integers(1, 2**61, size=n_rt + 1)
-    by_rank = rng.integers(1, 2**61, size=int(lay.count.max(initial=1)))
-    ordered = lay.by_patch
-    with np.errstate(over="ignore"):
-        pair_hash = ((pairs.class_of(ordered) * weights[0]
-                      + lay.local[ordered].astype(np.int64) @ weights[1:])
-                     * by_rank[lay.rank[ordered]])
-        patch_hash = np.zeros(lay.count.size, dtype=np.int64)
-        filled = lay.count > 0
-        patch_hash[filled] = np.add.reduceat(pair_hash, lay.start[filled])
-    keys = np.stack([size, lay.count, clamped.astype(np.int64), patch_hash], axis=1)
-    owner = patch_classes(keys)
-    return np.where(_same_pairs(lay, pairs, owner), owner, np.arange(owner.size))
-
-
-def _same_pairs(lay: PatchLayout, pairs: PairMatrices, owner: np.ndarray) -> np.ndarray:
-    """Whether each patch's pairs equal its ``owner``'s, rank by rank: element class and
-    local positions (the hash of ``_owners`` grouped them; this rules out collisions)."""
-    other = np.flatnonzero(owner != np.arange(owner.size))
-    same = np.ones(owner.size, dtype=bool)
-    if other.size == 0:
-        return same
-    mine, theirs = lay.pairs_of(other), lay.pairs_of(owner[other])   # equal counts: in the key
-    differs = ((pairs.class_of(mine) != pairs.class_of(theirs))
-               | (lay.local[mine] != lay.local[theirs]).any(axis=1))
-    patch = np.repeat(np.arange(other.size), lay.count[other])
-    same[other] = np.bincount(patch, differs, minlength=other.size) == 0
-    return same
 
 
 def _solve_chunk(lay, chunk, n, pairs, clamped, owner, out) -> None:

@@ -67,8 +67,9 @@ def test_shared_systems_give_the_stress_of_one_solve_per_patch(monkeypatch, orde
     solution = solve(get_formulation("vi")(scene, locally_refined(scene, 3), order=order),
                      "active-set")
     monkeypatch.setattr(patches, "BATCH", 64)      # several chunks, several classes each
-    owners, classify = [], patches._owners
-    monkeypatch.setattr(patches, "_owners", lambda *a: owners.append(classify(*a)) or owners[-1])
+    owners, classify = [], patches.patch_owners
+    monkeypatch.setattr(patches, "patch_owners",
+                        lambda *a: owners.append(classify(*a)) or owners[-1])
     shared = equilibrate(scene, solution, symmetrise=row_by_row)[0].dofs
     # the classes repeat: most chunks take the inverses, not an LU per patch
     assert 8 * np.unique(owners[0]).size < owners[0].size
@@ -88,13 +89,13 @@ def test_patches_whose_hashes_collide_keep_their_own_systems(monkeypatch):
     alone = equilibrate(scene, solution, symmetrise=row_by_row)[0].dofs
     monkeypatch.undo()
     monkeypatch.setattr(patches, "BATCH", 64)
-    shared_hashes, owners = patches.patch_classes, []
+    shared_hashes, owners = patch_classes.patch_classes, []
 
     def colliding(keys):
         owners.append(shared_hashes(keys[:, :3]))
         return owners[-1]
 
-    monkeypatch.setattr(patches, "patch_classes", colliding)
+    monkeypatch.setattr(patch_classes, "patch_classes", colliding)
     merged = equilibrate(scene, solution, symmetrise=row_by_row)[0].dofs
     assert np.unique(owners[0]).size <= 10    # 199 distinct systems, grouped as 8
     assert np.abs(merged - alone).max() <= 1e-11 * np.abs(alone).max()
