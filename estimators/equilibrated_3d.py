@@ -35,7 +35,7 @@ from estimators.equilibration import (
 )
 from estimators.guaranteed_contact import ContactBounds
 from estimators.guaranteed_contact_3d import surface_traction
-from estimators.jump_flux import flux_oscillation
+from estimators.jump_flux import SMOOTH_LEVELS, flux_oscillation
 from estimators.oscillation import oscillation
 from estimators.patch_data import interior_data, rebalanced
 from estimators.raviart_thomas_tet import sorted_tetrahedra
@@ -59,18 +59,33 @@ def estimate(scene, solution: DiscreteSolution) -> Estimate:
                   * rec.basis.dx).sum(axis=1)
     skew = ((0.5 * (rec.values - rec.values.transpose(1, 0, 2, 3))) ** 2).sum(axis=(0, 1))
     skew = (skew * rec.basis.dx).sum(axis=1)
-    jump = flux_oscillation(rec.basis.mesh, scene.body_force, rec.basis.elem.k,
-                            gap=stress_gap(rec, solution, stress_at), lame=(lam, mu))
-    if jump is not None:  # where f jumps: sigma* - tau on the rough elements (13.2)
-        if jump.divergence_defect > BALANCE_TOLERANCE:
-            raise NotEquilibrated(f"the moments of f - Pi_k f miss zero by "
-                                  f"{jump.divergence_defect:.1e} (relative) > "
-                                  f"{BALANCE_TOLERANCE:g}: no bound")
-        compliance[jump.elements], skew[jump.elements] = jump.symmetric, jump.skew
-    osc = oscillation(scene, rec.basis, boundary, jump)
+    osc = oscillation(scene, rec.basis, boundary,
+                      *body_force_terms(scene, solution, rec, compliance, skew))
     parts, volume = volume_parts(compliance, skew, osc, load.squares, constants, mu)
     return smallest(scene, solution, parts, volume, ContactBounds(marking=bounds, sharp=bounds),
                     None, "equilibrated")
+
+
+def body_force_terms(scene, solution: DiscreteSolution, rec, compliance: np.ndarray,
+                     skew: np.ndarray) -> tuple:
+    """The oscillation of f by RT_0 fluxes on sub-tetrahedra (``estimators.jump_flux``; 13.2,
+    "Where f jumps, element by element"): on the rough elements inside sigma* (their
+    ``compliance`` and ``skew`` squares replaced by those of sigma* - tau), on the others
+    apart; (None, None) without a body force."""
+    mesh, k = rec.basis.mesh, rec.basis.elem.k
+    jump = flux_oscillation(mesh, scene.body_force, k, gap=stress_gap(rec, solution, stress_at),
+                            lame=solution.elasticity.lame)
+    rough = np.zeros(0, dtype=np.int64) if jump is None else jump.elements
+    smooth = flux_oscillation(mesh, scene.body_force, k, SMOOTH_LEVELS,
+                              elements=np.setdiff1d(np.arange(mesh.t.shape[1]), rough))
+    for part in (jump, smooth):
+        if part is not None and part.divergence_defect > BALANCE_TOLERANCE:
+            raise NotEquilibrated(f"the moments of f - Pi_k f miss zero by "
+                                  f"{part.divergence_defect:.1e} (relative) > "
+                                  f"{BALANCE_TOLERANCE:g}: no bound")
+    if jump is not None:
+        compliance[jump.elements], skew[jump.elements] = jump.symmetric, jump.skew
+    return jump, smooth
 
 
 def equilibrate(scene, solution: DiscreteSolution):

@@ -34,6 +34,9 @@ from estimators.sub_simplices import REFERENCE_CELL, SubSimplices, sub_simplices
 from formulations.load import mapped_rule
 
 SUB_LEVELS = 2  # 8^2 = 64 sub-tetrahedra per rough element
+# where f is smooth, 8 sub-tetrahedra: (sum osc_T^2)^(1/2) 2.3x below Poincare's on T at a
+# thirtieth of the cost of 64 (docs/theory.md, 13.2, "Where f jumps, element by element")
+SMOOTH_LEVELS = 1
 RULE_DEGREE = 5  # on each sub-simplex; scikit-fem's degree-5 rules have positive weights
 CHUNK = 2000  # elements per batch
 # rules with positive weights exact for the squares of sigma* - tau (scikit-fem's tetrahedron
@@ -46,8 +49,8 @@ class FluxOscillation:
     """Per rough element (``elements``): ||tau||_T^2 (``flux``), sum_S (h_S / pi)^2
     ||r_1||_S^2 (``remainder``) and, if ``combined``, ||C^-1/2 sym(g - tau)||_T^2
     (``symmetric``) and ||skw(g - tau)||_T^2 (``skew``) for the stress gap g = sigma* - sigma_h;
-    ``divergence_defect`` the largest |sum_S m_S| relative to sum_S |m_S| (round-off: the
-    moments have zero sum on every element)."""
+    ``divergence_defect`` the largest |sum_S m_S| over the elements relative to the largest
+    int_T |f| (round-off: the moments have zero sum on every element)."""
 
     elements: np.ndarray
     flux: np.ndarray
@@ -71,44 +74,48 @@ class FluxOscillation:
 
 
 def flux_oscillation(mesh, body_force, k: int, levels: int = SUB_LEVELS, gap=None,
-                     lame: tuple[float, float] | None = None) -> FluxOscillation | None:
-    """The terms of the module docstring on the rough elements of ``mesh`` for sigma* with
-    divergence in P_k (None if f is smooth on every element). With ``gap`` (sigma* - sigma_h
-    (d, d, n, nq) at points x (d, n, nq) of elements ``cells``: ``gap(x, cells)``) and
-    ``lame``, tau goes inside sigma*: the terms of sigma* - tau are ``combined``."""
+                     lame: tuple[float, float] | None = None,
+                     elements: np.ndarray | None = None) -> FluxOscillation | None:
+    """The terms of the module docstring on the rough elements of ``mesh`` (or on
+    ``elements``) for sigma* with divergence in P_k (None if there are none, or no f). With
+    ``gap`` (sigma* - sigma_h (d, d, n, nq) at points x (d, n, nq) of elements ``cells``:
+    ``gap(x, cells)``) and ``lame``, tau goes inside sigma*: the terms of sigma* - tau are
+    ``combined``."""
     if (gap is None) != (lame is None):
         raise ValueError("flux_oscillation: gap and lame go together (got "
                          f"gap={'set' if gap is not None else None}, lame={lame})")
-    rough = rough_elements(mesh, body_force, k)
+    if body_force is None:
+        return None
+    rough = rough_elements(mesh, body_force, k) if elements is None else np.asarray(elements)
     if rough.size == 0:
         return None
     parts = [_chunk_terms(mesh, rough[s:s + CHUNK], body_force, k, levels, gap, lame)
              for s in range(0, rough.size, CHUNK)]
-    flux, remainder, defect, symmetric, skew = (
+    flux, remainder, missed, scale, symmetric, skew = (
         None if parts[0][i] is None else np.concatenate([p[i] for p in parts])
-        for i in range(5))
+        for i in range(6))
+    defect = missed.max() / max(scale.max(), np.finfo(float).tiny)
     return FluxOscillation(elements=rough, flux=flux, remainder=remainder,
-                           divergence_defect=float(defect.max()), symmetric=symmetric,
+                           divergence_defect=float(defect), symmetric=symmetric,
                            skew=skew)
 
 
 def _chunk_terms(mesh, cells, body_force, k: int, levels: int, gap, lame):
-    """flux, remainder, the moments' relative defect and, with ``gap``, the terms of
-    sigma* - tau (``FluxOscillation``) on ``cells``."""
+    """flux, remainder, |sum_S m_S| and int_T |f| (largest over the rows) and, with
+    ``gap``, the terms of sigma* - tau (``FluxOscillation``) on ``cells``."""
     d = mesh.dim()
     finest = sub_simplices(d, levels)
-    moments, squares = _sub_moments(mesh, cells, body_force, k, finest)  # (n, n_sub, d), (n, n_sub)
+    moments, squares, scale = _sub_moments(mesh, cells, body_force, k, finest)
     A = mesh.mapping().A[:, :, cells].transpose(2, 0, 1)                # (n, d, d)
     det = np.abs(np.linalg.det(A))
     r_1 = np.clip(squares - (moments**2).sum(axis=2) / (det[:, None] * finest.volume), 0.0,
                   None)
     remainder = ((_sub_diameters(A, finest) / np.pi) ** 2 * r_1).sum(axis=1)
     flux, coefficients = _least_flux(A, moments, finest)
-    total = np.abs(moments).sum(axis=1).max(axis=1)
-    defect = np.abs(moments.sum(axis=1)).max(axis=1) / np.maximum(total, np.finfo(float).tiny)
+    missed = np.abs(moments.sum(axis=1)).max(axis=1)
     if gap is None:
-        return flux, remainder, defect, None, None
-    return (flux, remainder, defect,
+        return flux, remainder, missed, scale, None, None
+    return (flux, remainder, missed, scale,
             *_gap_terms(mesh, cells, coefficients, finest, k, gap, lame))
 
 
@@ -138,8 +145,9 @@ def _gap_terms(mesh, cells, coefficients, sub: SubSimplices, k: int, gap, lame):
 
 def _sub_moments(mesh, cells, body_force, k: int, sub: SubSimplices):
     """int_S r (n, n_sub, d) and int_S |r|^2 (n, n_sub), r = f - Pi_k f, per sub-simplex of
-    every element of ``cells``: one rule of degree RULE_DEGREE per sub-simplex, Pi_k f the L2
-    projection on T with the same rule (so the moments sum to zero on T up to round-off)."""
+    every element of ``cells``, and int_T |f| (n,), the largest over the rows: one rule of
+    degree RULE_DEGREE per sub-simplex, Pi_k f the L2 projection on T with the same rule (so
+    the moments sum to zero on T up to round-off)."""
     d = mesh.dim()
     X, W = mapped_rule(sub.corners, get_quadrature(REFERENCE_CELL[d], RULE_DEGREE))
     shape = W.shape                                                      # (n_sub, nq)
@@ -157,7 +165,8 @@ def _sub_moments(mesh, cells, body_force, k: int, sub: SubSimplices):
     weighted = w.reshape(shape) * det                                    # (n, n_sub, nq)
     moments = (r.reshape(d, -1, *shape) * weighted).sum(axis=-1).transpose(1, 2, 0)
     squares = ((r**2).sum(axis=0).reshape(-1, *shape) * weighted).sum(axis=-1)
-    return moments, squares
+    scale = (np.abs(f).reshape(d, -1, *shape) * weighted).sum(axis=(2, 3)).max(axis=0)
+    return moments, squares, scale
 
 
 def _sub_diameters(A: np.ndarray, sub: SubSimplices) -> np.ndarray:

@@ -17,19 +17,20 @@ from scenes.base import simplex_measures
 
 
 def oscillation(scene, rt: Basis, boundary: list[BoundaryData],
-                jump: JumpOscillation | FluxOscillation | None = None) -> np.ndarray:
+                *jumps: JumpOscillation | FluxOscillation | None) -> np.ndarray:
     """Per element, (h_T / pi) ||f - Pi_k f||_T + sum_e C_e ||t - Pi_k t||_e over its facets
     with Neumann data, C_e^2 = |e| h_T^2 / |T| (1/pi^2 + 2/(d pi)) in d dimensions
-    (docs/theory.md, 13.2); on the elements of ``jump`` its own term of f instead (13.2, "Where
-    f jumps": ``JumpOscillation`` or ``FluxOscillation``)."""
+    (docs/theory.md, 13.2); on the elements of each of ``jumps`` its own term of f instead
+    (13.2, "Where f jumps": ``JumpOscillation`` or ``FluxOscillation``; None: none)."""
     mesh, k, d = rt.mesh, rt.elem.k, rt.mesh.dim()
     out = np.zeros(mesh.t.shape[1])
     if scene.body_force is not None:
         dg = Basis(mesh, ElementDG(scalar_lagrange(k, d)), quadrature=rt.quadrature)
         f = scene.body_force(np.asarray(rt.global_coordinates()))
         out += element_diameters(mesh) / np.pi * np.sqrt(projection_error(dg, f))
-        if jump is not None:
-            out[jump.elements] = np.sqrt(jump.osc_squares)
+        for jump in jumps:
+            if jump is not None:
+                out[jump.elements] = np.sqrt(jump.osc_squares)
     for part in boundary:
         if part.facets.size == 0:
             continue
