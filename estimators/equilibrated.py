@@ -137,12 +137,15 @@ def volume_parts(compliance: np.ndarray, skew: np.ndarray, osc: np.ndarray,
 
 def stress_gap(rec, solution: DiscreteSolution, stress=stress_at):
     """sigma* - sigma_h (d, d, n, nq) at points x (d, n, nq) of the elements ``cells``, as a
-    function ``gap(x, cells)`` (``estimators.jump_equilibration``, ``stress_gap``), sigma_h
-    from ``stress(solution, x (d, m), cells (m,))``."""
-    def gap(x: np.ndarray, cells: np.ndarray) -> np.ndarray:
+    function ``gap(x, cells, reference=None)`` (``estimators.jump_equilibration``,
+    ``stress_gap``; ``reference`` as in ``ReferenceRT.values_at``), sigma_h from
+    ``stress(solution, x (d, m), cells (m,))``."""
+    def gap(x: np.ndarray, cells: np.ndarray, reference: np.ndarray | None = None
+            ) -> np.ndarray:
         d = x.shape[0]
         sigma_h = stress(solution, x.reshape(d, -1), np.repeat(cells, x.shape[2]))
-        return rec.basis.values_at(rec.dofs, x, cells) - sigma_h.reshape(d, d, *x.shape[1:])
+        return (rec.basis.values_at(rec.dofs, x, cells, reference)
+                - sigma_h.reshape(d, d, *x.shape[1:]))
 
     return gap
 

@@ -78,9 +78,9 @@ def flux_oscillation(mesh, body_force, k: int, levels: int = SUB_LEVELS, gap=Non
                      elements: np.ndarray | None = None) -> FluxOscillation | None:
     """The terms of the module docstring on the rough elements of ``mesh`` (or on
     ``elements``) for sigma* with divergence in P_k (None if there are none, or no f). With
-    ``gap`` (sigma* - sigma_h (d, d, n, nq) at points x (d, n, nq) of elements ``cells``:
-    ``gap(x, cells)``) and ``lame``, tau goes inside sigma*: the terms of sigma* - tau are
-    ``combined``."""
+    ``gap`` (sigma* - sigma_h (d, d, n, nq) at points x (d, n, nq) of elements ``cells``,
+    the images of the reference points X (d, nq): ``gap(x, cells, X)``) and ``lame``, tau
+    goes inside sigma*: the terms of sigma* - tau are ``combined``."""
     if (gap is None) != (lame is None):
         raise ValueError("flux_oscillation: gap and lame go together (got "
                          f"gap={'set' if gap is not None else None}, lame={lame})")
@@ -132,7 +132,7 @@ def _gap_terms(mesh, cells, coefficients, sub: SubSimplices, k: int, gap, lame):
     x = np.einsum("ijn,jq->inq", A, X.reshape(d, -1)) + b[:, :, None]   # (d, n, n_sub nq)
     det = np.abs(np.linalg.det(A.transpose(2, 0, 1)))
     tau = np.einsum("acn,nrcsq->ransq", A, sub.values(coefficients, X)) / det[:, None, None]
-    values = gap(x, cells) - tau.reshape(d, d, cells.size, -1)
+    values = gap(x, cells, X.reshape(d, -1)) - tau.reshape(d, d, cells.size, -1)
     sym = 0.5 * (values + values.transpose(1, 0, 2, 3))
     trace = np.einsum("iinp->np", sym)
     lam, mu = lame

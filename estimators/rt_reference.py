@@ -89,15 +89,22 @@ class ReferenceRT:
                               optimize=True)
         return self._piola(reference, slice(None))
 
-    def values_at(self, dofs: np.ndarray, x: np.ndarray, cells: np.ndarray) -> np.ndarray:
+    def values_at(self, dofs: np.ndarray, x: np.ndarray, cells: np.ndarray,
+                  reference: np.ndarray | None = None) -> np.ndarray:
         """The values (r, d, n, nq) of fields with RT DOFs ``dofs`` (r, N) at physical points
-        x (d, n, nq), row i of x in element cells[i] (the Piola map of ``values``)."""
+        x (d, n, nq), row i of x in element cells[i] (the Piola map of ``values``); with
+        ``reference`` (d, nq), the reference points that x are the images of in every cell
+        (the basis is then evaluated once, not at every point)."""
+        if reference is not None:
+            phi, _ = reference_rt(self.elem.k, reference)                   # (n_rt, d, nq)
+            return self._piola(np.einsum("rjn,jcp->rcnp", self._signed(dofs, cells), phi),
+                               cells)
         d, n, nq = x.shape
         X = np.asarray(self.mesh.mapping().invF(x, tind=cells)).reshape(d, -1)
         n_rt = self.element_dofs.shape[0]
         phi = np.array([self.elem.lbasis(X, j)[0] for j in range(n_rt)]).reshape(n_rt, d, n, nq)
-        reference = np.einsum("rjn,jcnp->rcnp", self._signed(dofs, cells), phi)
-        return self._piola(reference, cells)
+        values = np.einsum("rjn,jcnp->rcnp", self._signed(dofs, cells), phi)
+        return self._piola(values, cells)
 
     def _signed(self, dofs: np.ndarray, cells) -> np.ndarray:
         """o_j times the DOF values (r, n_rt, n) of the elements ``cells``."""

@@ -144,8 +144,8 @@ def test_inside_sigma_star_a_zero_gap_leaves_the_flux_itself():
     """With g = 0, lambda = 0 and 2 mu = 1, ||C^-1/2 sym tau||^2 + ||skw tau||^2 = ||tau||^2:
     the values of tau at the sub-simplices' points against its mass-matrix norm."""
     mesh = _element().refined(1)
-    jump = flux_oscillation(mesh, _jumping, 1, gap=lambda x, cells: np.zeros((3, 3, *x.shape[1:])),
-                            lame=(0.0, 0.5))
+    jump = flux_oscillation(mesh, _jumping, 1, lame=(0.0, 0.5),
+                            gap=lambda x, cells, X: np.zeros((3, 3, *x.shape[1:])))
     assert jump.combined and jump.elements.size > 0
     # the same integral of a degree-2 polynomial two ways: round-off
     assert np.allclose(jump.symmetric + jump.skew, jump.flux, rtol=1e-10)
@@ -154,7 +154,7 @@ def test_inside_sigma_star_a_zero_gap_leaves_the_flux_itself():
 
 def test_a_gap_without_lame_parameters_is_refused():
     with pytest.raises(ValueError, match="gap and lame"):
-        flux_oscillation(_element(), _jumping, 1, gap=lambda x, cells: 0 * x)
+        flux_oscillation(_element(), _jumping, 1, gap=lambda x, cells, X: 0 * x)
 
 
 def test_batches_and_shapes_do_not_change_the_terms(monkeypatch):

@@ -82,3 +82,6 @@ def test_values_at_points_of_chosen_elements_are_scikit_fems(k, skewed_mesh):
     expected = np.array([np.asarray(basis.interpolate(d))[:, cells] for d in dofs])
     got = rt.values_at(dofs, x, cells)
     assert np.abs(got - expected).max() <= 1e-12 * np.abs(expected).max()
+    # the same points named by their reference coordinates: the basis evaluated once
+    shared = rt.values_at(dofs, x, cells, reference=X)
+    assert np.abs(shared - expected).max() <= 1e-12 * np.abs(expected).max()
