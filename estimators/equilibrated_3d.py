@@ -8,9 +8,9 @@ batched patch problems as on triangles (``estimators.equilibration``), with Neum
 symmetric by the curl of a potential (``estimators.symmetrisation_3d``): A = ||C^{-1/2}(sym
 sigma* - sigma_h)|| + C_K ||skw sigma*|| + C_G osc + C_F ||rho||, with the constants of
 ``estimators.constants`` on the 3D domain and the oscillation of ``estimators.oscillation``;
-where f jumps inside elements, an RT_0 flux on sub-tetrahedra takes most of it into sigma*
-(``estimators.jump_flux``; 13.2, "Where f jumps, element by element"). Frictionless contact
-only.
+the body force's part by RT_0 fluxes on sub-tetrahedra (``estimators.jump_flux``; 13.2,
+"Where f jumps, element by element"), inside sigma* where f jumps inside elements.
+Frictionless contact only.
 """
 
 from __future__ import annotations

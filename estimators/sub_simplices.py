@@ -11,7 +11,7 @@ import numpy as np
 from skfem.quadrature import get_quadrature
 from skfem.refdom import RefTet, RefTri
 
-from formulations.load import _REFERENCE, children, mapped_rule
+from formulations.load import REFERENCE_SIMPLEX, children, mapped_rule
 
 REFERENCE_CELL = {2: RefTri, 3: RefTet}
 
@@ -56,7 +56,7 @@ class SubSimplices:
 @lru_cache(maxsize=4)
 def sub_simplices(d: int, levels: int) -> SubSimplices:
     """The refined reference simplex and its RT_0 data (``SubSimplices``)."""
-    corners = _REFERENCE[d][None]
+    corners = REFERENCE_SIMPLEX[d][None]
     for _ in range(levels):
         corners = children(corners)
     n_sub = corners.shape[0]
