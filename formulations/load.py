@@ -29,8 +29,9 @@ MAX_DEPTH_3D = 2  # tetrahedra: 8^depth children each; see the module docstring
 ROUGH_TOLERANCE = 1e-4
 CHUNK = 100_000  # points per block when adding the refined rule's contributions
 # the reference triangle and tetrahedron, corners as rows
-REFERENCE_SIMPLEX = {2: np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]),
-              3: np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])}
+REFERENCE_SIMPLEX = {
+    2: np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]),
+    3: np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])}
 # the red refinement of a tetrahedron (0, 1, 2, 3) as corners among its vertices (0-3) and
 # edge midpoints (4: 01, 5: 02, 6: 03, 7: 12, 8: 13, 9: 23); the octahedron cut along 5-8
 TET_CHILDREN = np.array([[0, 4, 5, 6], [4, 1, 7, 8], [5, 7, 2, 9], [6, 8, 9, 3],
