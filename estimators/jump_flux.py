@@ -36,8 +36,8 @@ from estimators.sub_simplices import REFERENCE_CELL, SubSimplices, sub_simplices
 from formulations.load import mapped_rule
 
 SUB_LEVELS = 2  # 8^2 = 64 sub-tetrahedra per rough element
-# where f is smooth, 8 sub-tetrahedra: (sum osc_T^2)^(1/2) 2.3x below Poincare's on T at a
-# thirtieth of the cost of 64 (docs/theory.md, 13.2, "Where f jumps, element by element")
+# where f is smooth, 8 sub-tetrahedra: (sum osc_T^2)^(1/2) 2.3x below Poincare's on T in a
+# 26th of the time of 64 (docs/theory.md, 13.2, "Where f jumps, element by element")
 SMOOTH_LEVELS = 1
 RULE_DEGREE = 5  # on each sub-simplex; scikit-fem's degree-5 rules have positive weights
 CHUNK = 2000  # elements per batch
@@ -48,11 +48,12 @@ GAP_DEGREE = {1: 2, 2: 5}
 
 @dataclass(frozen=True, eq=False)
 class FluxOscillation:
-    """Per rough element (``elements``): ||tau||_T^2 (``flux``), sum_S (h_S / pi)^2
-    ||r_1||_S^2 (``remainder``) and, if ``combined``, ||C^-1/2 sym(g - tau)||_T^2
-    (``symmetric``) and ||skw(g - tau)||_T^2 (``skew``) for the stress gap g = sigma* - sigma_h;
-    ``divergence_defect`` the largest |sum_S m_S| over the elements relative to the largest
-    int_T |f| (round-off: the moments have zero sum on every element)."""
+    """Per element of ``elements`` (the rough ones, or those asked for): ||tau||_T^2
+    (``flux``), sum_S (h_S / pi)^2 ||r_1||_S^2 (``remainder``) and, if ``combined``,
+    ||C^-1/2 sym(g - tau)||_T^2 (``symmetric``) and ||skw(g - tau)||_T^2 (``skew``) for the
+    stress gap g = sigma* - sigma_h; ``divergence_defect`` the largest |sum_S m_S| over the
+    elements relative to the largest int_T |f| (round-off: the moments have zero sum on every
+    element)."""
 
     elements: np.ndarray
     flux: np.ndarray
