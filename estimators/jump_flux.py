@@ -32,7 +32,7 @@ from skfem.quadrature import get_quadrature
 from estimators.jump_equilibration import rough_elements
 from estimators.patch_data import scalar_lagrange
 from estimators.rt_reference import scalar_values
-from estimators.sub_simplices import REFERENCE_CELL, SubSimplices, sub_simplices
+from estimators.sub_simplices import SubSimplices, sub_simplices
 from formulations.load import mapped_rule
 
 SUB_LEVELS = 2  # 8^2 = 64 sub-tetrahedra per rough element
@@ -106,8 +106,7 @@ def flux_oscillation(mesh, body_force, k: int, levels: int = SUB_LEVELS, gap=Non
 def _chunk_terms(mesh, cells, body_force, k: int, levels: int, gap, lame):
     """flux, remainder, |sum_S m_S| and int_T |f| (largest over the rows) and, with
     ``gap``, the terms of sigma* - tau (``FluxOscillation``) on ``cells``."""
-    d = mesh.dim()
-    finest = sub_simplices(d, levels)
+    finest = sub_simplices(mesh.elem.refdom, levels)
     moments, squares, scale = _sub_moments(mesh, cells, body_force, k, finest)
     A = mesh.mapping().A[:, :, cells].transpose(2, 0, 1)                # (n, d, d)
     det = np.abs(np.linalg.det(A))
@@ -129,7 +128,7 @@ def _gap_terms(mesh, cells, coefficients, sub: SubSimplices, k: int, gap, lame):
         raise ValueError(f"k={k} has no rule for the stress gap here (allowed: "
                          f"{sorted(GAP_DEGREE)})")
     d = mesh.dim()
-    X, W = mapped_rule(sub.corners, get_quadrature(REFERENCE_CELL[d], GAP_DEGREE[k]))
+    X, W = mapped_rule(sub.corners, get_quadrature(sub.refdom, GAP_DEGREE[k]))
     mapping = mesh.mapping()
     A, b = mapping.A[:, :, cells], mapping.b[:, cells]
     x = np.einsum("ijn,jq->inq", A, X.reshape(d, -1)) + b[:, :, None]   # (d, n, n_sub nq)
@@ -152,7 +151,7 @@ def _sub_moments(mesh, cells, body_force, k: int, sub: SubSimplices):
     degree RULE_DEGREE per sub-simplex, Pi_k f the L2 projection on T with the same rule (so
     the moments sum to zero on T up to round-off)."""
     d = mesh.dim()
-    X, W = mapped_rule(sub.corners, get_quadrature(REFERENCE_CELL[d], RULE_DEGREE))
+    X, W = mapped_rule(sub.corners, get_quadrature(sub.refdom, RULE_DEGREE))
     shape = W.shape                                                      # (n_sub, nq)
     mapping = mesh.mapping()
     A, b = mapping.A[:, :, cells], mapping.b[:, cells]

@@ -6,25 +6,25 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import lru_cache
+from math import factorial
 
 import numpy as np
 from skfem.quadrature import get_quadrature
-from skfem.refdom import RefTet, RefTri
 
-from formulations.load import REFERENCE_SIMPLEX, children, mapped_rule
-
-REFERENCE_CELL = {2: RefTri, 3: RefTet}
+from formulations.load import children, mapped_rule
 
 
 @dataclass(frozen=True, eq=False)
 class SubSimplices:
-    """The reference simplex refined ``levels`` times (the load rule's red refinement):
-    ``corners`` (n_sub, d + 1, d), ``face`` (n_sub, d + 1) the inner face opposite each local
-    vertex (-1 on the simplex's boundary), ``sign`` (n_sub, d + 1) +1 where the sub-simplex is
-    the face's first, the signed incidence B (n_sub, n_inner) and C (d, d, n_inner, n_inner),
-    C[p, q, F, G] = int phi_F,p phi_G,q, phi_F the RT_0 function of unit flux across F from
-    its first sub-simplex to its second."""
+    """The reference simplex ``refdom`` (scikit-fem's ``RefTri`` or ``RefTet``) refined
+    ``levels`` times (the load rule's red refinement): ``corners`` (n_sub, d + 1, d),
+    ``face`` (n_sub, d + 1) the inner face opposite each local vertex (-1 on the simplex's
+    boundary), ``sign`` (n_sub, d + 1) +1 where the sub-simplex is the face's first, the
+    signed incidence B (n_sub, n_inner) and C (d, d, n_inner, n_inner), C[p, q, F, G] = int
+    phi_F,p phi_G,q, phi_F the RT_0 function of unit flux across F from its first
+    sub-simplex to its second."""
 
+    refdom: type
     corners: np.ndarray
     face: np.ndarray
     sign: np.ndarray
@@ -35,7 +35,7 @@ class SubSimplices:
     def volume(self) -> float:
         """The measure of one sub-simplex (they are all alike)."""
         edges = self.corners[0, 1:] - self.corners[0, :1]
-        return float(abs(np.linalg.det(edges)) / (2.0 if edges.shape[0] == 2 else 6.0))
+        return float(abs(np.linalg.det(edges)) / factorial(edges.shape[0]))
 
     def local_rt0(self, X: np.ndarray) -> np.ndarray:
         """phi (d + 1, d, n_sub, nq) at the points X (d, n_sub, nq) of every sub-simplex:
@@ -54,9 +54,10 @@ class SubSimplices:
 
 
 @lru_cache(maxsize=4)
-def sub_simplices(d: int, levels: int) -> SubSimplices:
+def sub_simplices(refdom: type, levels: int) -> SubSimplices:
     """The refined reference simplex and its RT_0 data (``SubSimplices``)."""
-    corners = REFERENCE_SIMPLEX[d][None]
+    d = refdom.dim()
+    corners = refdom.p.T[None]
     for _ in range(levels):
         corners = children(corners)
     n_sub = corners.shape[0]
@@ -76,13 +77,13 @@ def sub_simplices(d: int, levels: int) -> SubSimplices:
     incidence = np.zeros((n_sub, int((counts == 2).sum())))
     rows, cols = np.nonzero(inner)
     incidence[rows, face[rows, cols]] = sign[rows, cols]
-    sub = SubSimplices(corners, face, sign, incidence, np.zeros(0))
-    return SubSimplices(corners, face, sign, incidence, _rt0_tensors(sub))
+    sub = SubSimplices(refdom, corners, face, sign, incidence, np.zeros(0))
+    return SubSimplices(refdom, corners, face, sign, incidence, _rt0_tensors(sub))
 
 
 def _rt0_tensors(sub: SubSimplices) -> np.ndarray:
     """C of ``SubSimplices``, integrated exactly (degree 2) sub-simplex by sub-simplex."""
-    d, n_inner = sub.corners.shape[2], sub.incidence.shape[1]
-    X, W = mapped_rule(sub.corners, get_quadrature(REFERENCE_CELL[d], 2))
+    n_inner = sub.incidence.shape[1]
+    X, W = mapped_rule(sub.corners, get_quadrature(sub.refdom, 2))
     values = sub.values(np.eye(n_inner)[None], X)[0]                    # (F, d, n_sub, nq)
     return np.einsum("Fpsx,Gqsx,sx->pqFG", values, values, W)

@@ -28,10 +28,8 @@ MAX_DEPTH = 5  # a rough element ends in sub-triangles down to 1/32 of its size
 MAX_DEPTH_3D = 2  # tetrahedra: 8^depth children each; see the module docstring
 ROUGH_TOLERANCE = 1e-4
 CHUNK = 100_000  # points per block when adding the refined rule's contributions
-# the reference triangle and tetrahedron, corners as rows
-REFERENCE_SIMPLEX = {
-    2: np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]),
-    3: np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])}
+_REFERENCE = {2: np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]),
+              3: np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])}
 # the red refinement of a tetrahedron (0, 1, 2, 3) as corners among its vertices (0-3) and
 # edge midpoints (4: 01, 5: 02, 6: 03, 7: 12, 8: 13, 9: 23); the octahedron cut along 5-8
 TET_CHILDREN = np.array([[0, 4, 5, 6], [4, 1, 7, 8], [5, 7, 2, 9], [6, 8, 9, 3],
@@ -102,15 +100,15 @@ def refined_rule(body_force, basis: Basis, max_depth: int | None = None):
     if max_depth is None:
         max_depth = MAX_DEPTH if d == 2 else MAX_DEPTH_3D
     k, volume = 2**d, 1.0 / (2 if d == 2 else 6)  # children per simplex; reference measure
-    cells, corners = np.arange(n), np.broadcast_to(REFERENCE_SIMPLEX[d], (n, d + 1, d))
+    cells, corners = np.arange(n), np.broadcast_to(_REFERENCE[d], (n, d + 1, d))
     scale = np.abs(body_force(np.asarray(basis.global_coordinates()))).max()
-    whole = shared_integrals(body_force, mapping, cells, REFERENCE_SIMPLEX[d][None], rule)
+    whole = shared_integrals(body_force, mapping, cells, _REFERENCE[d][None], rule)
     kept, rough = [], None
     for depth in range(max_depth + 1):
         if cells.size == 0:
             break
         if depth == 0:   # every element's children are the reference's: one mapped rule
-            reference = children(REFERENCE_SIMPLEX[d][None])
+            reference = children(_REFERENCE[d][None])
             sub = np.broadcast_to(reference, (n, k, d + 1, d))
             parts = shared_integrals(body_force, mapping, cells, reference, rule)
         else:

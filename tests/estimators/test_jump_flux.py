@@ -53,7 +53,7 @@ def test_a_polynomial_load_leaves_no_rough_element():
 def test_the_flux_balances_the_piecewise_constant_part():
     """(r_0, v)_T = -(tau, grad v)_T for a quadratic v: tau . n = 0 on the boundary of T and
     div tau = r_0 on every sub-tetrahedron."""
-    mesh, sub = _element(), sub_simplices(3, 2)
+    mesh, sub = _element(), sub_simplices(RefTet, 2)
     moments, *_ = _sub_moments(mesh, np.array([0]), _jumping, 1, sub)
     A = mesh.mapping().A[:, :, 0]
     _, coefficients = _least_flux(A[None], moments, sub)
@@ -171,7 +171,7 @@ def test_batches_and_shapes_do_not_change_the_terms(monkeypatch):
 def test_the_remainder_is_poincare_on_every_sub_simplex():
     """sum_S (h_S / pi)^2 ||r - mean_S r||_S^2 for a quadratic f (no jump: exact rules),
     recomputed on scikit-fem's mesh of the 64 mapped sub-tetrahedra, h_S its diameters."""
-    mesh, sub = _element(), sub_simplices(3, 2)
+    mesh, sub = _element(), sub_simplices(RefTet, 2)
     A = mesh.mapping().A[:, :, 0]
     points = np.einsum("ij,skj->isk", A, sub.corners) + CORNERS[:, :1, None]  # (3, 64, 4)
     nodes, index = np.unique(np.round(points.reshape(3, -1), 12), axis=1, return_inverse=True)
