@@ -20,6 +20,8 @@ and the geometric and complementarity terms are the shared ``contact_terms``.
 
 from __future__ import annotations
 
+from math import isqrt
+
 import numpy as np
 from skfem import Basis
 
@@ -63,11 +65,13 @@ def stresses(grad: np.ndarray, lame: tuple[float, float]) -> np.ndarray:
 
 
 def compliance_energy(stress: np.ndarray, lam: float, mu: float) -> np.ndarray:
-    """sigma : C^-1 sigma for stresses given as (s11, s22, s12, ...); in 3D as the nine
-    entries, (sigma : sigma - lambda / (3 lambda + 2 mu) (tr sigma)^2) / (2 mu)."""
-    if len(stress) == 9:
-        trace = stress[0] + stress[4] + stress[8]
-        return ((stress**2).sum(axis=0) - lam / (3 * lam + 2 * mu) * trace**2) / (2 * mu)
+    """sigma : C^-1 sigma for stresses given as (s11, s22, s12, ...), or as all d^2 entries of
+    a symmetric tensor (the nine in 3D): (sigma : sigma - lambda / (d lambda + 2 mu)
+    (tr sigma)^2) / (2 mu)."""
+    d = isqrt(len(stress))
+    if d * d == len(stress):
+        trace = sum(stress[i * (d + 1)] for i in range(d))
+        return ((stress**2).sum(axis=0) - lam / (d * lam + 2 * mu) * trace**2) / (2 * mu)
     s11, s22, s12 = stress
     trace = s11 + s22
     return (s11**2 + s22**2 + 2 * s12**2 - lam / (2 * (lam + mu)) * trace**2) / (2 * mu)

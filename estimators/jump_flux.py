@@ -29,6 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 from skfem.quadrature import get_quadrature
 
+from estimators.averaging import compliance_energy
 from estimators.jump_equilibration import rough_elements
 from estimators.patch_data import scalar_lagrange
 from estimators.rt_reference import scalar_values
@@ -129,16 +130,11 @@ def _gap_terms(mesh, cells, coefficients, sub: SubSimplices, k: int, gap, lame):
                          f"{sorted(GAP_DEGREE)})")
     d = mesh.dim()
     X, W = mapped_rule(sub.corners, get_quadrature(sub.refdom, GAP_DEGREE[k]))
-    mapping = mesh.mapping()
-    A, b = mapping.A[:, :, cells], mapping.b[:, cells]
-    x = np.einsum("ijn,jq->inq", A, X.reshape(d, -1)) + b[:, :, None]   # (d, n, n_sub nq)
-    det = np.abs(np.linalg.det(A.transpose(2, 0, 1)))
-    tau = np.einsum("acn,nrcsq->ransq", A, sub.values(coefficients, X)) / det[:, None, None]
+    x, A, det = _mapped(mesh, cells, X)
+    tau = np.einsum("nac,nrcsq->ransq", A, sub.values(coefficients, X)) / det[:, None, None]
     values = gap(x, cells, X.reshape(d, -1)) - tau.reshape(d, d, cells.size, -1)
     sym = 0.5 * (values + values.transpose(1, 0, 2, 3))
-    trace = np.einsum("iinp->np", sym)
-    lam, mu = lame
-    energy = ((sym**2).sum(axis=(0, 1)) - lam / (d * lam + 2 * mu) * trace**2) / (2 * mu)
+    energy = compliance_energy(sym.reshape(d * d, *sym.shape[2:]), *lame)
     skew = ((0.5 * (values - values.transpose(1, 0, 2, 3))) ** 2).sum(axis=(0, 1))
     weights = W.ravel()[None] * det[:, None]
     return (energy * weights).sum(axis=1), (skew * weights).sum(axis=1)
@@ -153,9 +149,7 @@ def _sub_moments(mesh, cells, body_force, k: int, sub: SubSimplices):
     d = mesh.dim()
     X, W = mapped_rule(sub.corners, get_quadrature(sub.refdom, RULE_DEGREE))
     shape = W.shape                                                      # (n_sub, nq)
-    mapping = mesh.mapping()
-    A, b = mapping.A[:, :, cells], mapping.b[:, cells]
-    x = np.einsum("ijn,jq->inq", A, X.reshape(d, -1)) + b[:, :, None]
+    x, _, det = _mapped(mesh, cells, X)
     f = body_force(x)                                                    # (d, n, n_sub nq)
     q = scalar_values(scalar_lagrange(k, d), X.reshape(d, -1))           # (n_dg, n_sub nq)
     w = W.ravel()
@@ -163,12 +157,20 @@ def _sub_moments(mesh, cells, body_force, k: int, sub: SubSimplices):
     coefficients = np.linalg.solve(mass, np.einsum("rnp,lp,p->lrn", f, q, w).reshape(
         q.shape[0], -1)).reshape(q.shape[0], d, -1)
     r = f - np.einsum("lrn,lp->rnp", coefficients, q)
-    det = np.abs(np.linalg.det(A.transpose(2, 0, 1)))[:, None, None]
-    weighted = w.reshape(shape) * det                                    # (n, n_sub, nq)
+    weighted = w.reshape(shape) * det[:, None, None]                     # (n, n_sub, nq)
     moments = (r.reshape(d, -1, *shape) * weighted).sum(axis=-1).transpose(1, 2, 0)
     squares = ((r**2).sum(axis=0).reshape(-1, *shape) * weighted).sum(axis=-1)
     scale = (np.abs(f).reshape(d, -1, *shape) * weighted).sum(axis=(2, 3)).max(axis=0)
     return moments, squares, scale
+
+
+def _mapped(mesh, cells, X: np.ndarray):
+    """The physical points (d, n, m) of the reference points X (d, ...) (m of them) in every
+    element of ``cells``, the elements' J (n, d, d) and |det J| (n,)."""
+    mapping = mesh.mapping()
+    A = mapping.A[:, :, cells]
+    x = np.einsum("ijn,jq->inq", A, X.reshape(X.shape[0], -1)) + mapping.b[:, cells, None]
+    return x, A.transpose(2, 0, 1), np.abs(mapping.detA[cells])
 
 
 def _sub_diameters(A: np.ndarray, sub: SubSimplices) -> np.ndarray:
