@@ -25,12 +25,16 @@ def oscillation(scene, rt: Basis, boundary: list[BoundaryData],
     mesh, k, d = rt.mesh, rt.elem.k, rt.mesh.dim()
     out = np.zeros(mesh.t.shape[1])
     if scene.body_force is not None:
-        dg = Basis(mesh, ElementDG(scalar_lagrange(k, d)), quadrature=rt.quadrature)
-        f = scene.body_force(np.asarray(rt.global_coordinates()))
-        out += element_diameters(mesh) / np.pi * np.sqrt(projection_error(dg, f))
+        rest = np.ones(mesh.t.shape[1], dtype=bool)   # the elements no part covers
         for jump in jumps:
             if jump is not None:
-                out[jump.elements] = np.sqrt(jump.osc_squares)
+                out[jump.elements], rest[jump.elements] = np.sqrt(jump.osc_squares), False
+        rest = np.flatnonzero(rest)
+        if rest.size:
+            dg = Basis(mesh, ElementDG(scalar_lagrange(k, d)), quadrature=rt.quadrature,
+                       elements=rest)
+            f = scene.body_force(np.asarray(dg.global_coordinates()))
+            out[rest] = element_diameters(mesh)[rest] / np.pi * np.sqrt(projection_error(dg, f))
     for part in boundary:
         if part.facets.size == 0:
             continue
