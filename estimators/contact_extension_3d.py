@@ -58,6 +58,12 @@ class SurfaceExtension:
         weights = corner_weights(t)
         return corner.T @ weights + self.bubble[:, None] * 27 * weights.prod(axis=0)
 
+    def tangential_part(self, surface, t: np.ndarray) -> np.ndarray:
+        """d - (d . n) n (3, n_f, nq) at local coordinates t (the bubbles are normal)."""
+        d = np.einsum("icf,cq->ifq", self.nodal[:, surface.vertices], corner_weights(t))
+        n = surface.normal[:, :, None]
+        return d - (d * n).sum(axis=0) * n
+
     def energy(self, mesh, lame: tuple[float, float], surface) -> np.ndarray:
         """a(d, d) per element (the bubbles' tetrahedra on a rule of ENERGY_ORDER)."""
         gradients, volume = barycentric_gradients(mesh)                   # (4, 3, n_el)

@@ -79,7 +79,7 @@ def friction_complementarity(scene, solution: DiscreteSolution, at_points, t: np
         size, work = np.abs(u_t), solution.friction.traction(t) * u_t
     else:
         normal = np.repeat(trace.normal, nq, axis=1)
-        u = u - np.array([law.slide, 0.0, 0.0])[:, None]  # relative to the obstacle (w = slide e_x)
+        u = u - law.slide_vector(3)[:, None]  # relative to the obstacle (w = slide e_x)
         u_t = u - np.einsum("in,in->n", u, normal) * normal
         size = np.linalg.norm(u_t, axis=0).reshape(trace.size, nq)
         work = np.einsum("in,in->n", solution.friction.traction(t).reshape(3, -1),

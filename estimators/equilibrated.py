@@ -20,6 +20,7 @@ D and eta_complementarity sqrt(B).
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -101,7 +102,7 @@ def friction_terms(friction, duals: DualNorms) -> dict[str, float]:
                                     "patches, symmetrised by the curl of a stream function "
                                     "(Prager-Synge), plus Theorem 1's contact terms, "
                                     "every constant computed; Tresca friction's terms too",
-                    guaranteed=True, applies=tresca_only, friction=True)
+                    guaranteed=True, applies=tresca_only, friction=(2, 3))
 def estimate(scene, solution: DiscreteSolution) -> Estimate:
     rec, interior, load, bounds, boundary, _, shear = equilibrate(scene, solution)
     lam, mu = solution.elasticity.lame
@@ -118,7 +119,8 @@ def estimate(scene, solution: DiscreteSolution) -> Estimate:
                                   f"(relative) > {BALANCE_TOLERANCE:g}: no bound")
         compliance[jump.elements], skew[jump.elements] = jump.symmetric, jump.skew
     parts, volume = volume_parts(compliance, skew, osc, load.squares, constants, mu)
-    return smallest(scene, solution, parts, volume, bounds, shear, "equilibrated")
+    return smallest(scene, solution, parts, volume, bounds, friction_of(scene, solution, shear),
+                    "equilibrated")
 
 
 def volume_parts(compliance: np.ndarray, skew: np.ndarray, osc: np.ndarray,
@@ -157,10 +159,17 @@ def compliance_squares(rec, interior, lame: tuple[float, float]) -> np.ndarray:
     return (compliance_energy(sym, *lame) * rec.basis.dx).sum(axis=1)
 
 
-def smallest(scene, solution, parts: dict, volume: np.ndarray, bounds: ContactBounds, shear,
+def friction_of(scene, solution, shear):
+    """The friction terms of sigma*_t = ``shear`` on segments as a function of the extension
+    d (``guaranteed_friction.friction_bound``; None without friction)."""
+    return None if shear is None else functools.partial(friction_bound, scene, solution, shear)
+
+
+def smallest(scene, solution, parts: dict, volume: np.ndarray, bounds: ContactBounds, friction,
              name: str, duals: DualNorms | None = None) -> Estimate:
     """Every extension d gives a bound (13.3): the smallest over the relaxed fields, as
-    estimator ``name`` (``duals``: by default the computed C_T of 13.4 times the norms), with
+    estimator ``name``, ``friction(d)`` the friction terms (17.5; None without friction)
+    (``duals``: by default the computed C_T of 13.4 times the norms), with
     the indicators of the smallest over the one-layer fields, scaled to sum to eta^2: the
     relaxed fields' energy spreads over the strip's layers, away from the elements where the
     penetration is (13.3, "Marking")."""
@@ -168,7 +177,7 @@ def smallest(scene, solution, parts: dict, volume: np.ndarray, bounds: ContactBo
         duals = DualNorms(trace=domain_constants(scene).trace)
 
     def best(options):
-        return min((_combined(scene, solution, parts, volume, bound, shear, name, duals)
+        return min((_combined(parts, volume, bound, friction, name, duals)
                     for bound in options), key=lambda est: est.eta)
 
     steering, sharp = best(bounds.marking), best(bounds.sharp)
@@ -176,11 +185,11 @@ def smallest(scene, solution, parts: dict, volume: np.ndarray, bounds: ContactBo
     return replace(sharp, indicators=steering.indicators * scale)
 
 
-def _combined(scene, solution, parts: dict, volume: np.ndarray, bound, shear, name: str,
+def _combined(parts: dict, volume: np.ndarray, bound, friction_terms_of, name: str,
               duals: DualNorms) -> Estimate:
     """eta of 13.1 from the parts of A (``BoundTerms``' volume fields), the contact terms of
     one extension (``bound``) and, under friction, those of sigma*_t (17.5)."""
-    friction = None if shear is None else friction_bound(scene, solution, shear, bound.field)
+    friction = None if friction_terms_of is None else friction_terms_of(bound.field)
     negative_traction = duals.negative_traction
     if negative_traction is None:
         negative_traction = duals.trace * bound.negative

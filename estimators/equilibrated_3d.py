@@ -10,7 +10,7 @@ sigma* - sigma_h)|| + C_K ||skw sigma*|| + C_G osc + C_F ||rho||, with the const
 ``estimators.constants`` on the 3D domain and the oscillation of ``estimators.oscillation``;
 the body force's part by RT_0 fluxes on sub-tetrahedra (``estimators.jump_flux``; 13.2,
 "Where f jumps, element by element"), inside sigma* where f jumps inside elements.
-Frictionless contact only.
+Under Tresca friction sigma*_t beside lambda* (``estimators.guaranteed_friction_3d``).
 """
 
 from __future__ import annotations
@@ -34,7 +34,7 @@ from estimators.equilibration import (
     reconstruct,
 )
 from estimators.guaranteed_contact import ContactBounds
-from estimators.guaranteed_contact_3d import surface_traction
+from estimators.guaranteed_friction_3d import surface_tractions
 from estimators.jump_flux import SMOOTH_LEVELS, flux_oscillation
 from estimators.oscillation import oscillation
 from estimators.patch_data import interior_data, rebalanced
@@ -50,7 +50,7 @@ INTORDER = {1: 5, 2: 6}
 
 @register_cell_variant("equilibrated", "tet")
 def estimate(scene, solution: DiscreteSolution) -> Estimate:
-    rec, interior, load, bounds, boundary = equilibrate(scene, solution)
+    rec, interior, load, tractions, boundary = equilibrate(scene, solution)
     lam, mu = solution.elasticity.lame
     constants = domain_constants(scene)  # on the 3D domain (docs/theory.md, 13.4)
     diff = rec.values - interior.sigma_h
@@ -62,8 +62,9 @@ def estimate(scene, solution: DiscreteSolution) -> Estimate:
     osc = oscillation(scene, rec.basis, boundary,
                       *body_force_terms(scene, solution, rec, compliance, skew))
     parts, volume = volume_parts(compliance, skew, osc, load.squares, constants, mu)
-    return smallest(scene, solution, parts, volume, ContactBounds(marking=bounds, sharp=bounds),
-                    None, "equilibrated")
+    bounds = ContactBounds(marking=tractions.bounds, sharp=tractions.bounds)
+    return smallest(scene, solution, parts, volume, bounds, tractions.friction(scene, solution),
+                    "equilibrated")
 
 
 def body_force_terms(scene, solution: DiscreteSolution, rec, compliance: np.ndarray,
@@ -89,9 +90,9 @@ def body_force_terms(scene, solution: DiscreteSolution, rec, compliance: np.ndar
 
 
 def equilibrate(scene, solution: DiscreteSolution):
-    """sigma* (a ``Reconstruction`` on the sorted mesh), the patch data, rho, the contact terms
-    of lambda* with every extension d and the Neumann data of the auxiliary problem
-    (docs/theory.md, 13.2, 14.5)."""
+    """sigma* (a ``Reconstruction`` on the sorted mesh), the patch data, rho, the contact
+    tractions (lambda*, its terms with every extension d, sigma*_t) and the Neumann data of the
+    auxiliary problem (docs/theory.md, 13.2, 14.5, 17.5)."""
     elasticity = solution.elasticity
     mesh, order = sorted_tetrahedra(elasticity.mesh), elasticity.order
     if not np.array_equal(mesh.facets, elasticity.mesh.facets):
@@ -109,18 +110,15 @@ def equilibrate(scene, solution: DiscreteSolution):
     neumann = BoundaryData(scene.neumann_facets(mesh), scene.traction or (lambda x: 0.0 * x))
     neumann_flux = boundary_fluxes(interior, [neumann])
     reaction = interior.total - boundary_balance(n_v, neumann_flux, 3)
-    trace = solution.trace
-    lam_star, bounds = surface_traction(scene, solution, interior, reaction, clamped,
-                                        domain_constants(scene).trace)
-    contact = BoundaryData(trace.facets, lambda x: -lam_star.at(trace, x)[None]
-                           * trace.normal[:, :, None])
-    fluxes = neumann_flux + boundary_fluxes(interior, [contact])
+    tractions = surface_tractions(scene, solution, interior, reaction, clamped,
+                                  domain_constants(scene).trace)
+    fluxes = neumann_flux + boundary_fluxes(interior, [tractions.contact])
     interior, load = rebalanced(interior, interior.total - boundary_balance(n_v, fluxes, 3),
                                 clamped)
     rec = reconstruct(interior, fluxes, clamped, condense=True)  # 14.5: few shapes repeat
     if rec.imbalance > BALANCE_TOLERANCE:
         raise NotEquilibrated(f"the patch data do not balance (relative imbalance "
                               f"{rec.imbalance:.1e} > {BALANCE_TOLERANCE:g}): no bound")
-    prescribed = np.concatenate([neumann.facets, contact.facets])
+    prescribed = np.concatenate([neumann.facets, tractions.contact.facets])
     rec = symmetrised(rec, interior, prescribed, elasticity.lame, domain_constants(scene).korn)
-    return rec, interior, load, bounds, [neumann, contact]
+    return rec, interior, load, tractions, [neumann, tractions.contact]

@@ -40,6 +40,7 @@ from estimators.equilibrated import (
     NotEquilibrated,
     compliance_squares,
     equilibrate,
+    friction_of,
     smallest,
     tresca_only_for,
 )
@@ -120,7 +121,8 @@ def estimate(scene, solution: DiscreteSolution):
                                       sum(parts.values()), chain)
     spread = parts["load"] * np.sqrt(load.squares / max(load.squares.sum(), 1e-300))
     volume = (np.sqrt(compliance) + np.sqrt(skew) + osc + tau_sym + tau_skew + spread) ** 2
-    return smallest(scene, solution, parts, volume, bounds, shear, NAME, duals)
+    return smallest(scene, solution, parts, volume, bounds,
+                    friction_of(scene, solution, shear), NAME, duals)
 
 
 def dual_terms(scene, solution, constants, load, bound, shear, rest: float, chain

@@ -44,21 +44,31 @@ class SurfaceTraction:
 
     def at(self, surface, x: np.ndarray) -> np.ndarray:
         """lambda* (n_f, nq) at points x (3, n_f, nq) of the contact triangles."""
-        a, b, c = (surface.mesh.p[:, v][:, :, None] for v in surface.vertices)
-        e1, e2, r = b - a, c - a, x - a
-        g11, g12, g22 = (e1 * e1).sum(0), (e1 * e2).sum(0), (e2 * e2).sum(0)
-        r1, r2 = (r * e1).sum(0), (r * e2).sum(0)
-        det = g11 * g22 - g12 * g12
-        t0, t1 = (g22 * r1 - g12 * r2) / det, (g11 * r2 - g12 * r1) / det
-        return (self.corners[0][:, None] * (1 - t0 - t1) + self.corners[1][:, None] * t0
-                + self.corners[2][:, None] * t1)
+        return np.einsum("cfq,cf->fq", local_weights(surface, x), self.corners)
+
+
+def local_weights(surface, x: np.ndarray) -> np.ndarray:
+    """The P1 basis (3, n_f, nq) of each contact triangle at its points x (3, n_f, nq)."""
+    a, b, c = (surface.mesh.p[:, v][:, :, None] for v in surface.vertices)
+    e1, e2, r = b - a, c - a, x - a
+    g11, g12, g22 = (e1 * e1).sum(0), (e1 * e2).sum(0), (e2 * e2).sum(0)
+    r1, r2 = (r * e1).sum(0), (r * e2).sum(0)
+    det = g11 * g22 - g12 * g12
+    t0, t1 = (g22 * r1 - g12 * r2) / det, (g11 * r2 - g12 * r1) / det
+    return np.array([1 - t0 - t1, t0, t1])
 
 
 def projected_pressure(surface, pressure) -> SurfaceTraction:
     """The L2 projection of ``pressure(t)`` (n_f, nq) onto P1 per contact triangle."""
+    return SurfaceTraction(projected_corners(pressure))
+
+
+def projected_corners(values) -> np.ndarray:
+    """The corner values (3, ..., n_f) of the L2 projection of ``values(t)`` (..., n_f, nq)
+    onto P1 per contact triangle."""
     t, w = triangle_rule(PROJECTION_DEGREE)
-    moments = (pressure(t) * w) @ corner_weights(t).T                  # (n_f, 3) / area
-    return SurfaceTraction(np.linalg.solve(_MASS, moments.T))
+    moments = np.einsum("...fq,q,cq->c...f", values(t), w, corner_weights(t))  # / area
+    return np.tensordot(np.linalg.inv(_MASS), moments, axes=1)
 
 
 def traction_balance(interior, surface, traction: SurfaceTraction) -> np.ndarray:

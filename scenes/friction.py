@@ -51,6 +51,10 @@ class FrictionLaw:
                              "finite function >= 0)")
         return bound
 
+    def slide_vector(self, dim: int) -> np.ndarray:
+        """The obstacle's slide w as a vector in 3D (slide e_x; 2D slides along t)."""
+        return np.eye(dim)[0] * self.slide
+
     @property
     def active(self) -> bool:
         """Whether there is friction at all."""
