@@ -5,7 +5,9 @@
 * trace: C_T^2 = sup_v ||v . n||_{0,Gamma_C}^2 / a(v, v), which bounds the dual norm of a
   negative part of the auxiliary contact traction;
 * Friedrichs: C_F^2 = sup_v ||v||_0^2 / a(v, v), which bounds the dual norm of the load that
-  restores the balance of patches the discrete solution does not balance exactly.
+  restores the balance of patches the discrete solution does not balance exactly;
+* tangential trace, on a scene with friction: C_Tt^2 = sup_v ||v - (v . n) n||_{0,Gamma_C}^2 /
+  a(v, v), which bounds the dual norm of the shear traction's excess (17.5).
 
 Each is the largest eigenvalue of a generalised eigenproblem on P2 finite elements of the
 scene's initial mesh refined uniformly. Discrete suprema approach the true ones from below; the
@@ -33,8 +35,9 @@ class DomainConstants:
     korn: float        # C_K
     trace: float       # C_T
     friedrichs: float  # C_F
-    coarse: tuple[float, float, float]  # the three on the coarser mesh
+    coarse: tuple[float, ...]  # the same on the coarser mesh
     dofs: int          # free DOFs of the finer mesh
+    tangential_trace: float | None = None  # C_Tt (None: the scene has no friction)
 
 
 @BilinearForm
@@ -50,24 +53,31 @@ def _mass(u, v, w):
     return dot(u, v)
 
 
+@BilinearForm
+def _normal_mass(u, v, w):
+    return dot(u, w.n) * dot(v, w.n)
+
+
+@BilinearForm
+def _tangential_mass(u, v, w):
+    return dot(u, v) - dot(u, w.n) * dot(v, w.n)
+
+
 def _largest(scene, mesh) -> tuple[list[float], int]:
     elasticity = assemble_elasticity(scene, mesh, order=2)
     free = elasticity.free
     K = elasticity.K[free][:, free].tocsc()
     skew = asm(_skew, Basis(mesh, elasticity.basis.elem, intorder=2))[free][:, free]
-    facets = scene.contact_facets(mesh)
-
-    @BilinearForm
-    def normal_mass(u, v, w):
-        return dot(u, w.n) * dot(v, w.n)
-
-    trace = asm(normal_mass, FacetBasis(mesh, elasticity.basis.elem, facets=facets,
-                                        intorder=4))[free][:, free]
-    mass = asm(_mass, Basis(mesh, elasticity.basis.elem, intorder=4))[free][:, free]
-    solve = factorise(K)  # once for the three problems (a 3D P2 factorisation costs seconds)
+    surface = FacetBasis(mesh, elasticity.basis.elem, facets=scene.contact_facets(mesh),
+                         intorder=4)
+    matrices = [skew, asm(_normal_mass, surface)[free][:, free],
+                asm(_mass, Basis(mesh, elasticity.basis.elem, intorder=4))[free][:, free]]
+    if scene.friction.active:  # C_Tt only where a shear traction is charged (17.5)
+        matrices.append(asm(_tangential_mass, surface)[free][:, free])
+    solve = factorise(K)  # once for every problem (a 3D P2 factorisation costs seconds)
     inverse = LinearOperator(K.shape, matvec=solve, dtype=float)
     values = []
-    for A in (skew, trace, mass):
+    for A in matrices:
         top = eigsh(A.tocsc(), k=1, M=K, Minv=inverse, which="LA", return_eigenvectors=False)
         values.append(float(np.sqrt(max(top[0], 0.0))))
     return values, int(free.size)
@@ -85,7 +95,9 @@ def domain_constants(scene) -> DomainConstants:
             mesh = mesh.refined()
         coarse, _ = _largest(scene, mesh)
         fine, dofs = _largest(scene, mesh.refined())
-        korn, trace, friedrichs = (f + abs(f - c) for f, c in zip(fine, coarse, strict=True))
+        korn, trace, friedrichs, *tangential = (f + abs(f - c)
+                                                for f, c in zip(fine, coarse, strict=True))
         _CACHE[key] = DomainConstants(korn=korn, trace=trace, friedrichs=friedrichs,
-                                      coarse=tuple(coarse), dofs=dofs)
+                                      coarse=tuple(coarse), dofs=dofs,
+                                      tangential_trace=tangential[0] if tangential else None)
     return _CACHE[key]

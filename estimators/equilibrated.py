@@ -87,6 +87,9 @@ class DualNorms:
     trace: float
     negative_traction: float | None = None
     excess_shear: float | None = None
+    # C_Tt, the bound of ||v_t||_{Gamma_C} in N_t (None: ``trace`` bounds the whole trace
+    # ||v||_{Gamma_C}, as the proved constants do; the computed C_T bounds only v . n)
+    tangential_trace: float | None = None
 
 
 def friction_terms(friction, duals: DualNorms) -> dict[str, float]:
@@ -94,7 +97,10 @@ def friction_terms(friction, duals: DualNorms) -> dict[str, float]:
     if friction is None:
         return {}
     excess = duals.excess_shear
-    return {"excess_shear": duals.trace * friction.excess if excess is None else excess,
+    if excess is None:
+        excess = (duals.trace if duals.tangential_trace is None
+                  else duals.tangential_trace) * friction.excess
+    return {"excess_shear": excess,
             "friction_complementarity": float(np.sqrt(max(friction.complementarity, 0.0)))}
 
 
@@ -174,7 +180,8 @@ def smallest(scene, solution, parts: dict, volume: np.ndarray, bounds: ContactBo
     relaxed fields' energy spreads over the strip's layers, away from the elements where the
     penetration is (13.3, "Marking")."""
     if duals is None:
-        duals = DualNorms(trace=domain_constants(scene).trace)
+        constants = domain_constants(scene)
+        duals = DualNorms(trace=constants.trace, tangential_trace=constants.tangential_trace)
 
     def best(options):
         return min((_combined(parts, volume, bound, friction, name, duals)
@@ -261,7 +268,7 @@ def equilibrate(scene, solution: DiscreteSolution, symmetrise=None,
     if sheared:  # sigma*_t balances what is left along the tangents (17.5)
         left = reaction - boundary_balance(n_v, boundary_fluxes(interior, [normal]))
         if excess_term is None:
-            excess_term = l2_excess_term(trace, domain_constants(scene).trace
+            excess_term = l2_excess_term(trace, domain_constants(scene).tangential_trace
                                          if trace_constant is None else trace_constant)
         shear = auxiliary_shear(scene, solution, interior, left, clamped, bounds,
                                 excess_term)

@@ -110,8 +110,9 @@ def equilibrate(scene, solution: DiscreteSolution):
     neumann = BoundaryData(scene.neumann_facets(mesh), scene.traction or (lambda x: 0.0 * x))
     neumann_flux = boundary_fluxes(interior, [neumann])
     reaction = interior.total - boundary_balance(n_v, neumann_flux, 3)
+    constants = domain_constants(scene)
     tractions = surface_tractions(scene, solution, interior, reaction, clamped,
-                                  domain_constants(scene).trace)
+                                  constants.trace, constants.tangential_trace)
     fluxes = neumann_flux + boundary_fluxes(interior, [tractions.contact])
     interior, load = rebalanced(interior, interior.total - boundary_balance(n_v, fluxes, 3),
                                 clamped)
@@ -120,5 +121,5 @@ def equilibrate(scene, solution: DiscreteSolution):
         raise NotEquilibrated(f"the patch data do not balance (relative imbalance "
                               f"{rec.imbalance:.1e} > {BALANCE_TOLERANCE:g}): no bound")
     prescribed = np.concatenate([neumann.facets, tractions.contact.facets])
-    rec = symmetrised(rec, interior, prescribed, elasticity.lame, domain_constants(scene).korn)
+    rec = symmetrised(rec, interior, prescribed, elasticity.lame, constants.korn)
     return rec, interior, load, tractions, [neumann, tractions.contact]

@@ -8,9 +8,10 @@
   onto its plane. On a plane Gamma_C that projection changes nothing, and u_h balances every
   hat function in every direction; on a curved one what it leaves goes to rho (13.2). Of the
   two starts, the one with the smaller N_t + sqrt(B_t^+).
-* N_t = C_T ||(|sigma*_t| - s)_+|| and B_t = int s |xi_h + d_t| + sigma*_t . (xi_h + d_t) +
-  (|sigma*_t| - s)_+ |xi_h|, with |.| the length of a tangential vector, xi_h = (u_h - w)_t (w
-  the obstacle's slide) and d_t the tangential part of the extension d.
+* N_t = C_Tt ||(|sigma*_t| - s)_+|| (C_Tt the tangential trace constant, 13.4) and B_t =
+  int s |xi_h + d_t| + sigma*_t . (xi_h + d_t) + (|sigma*_t| - s)_+ |xi_h|, with |.| the
+  length of a tangential vector, xi_h = (u_h - w)_t (w the obstacle's slide) and d_t the
+  tangential part of the extension d.
 """
 
 from __future__ import annotations
@@ -115,9 +116,10 @@ class SurfaceTractions:
 
 
 def surface_tractions(scene, solution, interior, reaction: np.ndarray, clamped: np.ndarray,
-                      trace_constant: float) -> SurfaceTractions:
-    """lambda* (``estimators.guaranteed_contact_3d``) for the normal balance net of sigma_t,h's
-    own and, under friction, sigma*_t for what is left (module docstring)."""
+                      trace_constant: float, shear_constant: float | None) -> SurfaceTractions:
+    """lambda* (``estimators.guaranteed_contact_3d``, chosen with C_T = ``trace_constant``) for
+    the normal balance net of sigma_t,h's own and, under friction, sigma*_t for what is left
+    (module docstring; chosen with C_Tt = ``shear_constant``)."""
     surface = solution.trace
     starts = [] if solution.friction is None else [
         SurfaceShear(projected_corners(solution.friction.traction).transpose(1, 0, 2)),
@@ -136,7 +138,7 @@ def surface_tractions(scene, solution, interior, reaction: np.ndarray, clamped: 
 
         def terms(candidate):  # N_t + sqrt(B_t^+), B_t the least over the extensions
             bound = [friction_bound(scene, solution, candidate, b.field) for b in bounds]
-            return (trace_constant * bound[0].excess
+            return (shear_constant * bound[0].excess
                     + np.sqrt(max(min(b.complementarity for b in bound), 0.0)))
 
         shear = min((balanced_shear(surface, start, left - shear_balance(interior, surface,

@@ -8,6 +8,7 @@ import pytest
 from bench.measure.discretisation_error import element_energy_errors
 from estimators import get_estimator
 from estimators.base import ESTIMATORS
+from estimators.constants import domain_constants
 from estimators.equilibrated import equilibrate
 from formulations import get_formulation, solve
 from formulations.registry import FORMULATIONS
@@ -56,3 +57,16 @@ def test_coulomb_is_refused_by_the_bound_and_tresca_is_not():
     assert why == ("estimator 'equilibrated' bounds the error under Tresca friction only (the "
                    "scene's law is coulomb(mu=0.3): Coulomb's is not a minimisation)")
     assert ESTIMATORS.why_not("equilibrated", scene=get_scene("stick-slip")) is None
+
+
+def test_the_tangential_trace_constant_bounds_a_shear_that_the_normal_one_does_not():
+    # v = ((1 - y) / 2, 0) vanishes on the clamped top of (-1, 1)^2 and slides the whole of
+    # Gamma_C (y = -1) by 1: ||v_t||^2 = 2 there, eps_xy = -1/4 everywhere, a(v, v) = 2 mu
+    # (2 / 16) 4 = mu; so C_Tt^2 >= 2 / mu (5.2 at E = 1, nu = 0.3), while C_T bounds v . n,
+    # which is 0 here, and is smaller (C_T^2 = 1.8): N_t needs its own constant (17.5)
+    scene = get_scene("stick-slip")
+    constants = domain_constants(scene)
+    ratio = 2 / scene.material.lame[1]
+    assert constants.trace**2 < ratio <= constants.tangential_trace**2
+    assert constants.coarse[3] <= constants.tangential_trace  # fine + (fine - coarse)
+    assert domain_constants(get_scene("paper")).tangential_trace is None  # no friction
