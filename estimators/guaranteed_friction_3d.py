@@ -7,7 +7,8 @@
   component; M the P1 mass matrix of Gamma_C), each triangle's corner values then projected
   onto its plane. On a plane Gamma_C that projection changes nothing, and u_h balances every
   hat function in every direction; on a curved one what it leaves goes to rho (13.2). Of the
-  two starts, the one with the smaller N_t + sqrt(B_t^+).
+  two starts, the one with the smaller N_t + sqrt(B_t^+) (a third, within s at the corners
+  by a cone program as on segments, lowered N_t by at most 10 %: docs/theory.md 17.5).
 * N_t = C_Tt ||(|sigma*_t| - s)_+|| (C_Tt the tangential trace constant, 13.4) and B_t =
   int s |xi_h + d_t| + sigma*_t . (xi_h + d_t) + (|sigma*_t| - s)_+ |xi_h|, with |.| the
   length of a tangential vector, xi_h = (u_h - w)_t (w the obstacle's slide) and d_t the
@@ -32,6 +33,7 @@ from estimators.guaranteed_contact_3d import (
     local_weights,
     projected_corners,
     surface_traction,
+    traction_balance,
 )
 from estimators.guaranteed_friction import FrictionBound
 from formulations.contact_surface import triangle_rule
@@ -132,9 +134,7 @@ def surface_tractions(scene, solution, interior, reaction: np.ndarray, clamped: 
 
     shear = None
     if starts:
-        left = reaction - boundary_balance(
-            reaction.shape[0], boundary_fluxes(interior, [BoundaryData(surface.facets, normal)]),
-            3)
+        left = reaction - traction_balance(interior, surface, lam_star)
 
         def terms(candidate):  # N_t + sqrt(B_t^+), B_t the least over the extensions
             bound = [friction_bound(scene, solution, candidate, b.field) for b in bounds]
