@@ -17,7 +17,7 @@ class BoundTerms:
     units, so that a user sees which one dominates: ``symmetric`` the compliance norm of
     sym sigma* - sigma_h, ``skew`` C_K ||skw sigma*||, ``oscillation`` C_G osc, ``load``
     C_F ||rho||, ``negative_traction`` C_T ||lambda*_-||; with Tresca friction
-    ``excess_shear`` C_T ||(|sigma*_t| - s)_+|| and ``friction_complementarity`` sqrt(B_t^+)
+    ``excess_shear`` C_Tt ||(|sigma*_t| - s)_+|| and ``friction_complementarity`` sqrt(B_t^+)
     (docs/theory.md, 17.5; 0 without friction)."""
 
     symmetric: float

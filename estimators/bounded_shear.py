@@ -1,8 +1,8 @@
 """A bounded auxiliary shear traction sigma*_t for the guaranteed bound under Tresca friction
 (docs/theory.md, 17.5).
 
-The bound charges the excess of sigma*_t over the slip bound s with the trace constant, N_t =
-C_T ||(|sigma*_t| - s)_+||. The projection of sigma_t,h plus its P1 correction
+The bound charges the excess of sigma*_t over the slip bound s with the tangential trace
+constant, N_t = C_Tt ||(|sigma*_t| - s)_+||. The projection of sigma_t,h plus its P1 correction
 (``guaranteed_friction.balanced_shear``) exceeds s where the discrete shear does (the mixed
 method's multiplier between the nodes where it is bounded, the penalty's projection) and where
 the correction adds to it (vi's). This one is a polynomial of degree k on each contact facet

@@ -82,7 +82,7 @@ tresca_only = tresca_only_for("equilibrated", solid=True)
 class DualNorms:
     """What replaces C_T times a norm in N and N_t (``estimators.equilibrated_local``): the
     trace constant, and N and N_t themselves where they are bounded otherwise (None: C_T
-    ||lambda*_-|| and C_T ||(|sigma*_t| - s)_+||)."""
+    ||lambda*_-|| and C_Tt ||(|sigma*_t| - s)_+||)."""
 
     trace: float
     negative_traction: float | None = None
@@ -175,7 +175,7 @@ def smallest(scene, solution, parts: dict, volume: np.ndarray, bounds: ContactBo
              name: str, duals: DualNorms | None = None) -> Estimate:
     """Every extension d gives a bound (13.3): the smallest over the relaxed fields, as
     estimator ``name``, ``friction(d)`` the friction terms (17.5; None without friction)
-    (``duals``: by default the computed C_T of 13.4 times the norms), with
+    (``duals``: by default the computed C_T and C_Tt of 13.4 times the norms), with
     the indicators of the smallest over the one-layer fields, scaled to sum to eta^2: the
     relaxed fields' energy spreads over the strip's layers, away from the elements where the
     penetration is (13.3, "Marking")."""
@@ -238,7 +238,7 @@ def equilibrate(scene, solution: DiscreteSolution, symmetrise=None,
     the contact terms of lambda* (``ContactBounds``, lambda* chosen with
     ``trace_constant``, by default the computed C_T), the Neumann data of the auxiliary
     problem, the clamped vertices and sigma*_t (None without friction; chosen with
-    ``excess_term``, by default C_T ||g||, ``estimators.bounded_shear``) (docs/theory.md, 13.2,
+    ``excess_term``, by default C_Tt ||g||, ``estimators.bounded_shear``) (docs/theory.md, 13.2,
     13.3 and 17.5)."""
     elasticity = solution.elasticity
     mesh, order = elasticity.mesh, elasticity.order

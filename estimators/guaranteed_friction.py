@@ -7,7 +7,7 @@ does along the normals, ``estimators.guaranteed_contact``). With s the slip boun
 obstacle's slide, xi_h = u_ht - w and d the extension of the contact terms, the bound of 13.1
 gains
 
-    N_t = C_T ||(|sigma*_t| - s)_+||_{0,Gamma_C}                      (added to a),
+    N_t = C_Tt ||(|sigma*_t| - s)_+||_{0,Gamma_C}                      (added to a),
     B_t = int_{Gamma_C} s |xi_h + d_t| + sigma*_t (xi_h + d_t) + (|sigma*_t| - s)_+ |xi_h|
                                                                       (added to b).
 
