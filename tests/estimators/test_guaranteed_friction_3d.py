@@ -112,7 +112,7 @@ def test_the_bound_is_above_the_exact_error_with_tresca_friction_in_3d(formulati
     error = exact_errors(SCENE, solution).energy_error
     # a bound, not an estimate: no tolerance beyond the exact error's quadrature (~1e-8)
     assert estimate.eta >= error * (1 - 1e-6), (estimate.eta, error)
-    assert estimate.eta <= 5 * error  # and a useful one: measured 2.1 .. 2.7 on this mesh
+    assert estimate.eta <= 5 * error  # and a useful one: measured 2.19 .. 2.77 on this mesh
     parts = estimate.bound
     # the shear is charged: the excess and B_t are parts of eta (measured > 1e-4 each)
     assert parts.excess_shear > 0 and parts.friction_complementarity > 0
