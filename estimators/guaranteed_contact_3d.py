@@ -73,8 +73,14 @@ def projected_corners(values) -> np.ndarray:
 
 def traction_balance(interior, surface, traction: SurfaceTraction) -> np.ndarray:
     """int psi_a (-lambda* n) over Gamma_C per vertex, (n_vertices, 3)."""
-    part = BoundaryData(surface.facets, lambda x: -traction.at(surface, x)[None]
-                        * surface.normal[:, :, None])
+    return surface_balance(interior, surface, lambda x: -traction.at(surface, x)[None]
+                           * surface.normal[:, :, None])
+
+
+def surface_balance(interior, surface, values) -> np.ndarray:
+    """int psi_a t over Gamma_C per vertex, (n_vertices, 3), for a traction t given by
+    ``values(x)`` (3, n_f, nq) at points x of the contact triangles."""
+    part = BoundaryData(surface.facets, values)
     return boundary_balance(interior.total.shape[0], boundary_fluxes(interior, [part]), 3)
 
 

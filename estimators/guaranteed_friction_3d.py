@@ -25,13 +25,14 @@ from scipy.sparse.linalg import splu
 
 from estimators.contact_extension import vertex_normals
 from estimators.contact_extension_3d import SurfaceExtension, corner_weights
-from estimators.equilibration import BoundaryData, boundary_balance, boundary_fluxes
+from estimators.equilibration import BoundaryData
 from estimators.guaranteed_contact import contact_mass
 from estimators.guaranteed_contact_3d import (
     QUADRATURE_DEGREE,
     SurfaceTraction,
     local_weights,
     projected_corners,
+    surface_balance,
     surface_traction,
     traction_balance,
 )
@@ -64,8 +65,7 @@ def in_plane(vectors: np.ndarray, normal: np.ndarray) -> np.ndarray:
 
 def shear_balance(interior, surface, shear: SurfaceShear) -> np.ndarray:
     """int psi_a sigma*_t over Gamma_C per vertex, (n_vertices, 3)."""
-    part = BoundaryData(surface.facets, lambda x: shear.at(surface, x))
-    return boundary_balance(interior.total.shape[0], boundary_fluxes(interior, [part]), 3)
+    return surface_balance(interior, surface, lambda x: shear.at(surface, x))
 
 
 def balanced_shear(surface, start: SurfaceShear, defect: np.ndarray,
@@ -84,7 +84,7 @@ def balanced_shear(surface, start: SurfaceShear, defect: np.ndarray,
 
 
 def friction_bound(scene, solution, shear: SurfaceShear, d: SurfaceExtension) -> FrictionBound:
-    """N_t / C_T and B_t of the module docstring with the extension ``d``."""
+    """N_t / C_Tt and B_t of the module docstring with the extension ``d``."""
     surface, law = solution.trace, scene.friction
     t, w = triangle_rule(QUADRATURE_DEGREE)
     at = evaluate_on_trace(solution.elasticity.basis, surface, t)
