@@ -68,6 +68,20 @@ FRICTION_STATES = ("separated", "stick", "slip")
 
 
 @dataclass(frozen=True, eq=False)
+class ConsistencyTerm:
+    """A term of the discrete equation beyond a(u_h, v) - L(v) and the contact tractions
+    lambda_h, sigma_t,h: the equation holds with - (q, sigma(v) n)_{Gamma_C} added, q (d,
+    n_facets, nq) a vector at the local coordinates ``points`` of every contact facet and
+    ``weights`` (n_facets * nq) the quadrature weights times the facets' measures, the rule the
+    formulation integrates with (Nitsche's theta/gamma times the traction residual,
+    docs/theory.md 12.1 and 13.2, "Balance")."""
+
+    points: np.ndarray
+    weights: np.ndarray
+    vector: np.ndarray
+
+
+@dataclass(frozen=True, eq=False)
 class FrictionState:
     """The friction law's answer at the points where a formulation poses it (the nodes of
     Gamma_C for vi; docs/theory.md, 17.2): their contact coordinate, tangential reaction (a
@@ -228,6 +242,7 @@ class DiscreteSolution:
     pressure_mismatch: float = 0.0
     diagnostics: SolverDiagnostics = field(default_factory=SolverDiagnostics)
     friction: FrictionState | None = None  # with a friction law
+    consistency: ConsistencyTerm | None = None  # Nitsche (theta != 0)
 
     @property
     def ok(self) -> bool:

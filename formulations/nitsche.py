@@ -35,12 +35,23 @@ import numpy as np
 from scipy import sparse
 from skfem import MeshTri
 
-from formulations.base import ContactQP, DiscreteSolution, QPSolution, Residuals, slack_qp
+from formulations.base import (
+    ConsistencyTerm,
+    ContactQP,
+    DiscreteSolution,
+    QPSolution,
+    Residuals,
+    slack_qp,
+)
 from formulations.contact import contact_trace, gap_interpolant
 from formulations.discretisation import Discretisation, discrete_solution
 from formulations.elasticity import assemble_elasticity, check_order
 from formulations.evaluation import evaluate_on_trace
-from formulations.nitsche_friction import nitsche_friction_qp, nitsche_friction_state
+from formulations.nitsche_friction import (
+    nitsche_friction_qp,
+    nitsche_friction_state,
+    shear_residual,
+)
 from formulations.registry import register_formulation
 from formulations.semismooth import SemismoothSystem
 from scenes import Scene
@@ -115,6 +126,26 @@ def nitsche_system(scene: Scene, elasticity, trace, gap_h, t: np.ndarray, w: np.
         near_null=elasticity.rigid_modes)
 
 
+def consistency_term(system: SemismoothSystem, elasticity, trace, t: np.ndarray,
+                     u_free: np.ndarray, pressure, shear_residual=None) -> ConsistencyTerm | None:
+    """(12.1)'s terms beyond the tractions lambda_h and sigma_t,h as a ``ConsistencyTerm``:
+    q = theta/gamma ((sigma_nn(u_h) + lambda_h) n + the shear residual ``shear_residual(t)``
+    under friction, ``formulations.nitsche_friction``) at the points t of every contact facet
+    (docs/theory.md 13.2, "Balance"); None for theta = 0, whose equation has none."""
+    if system.theta == 0:
+        return None
+    nq = t.shape[-1]
+    at = evaluate_on_trace(elasticity.basis, trace, t)
+    normal = np.repeat(trace.normal, nq, axis=1)
+    residual = (at.normal_stress_matrix(normal, elasticity.lame) @ elasticity.expand(u_free)
+                + pressure(t).ravel()) * normal                      # (d, n_f nq)
+    if shear_residual is not None:
+        residual = residual + shear_residual(t).reshape(residual.shape)
+    return ConsistencyTerm(points=t, weights=system.weight,
+                           vector=(system.theta / system.gamma * residual).reshape(
+                               trace.dim, trace.size, nq))
+
+
 def check_friction(scene: Scene, theta: float) -> None:
     if scene.friction.active and theta != 1:
         raise ValueError(f"theta={theta:g} with friction ({scene.friction.label}) is not "
@@ -147,12 +178,16 @@ def discretise(scene: Scene, mesh: MeshTri, theta: float = 1.0,
         u_free = answer.u[:n]  # the QP route carries one slack per Gauss point after u
         pressure_at_points = system.pressure(u_free)
         pressure = pressure_function(gap_h, elasticity, trace, gamma_facet, u_free)
+        residual = (shear_residual(scene, elasticity, trace, gamma_facet, u_free, pressure)
+                    if friction is not None else None)
         return discrete_solution(
             "nitsche", elasticity, trace, replace(answer, multipliers=pressure_at_points),
             residuals, status, reason, u_free=u_free, pressure=pressure,
             multiplier_breaks=(np.append(trace.coordinate[0], trace.coordinate[1, -1])
                                if trace.dim == 2 else np.zeros(0)),
             active_constraints=int((pressure_at_points > 0).sum()), details=details,
+            consistency=consistency_term(system, elasticity, trace, t, u_free, pressure,
+                                         residual),
             friction=None if friction is None else nitsche_friction_state(
                 scene, friction, answer, elasticity, trace, t, system.weight, gamma_facet,
                 pressure))

@@ -64,35 +64,65 @@ def nitsche_friction_qp(scene, system: SemismoothSystem, elasticity, trace,
                              near_null=elasticity.rigid_modes)
 
 
-def shear_function(scene, elasticity, trace, gamma_facet: np.ndarray, u_free: np.ndarray,
-                   pressure):
-    """sigma_t,h(t) = [P_t(u_h)]_s at local coordinates t of every contact facet (in 3D the
-    vector P_t projected onto the disc of radius s)."""
+def shear_parts(scene, elasticity, trace, gamma_facet: np.ndarray, u_free: np.ndarray,
+                pressure):
+    """At local coordinates t of every contact facet, sigma_nt(u_h) and sigma_t,h = [P_t(u_h)]_s
+    along each tangent of ``contact_tangents`` (each (n_facets, nt, d - 1); in 3D P_t is
+    projected onto the disc of radius s as a vector)."""
     u, law = elasticity.expand(u_free), scene.friction
     tangents = contact_tangents(trace)
     # w . t_k per facet (0 if the obstacle does not slide)
     slides = ([np.zeros(trace.size)] * len(tangents) if not law.slide else
               list(slide_components(law.slide, tangents).reshape(trace.size, -1).T))
 
-    def shear(tt):
+    def parts(tt):
         tt = np.asarray(tt, dtype=float)
         nq = tt.shape[-1]
         at = evaluate_on_trace(elasticity.basis, trace, tt)
         normal = np.repeat(trace.normal, nq, axis=1)
-        argument = np.stack([
-            (at.stress_matrix(normal, np.repeat(tangent, nq, axis=1), elasticity.lame) @ u
-             - np.repeat(gamma_facet, nq) * (at.matrix(np.repeat(tangent, nq, axis=1)) @ u
-                                             - np.repeat(slide, nq))).reshape(trace.size, nq)
-            for tangent, slide in zip(tangents, slides, strict=True)], axis=-1)
-        # (facet, point, tangent)
+        stress = np.stack([(at.stress_matrix(normal, np.repeat(tangent, nq, axis=1),
+                                             elasticity.lame) @ u).reshape(trace.size, nq)
+                           for tangent in tangents], axis=-1)
+        argument = stress - np.stack([
+            np.repeat(gamma_facet, nq).reshape(trace.size, nq)
+            * ((at.matrix(np.repeat(tangent, nq, axis=1)) @ u).reshape(trace.size, nq)
+               - slide[:, None]) for tangent, slide in zip(tangents, slides, strict=True)],
+            axis=-1)                                          # (facet, point, tangent)
         bound = (law.coefficient * pressure(tt) if law.kind == "coulomb"
                  else law.slip_bound_at(trace.points(tt)).reshape(trace.size, nq))
         size = np.linalg.norm(argument, axis=-1)
         projected = argument * (np.minimum(size, bound) / np.where(size > 0, size, 1.0))[
             ..., None]
+        return stress, projected
+
+    return parts
+
+
+def shear_function(scene, elasticity, trace, gamma_facet: np.ndarray, u_free: np.ndarray,
+                   pressure):
+    """sigma_t,h(t) = [P_t(u_h)]_s at local coordinates t of every contact facet (in 3D the
+    vector P_t projected onto the disc of radius s)."""
+    parts = shear_parts(scene, elasticity, trace, gamma_facet, u_free, pressure)
+    tangents = contact_tangents(trace)
+
+    def shear(tt):
+        projected = parts(tt)[1]
         return projected[..., 0] if trace.dim == 2 else shear_vectors(projected, tangents)
 
     return shear
+
+
+def shear_residual(scene, elasticity, trace, gamma_facet: np.ndarray, u_free: np.ndarray,
+                   pressure):
+    """sum_k (sigma_nt_k(u_h) - sigma_t,h . t_k) t_k (d, n_facets, nt) at local coordinates t
+    of every contact facet: the tangential part of Nitsche's traction residual."""
+    parts = shear_parts(scene, elasticity, trace, gamma_facet, u_free, pressure)
+
+    def residual(tt):
+        stress, projected = parts(tt)
+        return shear_vectors(stress - projected, contact_tangents(trace))
+
+    return residual
 
 
 def nitsche_friction_state(scene, qp: ContactQP, answer, elasticity, trace, t: np.ndarray,

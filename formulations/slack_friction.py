@@ -48,8 +48,8 @@ def tangential_rows(elasticity, trace, t: np.ndarray) -> sparse.csr_matrix:
 
 
 def shear_vectors(values: np.ndarray, tangents: list[np.ndarray]) -> np.ndarray:
-    """sum_k values_k t_k (3, n_facets, nt) from the components ``values`` (n_facets, nt, 2)
-    along each facet's tangents (3D)."""
+    """sum_k values_k t_k (d, n_facets, nt) from the components ``values`` (n_facets, nt,
+    d - 1) along each facet's tangents (``contact_tangents``)."""
     return sum(values[..., k][None] * tangent[:, :, None] for k, tangent in enumerate(tangents))
 
 
