@@ -29,6 +29,7 @@ from estimators.auxiliary_traction import contact_traction
 from estimators.averaging import compliance_energy
 from estimators.base import BoundTerms, Estimate, planar_only, register_estimator
 from estimators.bounded_shear import auxiliary_shear, l2_excess_term
+from estimators.consistency_stress import consistency_stress, with_consistency
 from estimators.constants import domain_constants
 from estimators.equilibration import (
     BoundaryData,
@@ -250,7 +251,9 @@ def equilibrate(scene, solution: DiscreteSolution, symmetrise=None,
 
     clamped = np.zeros(mesh.p.shape[1], dtype=bool)
     clamped[mesh.facets[:, scene.dirichlet_facets(mesh)].ravel()] = True
-    interior = interior_data(mesh, stress, scene.body_force, order, max(4, 2 * order + 2))
+    interior = with_consistency(  # Nitsche's consistency term in the data (13.2)
+        interior_data(mesh, stress, scene.body_force, order, max(4, 2 * order + 2)),
+        consistency_stress(solution))
     trace = solution.trace
     n_v = mesh.p.shape[1]
     neumann = BoundaryData(scene.neumann_facets(mesh), scene.traction or (lambda x: 0.0 * x))

@@ -19,6 +19,7 @@ import numpy as np
 
 from estimators.averaging import compliance_energy
 from estimators.base import Estimate, register_cell_variant
+from estimators.consistency_stress import consistency_stress, with_consistency
 from estimators.constants import domain_constants
 from estimators.equilibrated import (
     BALANCE_TOLERANCE,
@@ -106,7 +107,9 @@ def equilibrate(scene, solution: DiscreteSolution):
 
     clamped = np.zeros(n_v, dtype=bool)
     clamped[mesh.facets[:, scene.dirichlet_facets(mesh)].ravel()] = True
-    interior = interior_data(mesh, stress, scene.body_force, order, INTORDER[order])
+    interior = with_consistency(  # Nitsche's consistency term in the data (13.2)
+        interior_data(mesh, stress, scene.body_force, order, INTORDER[order]),
+        consistency_stress(solution))
     neumann = BoundaryData(scene.neumann_facets(mesh), scene.traction or (lambda x: 0.0 * x))
     neumann_flux = boundary_fluxes(interior, [neumann])
     reaction = interior.total - boundary_balance(n_v, neumann_flux, 3)

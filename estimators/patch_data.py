@@ -76,11 +76,16 @@ def interior_data(mesh, sigma_h, body_force, k: int, intorder: int) -> Interior:
     rhs, data = patch_rhs(mesh, k, X, W, dg, stress, barycentric_gradients(mesh)[0])
     if body_force is not None:
         data = data - load_moments(mesh, body_force, k)
-    total = np.array([np.bincount(mesh.t.T.ravel(), data[:, :, r].sum(axis=-1).ravel(),
-                                  minlength=mesh.p.shape[1]) for r in range(d)]).T
     return Interior(rt=rt, sigma_h=stress, classes=classes, class_mass=mass,
                     class_divergence=divergence, rhs=rhs,
-                    data=data, total=total, k=k, intorder=intorder)
+                    data=data, total=vertex_totals(mesh, data), k=k, intorder=intorder)
+
+
+def vertex_totals(mesh, data: np.ndarray) -> np.ndarray:
+    """sum_T int_T (data) per vertex a and row r (n_vertices, d) from the divergence data
+    (n_el, d + 1, d, n_dg) (the P_k DG functions sum to 1)."""
+    return np.array([np.bincount(mesh.t.T.ravel(), data[:, :, r].sum(axis=-1).ravel(),
+                                 minlength=mesh.p.shape[1]) for r in range(mesh.dim())]).T
 
 
 def load_moments(mesh, body_force, k: int) -> np.ndarray:
@@ -119,7 +124,7 @@ def rebalanced(interior: Interior, defect: np.ndarray,
     c = np.where(clamped[:, None], 0.0, defect / weight[:, None])      # (n_vertices, d)
     local = c[mesh.t]                                                  # (d + 1, n_el, d)
     data = interior.data - np.einsum("ier,il,e->eirl", local,
-                                     _hat_moments(interior.k, mesh.dim()), area)
+                                     hat_moments(interior.k, mesh.dim()), area)
     # int_T (sum_i c_i lambda_i)^2 = |T| (sum c_i^2 + (sum c_i)^2) / ((d + 1)(d + 2))
     norm2 = area / (corners * (corners + 1)) * ((local**2).sum(axis=0)
                                                 + local.sum(axis=0) ** 2).sum(axis=-1)
@@ -127,7 +132,7 @@ def rebalanced(interior: Interior, defect: np.ndarray,
     return replace(interior, data=data, total=total), BalancingLoad(c, norm2)
 
 
-def _hat_moments(k: int, dim: int) -> np.ndarray:
+def hat_moments(k: int, dim: int) -> np.ndarray:
     """int_T lambda_i q_l / |T| for the barycentric lambda_i and the P_k DG basis q_l,
     (d + 1, n_dg) (the same on every simplex)."""
     X, W = get_quadrature(REFERENCE[dim], k + 1)
