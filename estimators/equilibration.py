@@ -27,7 +27,7 @@ import numpy as np
 from skfem import FacetBasis
 
 from estimators.patch_condensation import condensed
-from estimators.patch_data import Interior
+from estimators.patch_data import Interior, vertex_totals
 from estimators.patches import (
     FIXED,
     FREE,
@@ -173,8 +173,9 @@ def reconstruct(interior: Interior, fluxes: list[Flux], clamped: np.ndarray,
         np.add.at(sigma[r], lay.key_dof, free_values[:, r])
         np.add.at(sigma[r], dofs[status == FIXED], fixed[..., r][status == FIXED])
     balance = boundary_balance(n_v, fluxes, d)
-    gap = (interior.total - balance)[~clamped]
-    scale = np.abs(interior.total).max() + np.abs(balance).max() + np.finfo(float).tiny
+    total = vertex_totals(mesh, interior.data)  # from the data the patches solved with
+    gap = (total - balance)[~clamped]
+    scale = np.abs(total).max() + np.abs(balance).max() + np.finfo(float).tiny
     return Reconstruction(basis=rt, dofs=sigma, values=rt.values(sigma),
                           imbalance=float(np.abs(gap).max(initial=0.0) / scale))
 
