@@ -9,6 +9,7 @@ from scipy.linalg import eigh
 
 from formulations import get_formulation, solve
 from formulations.discretisation import why_unsolvable
+from formulations.evaluation import evaluate_on_trace
 from formulations.nitsche import DEFAULT_GAMMA_0
 from formulations.registry import FORMULATIONS
 from formulations.solvers.backends import available_backends
@@ -46,6 +47,32 @@ def test_every_variant_solves_its_equation_to_roundoff(theta, backend):
     J = system_matrix(disc.system, active)
     assert np.linalg.norm(J @ u + disc.system.T.T @ c - disc.system.F) <= ROUNDOFF * scale
     assert sol.diagnostics.active_set_changes[-1] == 0
+
+
+@pytest.mark.parametrize("theta, order", [(1.0, 1), (-1.0, 2)])
+def test_the_consistency_term_is_what_the_equation_adds_to_the_tractions(theta, order):
+    # K u - F + N'(W lambda_h) - c = 0 with c_i = sum_q w_q q_q . sigma(phi_i) n, c assembled
+    # here from the stored q, weights and points by the traction sigma(v) n component by
+    # component (not by sigma_nn): the residual is the solve's round-off (ROUNDOFF)
+    disc = discretised(theta, refinements=2, order=order)
+    sol = solve(disc, "active-set")
+    term, trace, elasticity = sol.consistency, sol.trace, disc.elasticity
+    nq = term.points.shape[-1]
+    at = evaluate_on_trace(elasticity.basis, trace, term.points)
+    normal = np.repeat(trace.normal, nq, axis=1)
+    vector = term.vector.reshape(2, -1)
+    c = sum(elasticity.restrict(at.stress_matrix(normal, np.repeat(axis[:, None], normal.shape[1],
+                                                                   axis=1), elasticity.lame)
+                                ).T @ (term.weights * vector[j])
+            for j, axis in enumerate(np.eye(2)))
+    u = sol.u[elasticity.free]
+    lam = sol.pressure(term.points).ravel()
+    residual = disc.system.K @ u - disc.system.F + disc.system.N.T @ (term.weights * lam) - c
+    scale = max(np.linalg.norm(disc.system.K @ u), np.linalg.norm(disc.system.F))
+    assert np.linalg.norm(residual) <= ROUNDOFF * scale
+    assert np.linalg.norm(c) >= 1e-6 * scale  # the term is there to be found
+    across = vector[0] * normal[1] - vector[1] * normal[0]
+    assert np.abs(across).max() <= 1e-12 * np.abs(vector).max()  # along n without friction
 
 
 @pytest.mark.parametrize("order", [1, 2, 3])
