@@ -14,7 +14,8 @@ from scenes import get_scene
 @pytest.mark.parametrize("name", ["free-boundary-3d", "stick-slip-3d"])
 def test_rho_is_round_off_where_the_body_force_is_rough(name):
     # refined once, both scenes have elements on the refined load rule. rho / eta measured:
-    # 5e-14 (free-boundary-3d) and 5e-8 (stick-slip-3d, Tresca's shear data); with the
+    # 5e-14 (free-boundary-3d) and 5e-8 (stick-slip-3d: at its Neumann vertices, where the
+    # formulation and the estimator integrate the smooth traction with two rules); with the
     # octahedra cut along a diagonal of the local vertex order it was 7e-3 and 4e-3. The
     # bound 1e-6 sits between the two with a factor >= 20 each way.
     scene = get_scene(name)
