@@ -12,9 +12,10 @@ disagree about int f by more than ROUGH_TOLERANCE max|f| |T| is split, up to MAX
 tetrahedra the same with eight children (the red refinement: four corner tetrahedra and the
 inner octahedron cut along one diagonal into four, the diagonal chosen by the global vertex
 numbers so that the rule does not depend on the order an element lists its vertices in),
-down to MAX_DEPTH_3D only: 8^depth children per rough element (measured on ``free-boundary-3d``, vi, P2, uniform: the energy
-error at 13 872 DOFs is 9.53e-4 with scikit-fem's rule, 8.97e-4 / 9.07e-4 / 8.96e-4 with depth
-1 / 2 / 3, the load taking 0.8 / 1.0 / 3.2 s; depth 5 took 90 s).
+down to MAX_DEPTH_3D only: 8^depth children per rough element (measured on
+``free-boundary-3d``, vi, P2, uniform: the energy error at 13 872 DOFs is 9.53e-4 with
+scikit-fem's rule, 8.97e-4 / 9.07e-4 / 8.96e-4 with depth 1 / 2 / 3, the load taking 0.8 /
+1.0 / 3.2 s; depth 5 took 90 s).
 """
 
 from __future__ import annotations
