@@ -126,15 +126,16 @@ def nitsche_system(scene: Scene, elasticity, trace, gap_h, t: np.ndarray, w: np.
         near_null=elasticity.rigid_modes)
 
 
-def consistency_term(system: SemismoothSystem, trace, nq: int, u_free: np.ndarray,
-                     points: np.ndarray, shear_residual=None) -> ConsistencyTerm | None:
+def consistency_term(system: SemismoothSystem, trace, u_free: np.ndarray, points: np.ndarray,
+                     shear_residual=None) -> ConsistencyTerm | None:
     """(12.1)'s terms beyond the tractions lambda_h and sigma_t,h as a ``ConsistencyTerm``:
     q = theta/gamma ((sigma_nn(u_h) + lambda_h) n + the shear residual ``shear_residual(t)``
     under friction, ``formulations.nitsche_friction``) at the system's own points (``points``
-    t, ``nq`` per contact facet; docs/theory.md 13.2, "Balance"); None for theta = 0, whose
+    t on every contact facet; docs/theory.md 13.2, "Balance"); None for theta = 0, whose
     equation has none."""
     if system.theta == 0:
         return None
+    nq = points.shape[-1]
     normal = np.repeat(trace.normal, nq, axis=1)
     residual = (system.S @ u_free + system.pressure(u_free)) * normal          # (d, n_f nq)
     if shear_residual is not None:
@@ -184,7 +185,7 @@ def discretise(scene: Scene, mesh: MeshTri, theta: float = 1.0,
             multiplier_breaks=(np.append(trace.coordinate[0], trace.coordinate[1, -1])
                                if trace.dim == 2 else np.zeros(0)),
             active_constraints=int((pressure_at_points > 0).sum()), details=details,
-            consistency=consistency_term(system, trace, t.shape[-1], u_free, t, residual),
+            consistency=consistency_term(system, trace, u_free, t, residual),
             friction=None if friction is None else nitsche_friction_state(
                 scene, friction, answer, elasticity, trace, t, system.weight, gamma_facet,
                 pressure))
