@@ -16,9 +16,10 @@ from bench.cli.diff import diff_command
 from bench.cli.generated import run_values
 from bench.cli.guards import InputError, check_compare_out, check_output_folders
 from bench.cli.listing import list_command
-from bench.cli.parser import build_parser
+from bench.cli.parser import build_parser, with_negative_values
 from bench.cli.progress import Progress
 from bench.cli.scaling_commands import scaling_command
+from bench.cli.signals import ending_signals, exit_status, signal_name
 from bench.cli.study import study_command
 from bench.export import export_results
 from bench.hard import (
@@ -35,6 +36,7 @@ from bench.matrix.config_files import (
     read_run_file,
     save_run_file,
 )
+from bench.matrix.files import FULL, DiskFull
 from bench.matrix.plugins import load_plugins
 from bench.matrix.run import RunRefused, compare_reference_dofs
 from bench.matrix.scene_files import load_scene_files, scene_files_in
@@ -278,19 +280,33 @@ def main(argv: list[str] | None = None) -> int:
     except ValueError as error:  # a run file that cannot be read, an unknown key
         print(f"error: {error}", file=sys.stderr)
         return 2
-    args = build_parser(defaults).parse_args(argv)
+    args = build_parser(defaults).parse_args(with_negative_values(argv))
     args.argv = argv
     args.file_fields = defaults.get(args.command, {})
     try:
-        check_output_folders(args.command, args)
-        return COMMANDS[args.command](args)
+        with ending_signals():
+            check_output_folders(args.command, args)
+            return COMMANDS[args.command](args)
     except (InputError, ResultsError, RunRefused) as error:
         print(f"error: {error}", file=sys.stderr)
         return 2
     except BrokenPipeError:  # the reader went away (e.g. `| head`): stop quietly
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 1
-    except KeyboardInterrupt:
+    except OSError as error:
+        if error.errno not in FULL:
+            raise
+        print(f"error: {error if isinstance(error, DiskFull) else full_disk(error)}",
+              file=sys.stderr)
+        return 2
+    except KeyboardInterrupt as error:
         print(f"interrupted: every finished row is kept in {getattr(args, 'out', 'the output')}"
-              " (results.parquet, results.csv)", file=sys.stderr)
-        return 130
+              f" (results.parquet, results.csv); ended by {signal_name(error)}",
+              file=sys.stderr)
+        return exit_status(error)
+
+
+def full_disk(error: OSError) -> str:
+    where = f" while writing {error.filename}" if error.filename else ""
+    return (f"no space left on the device{where}; free some space and run again: every row "
+            "finished before this is kept")

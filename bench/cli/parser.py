@@ -4,6 +4,7 @@ Every list of names comes from a registry."""
 from __future__ import annotations
 
 import argparse
+import re
 import sys
 from pathlib import Path
 
@@ -20,6 +21,22 @@ from bench.matrix.config import RunConfig
 from bench.matrix.config_files import compare_settings
 from bench.matrix.run import COMPARE_REFERENCE_DOFS, COMPARE_REFERENCE_DOFS_3D
 from formulations.cells import DEFAULT_CELL, cell_names
+
+NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$")
+
+
+def with_negative_values(argv: list[str]) -> list[str]:
+    """``--target-error -1e-3`` as ``--target-error=-1e-3``: argparse takes a token that starts
+    with '-' and is not a plain negative number for an option ("expected one argument"), so
+    the option's own check could not say what is allowed."""
+    out: list[str] = []
+    for token in argv:
+        if out and NEGATIVE_NUMBER.match(token) and out[-1].startswith("--") \
+                and "=" not in out[-1]:
+            out[-1] = f"{out[-1]}={token}"
+        else:
+            out.append(token)
+    return out
 
 
 def _scene_file_option(parser) -> None:

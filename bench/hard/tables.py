@@ -9,6 +9,7 @@ from pathlib import Path
 import pandas as pd
 
 from bench.hard.verdicts import ACCURATE
+from bench.matrix.files import atomic_text, atomic_write
 
 
 def check_expected(table: pd.DataFrame, expected: list[dict]) -> list[dict]:
@@ -57,6 +58,6 @@ def write_hard(table: pd.DataFrame, out) -> Path:
     """``out/hard.csv`` (every column) and ``out/hard.md`` (the verdict table)."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    table.to_csv(out / "hard.csv", index=False)
-    (out / "hard.md").write_text(hard_markdown(table) + "\n")
+    atomic_write(table, out / "hard.csv", "csv")
+    atomic_text(hard_markdown(table) + "\n", out / "hard.md")
     return out / "hard.csv"

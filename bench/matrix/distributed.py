@@ -9,8 +9,12 @@ cache, which must be shared storage for a remote cluster (``--cache``)."""
 from __future__ import annotations
 
 import asyncio
+import logging
 import os
+import signal
 import socket
+import threading
+from contextlib import contextmanager
 from dataclasses import replace
 from pathlib import Path
 from urllib.parse import urlsplit
@@ -100,14 +104,33 @@ def sequence_task(spec: SequenceSpec, out: str, run: dict, cache: str | None,
     return Outcome(spec.key, end, tuple(replace(r, sequence_end=end) for r in rows))
 
 
+@contextmanager
+def signals_ignored():
+    """SIGINT, SIGTERM and SIGHUP ignored while worker processes start, which keep it: a
+    Ctrl-C reaches the whole process group, and the driver, not each worker, ends the run
+    (``cluster.close`` stops them) with one line instead of a traceback per worker."""
+    ending = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    saved = {s: signal.signal(s, signal.SIG_IGN) for s in ending}
+    try:
+        yield
+    finally:
+        for number, handler in saved.items():
+            signal.signal(number, handler)
+
+
 def client_for(config):
     """A client of the cluster at ``config.scheduler``, or of a new local cluster."""
     from dask.distributed import Client, LocalCluster
 
     if config.scheduler:
         return Client(config.scheduler, timeout=SCHEDULER_TIMEOUT), None
-    cluster = LocalCluster(n_workers=config.workers, threads_per_worker=1, processes=True,
-                           env=SINGLE_THREAD, dashboard_address=":0")
+    with signals_ignored():  # the workers inherit it: the driver alone answers Ctrl-C
+        cluster = LocalCluster(n_workers=config.workers, threads_per_worker=1,
+                               processes=True, env=SINGLE_THREAD, dashboard_address=":0",
+                               silence_logs=logging.ERROR)
     client = Client(cluster)
     print(f"Dask dashboard: {client.dashboard_link}", flush=True)
     return client, cluster
@@ -134,7 +157,7 @@ def run_on_dask(specs: list[SequenceSpec], store: ResultStore, run: dict, config
         for future in as_completed(futures):
             outcome = future.result()
             rows += outcome.rows
-            store.consolidate()
+            store.finish(outcome.key, outcome.end)
             if on_sequence is not None:
                 on_sequence(futures[future], outcome.end)
         return rows

@@ -1,18 +1,47 @@
-"""Files of a results folder that may be damaged: a parquet read from one open, atomic writes,
-the checksums that say whether the tables are stale, and a damaged partition restored from
-the tables or set aside (docs/reliability.md)."""
+"""Files of a results folder: a parquet read from one open, writes that either happen whole or
+not at all (a temporary file, fsync, rename, fsync of the folder), a full disk named in one
+line with nothing half-written left, and the checksums that say whether the tables are stale
+(docs/reliability.md, "The store")."""
 
 from __future__ import annotations
 
+import errno
 import hashlib
 import io
 import os
-import sys
+import shutil
+from contextlib import contextmanager, suppress
 from pathlib import Path
 
 import pandas as pd
 
-from bench.sequence.rows import COLUMNS, with_labels
+FULL = (errno.ENOSPC, errno.EDQUOT, errno.EFBIG)  # the write did not fit
+
+
+class DiskFull(OSError):
+    """A write that did not fit on its file system: names the folder and the space it needed."""
+
+    def __init__(self, path: Path, needed: int, error: OSError):
+        folder = Path(path).parent
+        try:
+            free = shutil.disk_usage(folder).free
+        except OSError:
+            free = 0
+        super().__init__(error.errno, f"no space left on the device of {folder} while writing "
+                         f"{Path(path).name} ({_size(needed)} needed, {_size(free)} free); "
+                         "free some space and run again: every row finished before this is "
+                         "kept")
+        self.folder, self.needed = folder, needed
+
+    def __str__(self) -> str:
+        return self.strerror
+
+
+def _size(nbytes: int) -> str:
+    for unit, scale in (("GB", 1e9), ("MB", 1e6), ("kB", 1e3)):
+        if nbytes >= scale:
+            return f"{nbytes / scale:.1f} {unit}"
+    return f"{nbytes} bytes"
 
 
 def read_snapshot(path: Path) -> pd.DataFrame:
@@ -21,14 +50,64 @@ def read_snapshot(path: Path) -> pd.DataFrame:
     return pd.read_parquet(io.BytesIO(path.read_bytes()))
 
 
-def atomic_write(frame: pd.DataFrame, path: Path, kind: str) -> None:
-    """Write ``frame`` to ``path`` as parquet or csv through a temporary file of this process."""
+def _fsync_folder(folder: Path) -> None:
+    with suppress(OSError):  # some file systems cannot sync a folder; the rename still holds
+        handle = os.open(folder, os.O_RDONLY)
+        try:
+            os.fsync(handle)
+        finally:
+            os.close(handle)
+
+
+@contextmanager
+def atomic_path(path: Path, needed: int = 0):
+    """A temporary path of this process beside ``path``: what is written to it becomes
+    ``path`` (synced, then renamed) when the block ends, or nothing at all if it raises; a full
+    disk raises DiskFull naming the folder and ``needed`` (or the bytes written so far)."""
+    path = Path(path)
     tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    try:
+        yield tmp
+        with open(tmp, "rb+") as handle:
+            os.fsync(handle.fileno())
+        os.replace(tmp, path)
+    except OSError as error:
+        written = tmp.stat().st_size if tmp.exists() else 0
+        with suppress(OSError):
+            tmp.unlink()
+        if error.errno in FULL and not isinstance(error, DiskFull):
+            raise DiskFull(path, max(needed, written), error) from None
+        raise
+    except BaseException:
+        with suppress(OSError):
+            tmp.unlink()
+        raise
+    _fsync_folder(path.parent)
+
+
+def atomic_bytes(data: bytes, path: Path) -> None:
+    """Write ``data`` to ``path`` whole or not at all (``atomic_path``)."""
+    with atomic_path(path, len(data)) as tmp:
+        with open(tmp, "wb") as handle:
+            handle.write(data)
+
+
+def atomic_text(text: str, path: Path) -> None:
+    atomic_bytes(text.encode(), path)
+
+
+def frame_bytes(frame: pd.DataFrame, kind: str) -> bytes:
+    """``frame`` as parquet or csv, in memory (so its size is known before it is written)."""
     if kind == "parquet":
-        frame.to_parquet(tmp, index=False)
-    else:
-        frame.to_csv(tmp, index=False)
-    os.replace(tmp, path)
+        buffer = io.BytesIO()
+        frame.to_parquet(buffer, index=False)
+        return buffer.getvalue()
+    return frame.to_csv(index=False).encode()
+
+
+def atomic_write(frame: pd.DataFrame, path: Path, kind: str) -> None:
+    """Write ``frame`` to ``path`` as parquet or csv, whole or not at all."""
+    atomic_bytes(frame_bytes(frame, kind), path)
 
 
 def checksums(folder: Path, tables: bool = True) -> dict[str, str]:
@@ -41,35 +120,15 @@ def checksums(folder: Path, tables: bool = True) -> dict[str, str]:
             if p.exists() else "" for p in paths}
 
 
-def read_partition(path: Path) -> pd.DataFrame | None:
-    """The rows of one partition. A damaged one is rewritten from the rows of its sequence in
-    the folder's tables when they hold them, else renamed ``*.damaged`` (its sequence is then
-    rerun by the next run); either way one line on standard error says so."""
-    try:
-        return read_snapshot(path)
-    except Exception as error:  # pyarrow raises several types for a damaged file
-        why = f"{path} is unreadable ({type(error).__name__}: {error})"
-    rows = _table_rows(path.parent.parent, path.stem)
-    if rows is not None and len(rows):
-        atomic_write(with_labels(rows.reindex(columns=COLUMNS)), path, "parquet")
-        print(f"note: {why}; restored its {len(rows)} rows from the folder's results table",
-              file=sys.stderr)
-        return read_snapshot(path)
-    damaged = path.with_name(path.name + ".damaged")
-    os.replace(path, damaged)
-    print(f"warning: {why}, and the folder's tables do not hold its rows; set aside as "
-          f"{damaged.name}: the next run reruns its sequence (delete the file when done)",
-          file=sys.stderr)
-    return None
-
-
-def _table_rows(folder: Path, key: str) -> pd.DataFrame | None:
-    """The rows of sequence ``key`` in ``folder``'s parquet table, else its CSV mirror."""
+def read_table(folder: Path) -> pd.DataFrame | None:
+    """The rows of ``folder``'s consolidated table: results.parquet, else its CSV mirror when
+    that is intact; None when neither can be read."""
     for path, read in ((folder / "results.parquet", read_snapshot),
                        (folder / "results.csv", pd.read_csv)):
         try:
             table = read(path)
-            return table[table["sequence_key"].astype(str) == key]
-        except Exception:  # missing or damaged too: try the next, else nothing to restore
+        except Exception:  # missing or damaged (pyarrow, pandas raise several types)
             continue
+        if "scene" in table.columns and "level" in table.columns:
+            return table
     return None

@@ -10,6 +10,7 @@ import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
+from bench.matrix.files import atomic_text
 from bench.matrix.provenance import provenance
 from bench.matrix.spec import SequenceSpec
 from bench.matrix.store import ResultStore
@@ -41,7 +42,7 @@ def write_truth_summary(out, name: str, truth) -> None:
             summary[name]["crosscheck"] = truth.crosscheck.summary()
     else:
         summary[name] = {"kind": "exact", "source": truth.scene.exact.source}
-    path.write_text(json.dumps(summary, indent=1, default=float))
+    atomic_text(json.dumps(summary, indent=1, default=float), path)
 
 
 def run_specs(specs: Sequence[SequenceSpec], store: ResultStore, run: dict,

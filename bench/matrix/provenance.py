@@ -12,6 +12,8 @@ import subprocess
 from importlib import metadata
 from pathlib import Path
 
+from bench.matrix.files import atomic_text
+
 PACKAGES = ("numpy", "scipy", "scikit-fem", "cvxpy", "clarabel", "pandas")
 NUMERICAL_STACK = ("numpy", "scipy", "scikit-fem", "mkl", "pypardiso", "scikit-sparse",
                    "clarabel", "cvxpy", "meshio")
@@ -71,4 +73,4 @@ def write_run_record(out: Path, config, run_id: str, reused) -> None:
         pass  # none, or damaged: this run's record replaces it
     record = {"command": config.command, "configuration": config.record(), "run_id": run_id,
               "reused": list(reused), "numerics": numerics(), "earlier": earlier}
-    path.write_text(json.dumps(record, indent=1, default=str))
+    atomic_text(json.dumps(record, indent=1, default=str), path)

@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from bench.matrix.files import atomic_text, atomic_write
 from bench.sequence.rows import KEYS, with_labels
 from formulations import STATUS_OK
 
@@ -98,8 +99,8 @@ def write_rates(table: pd.DataFrame, out: str | Path) -> Path:
     """rates.csv and rates.md next to the results."""
     out = Path(out)
     rates = rates_table(table)
-    rates.to_csv(out / "rates.csv", index=False)
-    (out / "rates.md").write_text(
+    atomic_write(rates, out / "rates.csv", "csv")
+    atomic_text(
         f"Slopes over the last {RATE_LEVELS} levels (-1/4 = O(h^1/2), -1/2 = O(h)).\n\n"
-        + rates.to_markdown(index=False, floatfmt=".3g") + "\n")
+        + rates.to_markdown(index=False, floatfmt=".3g") + "\n", out / "rates.md")
     return out / "rates.md"

@@ -158,16 +158,11 @@ def _run_into(store: ResultStore, config: RunConfig, specs, truths, on_level, on
         write_truth_summary(store.out, name, truth)
     write_run_record(store.out, config, identity["run_id"], reused)
 
-    def sequence_done(spec: SequenceSpec, end: str) -> None:
-        store.keep_new()  # a sequence of this run finished: the old results may go
-        if on_sequence is not None:
-            on_sequence(spec, end)
-
     if config.workers or config.scheduler:
         from bench.matrix.distributed import run_on_dask
 
-        rows = run_on_dask(todo, store, identity, config, sequence_done)
+        rows = run_on_dask(todo, store, identity, config, on_sequence)
     else:
         rows = run_specs(todo, store, identity, on_level, truths, config.max_memory_gib,
-                         sequence_done)
+                         on_sequence)
     return rows, reused

@@ -1,15 +1,15 @@
-"""The result store of an output folder: one partition per sequence, and the consolidated
-``results.parquet`` and ``results.csv`` derived from them.
+"""The result store of an output folder (docs/reliability.md, "The store"): one partition per
+sequence, the record, and the consolidated ``results.parquet`` and ``results.csv`` derived
+from them.
 
-Each sequence writes only its own partition, ``sequences/<sequence key>.parquet``, rewritten
-atomically (a temporary file of the writing process, then a rename) after every finished level,
-so concurrent runs and Dask workers never write the same file and an interrupted run loses no
-finished level. ``consolidate`` (when a sequence ends) rebuilds the two tables from all
-partitions under a file lock,
-each atomically: no row is lost or duplicated, and a rerun of a sequence replaces its own
-partition. Rows of earlier runs are kept unless ``overwrite`` is set; a folder written by an
-older version (tables, no partitions) is taken over as one partition.
-"""
+Each sequence writes only its own partition, ``sequences/<sequence key>.parquet``, whole or not
+at all (``files.atomic_write``) after every finished level, so concurrent runs and Dask workers
+never write the same file and an ended process loses no finished level. ``consolidate`` (when
+a sequence ends) rewrites the two tables from all partitions under a file lock. Readers
+(``read_results``: ``report``, ``diff``, ``compare``'s report) never write into a folder; the
+writer repairs what ``FolderState`` found when it opens the folder: a set-aside folder whose run
+has ended comes back, rows the tables hold and the partitions lost become partitions again, a
+damaged partition is set aside."""
 
 from __future__ import annotations
 
@@ -17,23 +17,16 @@ import fcntl
 import hashlib
 import json
 import os
-import shutil
 import sys
-import time
 from contextlib import contextmanager
 from pathlib import Path
 
 import pandas as pd
 
-from bench.matrix.files import (
-    atomic_write,
-    checksums,
-    read_partition,
-    read_snapshot,
-)
+from bench.matrix.files import atomic_text, atomic_write, checksums, read_snapshot
+from bench.matrix.folder_state import MANIFEST, FolderState
+from bench.matrix.set_aside import SetAsideFolder, discard, discard_folder, restore_into
 from bench.sequence.rows import COLUMNS, FINISHED, ResultRow, with_labels
-
-MANIFEST = "results.sha256"  # checksums of the partitions and tables at consolidation
 
 
 class ResultsError(ValueError):
@@ -41,66 +34,75 @@ class ResultsError(ValueError):
 
 
 def read_results(folder: str | Path) -> pd.DataFrame | None:
-    """The rows of ``folder`` (None if it has none). The partitions in ``sequences/`` are the
-    source of truth: when ``results.parquet`` is missing, unreadable or holds other rows than
-    they do, both tables are rebuilt from them (with a note on standard error). Without
-    partitions, an unreadable parquet falls back to the CSV mirror when that is intact; when
-    both are unreadable, ResultsError names the file and what to do."""
+    """The rows of ``folder`` (None if it has none), read without writing: the partitions in
+    ``sequences/`` and what the tables or a set-aside folder hold beyond them (each counted in
+    one note on standard error). Without partitions (an older version's folder) the table,
+    or its CSV mirror when the parquet is unreadable; ResultsError when neither can be read."""
     folder = Path(folder)
+    state = FolderState.read(folder)
+    if state.partitions or state.damaged or state.set_aside:
+        if state.tables_current():
+            return read_snapshot(folder / "results.parquet")
+        for line in notes(state) or [stale_note(folder)]:
+            print(line, file=sys.stderr)
+        return state.rows()
     parquet, csv = folder / "results.parquet", folder / "results.csv"
-    partitions = folder / "sequences"
-    if any(partitions.glob("*.parquet")):
-        return _rebuilt_if_stale(folder)
-    if not parquet.exists():
+    if not parquet.exists() and not csv.exists():
         return None
+    if state.table is None:
+        raise ResultsError(f"{parquet} is unreadable, and so is its CSV mirror {csv}; move the "
+                           "folder away or rerun with --overwrite")
+    if "sequence_end" not in state.table.columns or not _parquet_readable(parquet):
+        print(f"note: {parquet} is unreadable; using its CSV mirror {csv} "
+              f"({len(state.table)} rows)", file=sys.stderr)
+    return state.table
+
+
+def _parquet_readable(path: Path) -> bool:
     try:
-        return read_snapshot(parquet)
-    except Exception as error:  # pyarrow raises several types for a damaged file
-        why = f"{parquet} is unreadable ({type(error).__name__}: {error})"
-    try:
-        table = pd.read_csv(csv)
-        if "scene" not in table.columns or "level" not in table.columns:
-            raise ValueError("not a results table")
-    except Exception as error:
-        raise ResultsError(f"{why}, and so is its CSV mirror {csv} ({error}); move the folder "
-                           "away or rerun with --overwrite") from None
-    print(f"note: {why}; using its CSV mirror {csv} ({len(table)} rows)", file=sys.stderr)
-    return table
+        read_snapshot(path)
+        return True
+    except Exception:  # pyarrow raises several types for a damaged file
+        return False
 
 
-def _rebuilt_if_stale(folder: Path) -> pd.DataFrame:
-    """The consolidated table of ``folder``'s partitions. The tables on disk are trusted only
-    when the checksums recorded at their consolidation (``results.sha256``) still match every
-    partition and both tables; else both are rewritten from the partitions."""
-    parquet, csv = folder / "results.parquet", folder / "results.csv"
-    table = partition_table(folder / "sequences")
-    why = None
-    try:
-        recorded = json.loads((folder / MANIFEST).read_text())
-        if recorded != checksums(folder):
-            why = f"{parquet.name} or {csv.name} holds other rows than the partitions"
-        else:
-            on_disk = read_snapshot(parquet)
-    except Exception as error:  # missing or damaged: json, pyarrow raise several types
-        why = f"{parquet} or {csv.name} (or its checksums {MANIFEST}) is missing or " \
-              f"unreadable ({type(error).__name__}: {error})"
-    if why is None:
-        return on_disk
-    store = ResultStore(folder)
-    table = store.consolidate().reset_index(drop=True)
-    print(f"note: {why}; rebuilt both from the partitions in {store.partitions} "
-          f"({len(table)} rows)", file=sys.stderr)
-    return table
+def notes(state: FolderState, writing: bool = False) -> list[str]:
+    """One line for each way the folder differs from its record, with the rows it keeps
+    (``writing``: as the writer that repairs it says it)."""
+    folder, lines = state.folder, []
+    kept = "they are written back" if writing else \
+        f"they are kept (the next run into {folder} writes them back)"
+    orphans = state.orphans()
+    by_key = orphans["sequence_key"].astype(str) if len(orphans) else pd.Series(dtype=str)
+    for path in state.damaged:
+        held = int((by_key == path.stem).sum())
+        lines.append(f"note: {path} is unreadable; its {held} rows are in the folder's results "
+                     f"table: {kept}" if held else
+                     f"warning: {path} is unreadable, and the folder's tables do not hold its "
+                     f"rows; " + (f"set aside as {path.name}.damaged: this run reruns its "
+                                  "sequence" if writing else
+                                  f"left out (the next run into {folder} sets it aside and "
+                                  "reruns its sequence)"))
+    missing = orphans[~by_key.isin({p.stem for p in state.damaged})]
+    if len(missing):
+        lines.append(f"note: the results table holds {len(missing)} rows of "
+                     f"{missing['sequence_key'].nunique()} sequences whose files are missing "
+                     f"from {folder / 'sequences'}; {kept}")
+    for aside in state.set_aside:
+        taken = [f for stem, f in state.restored() if stem in aside.partitions]
+        if taken and not aside.alive:
+            lines.append(f"note: {aside.path} holds {sum(map(len, taken))} rows of "
+                         f"{len(taken)} sequences that an --overwrite run set aside and did not "
+                         f"replace (it ended before finishing a sequence); "
+                         + ("they are put back" if writing else
+                            f"they are kept (the next run into {folder} puts them back)"))
+    return lines
 
 
-def partition_table(partitions: Path) -> pd.DataFrame:
-    """Every row of the partitions ``partitions/*.parquet``, with every column; a damaged
-    partition is restored from the folder's tables or set aside (``read_partition``)."""
-    frames = [read_partition(path) for path in sorted(partitions.glob("*.parquet"))]
-    frames = [f for f in frames if f is not None and len(f)]
-    if not frames:
-        return pd.DataFrame(columns=COLUMNS)
-    return with_labels(pd.concat(frames, ignore_index=True).reindex(columns=COLUMNS))
+def stale_note(folder: Path) -> str:
+    return (f"note: {folder / 'results.parquet'} or results.csv holds other rows than the "
+            f"partitions (or is missing); read from the partitions (the next run into {folder} "
+            "rewrites both)")
 
 
 @contextmanager
@@ -134,115 +136,116 @@ class SequenceWriter:
 
 
 class ResultStore:
-    """The store of one output folder. With ``overwrite`` the earlier results are moved aside
-    (``.previous-*``), not deleted: ``keep_new`` deletes them once the new run has finished a
-    sequence, ``restore_previous`` puts them back when it fails before that."""
-
-    PREVIOUS = ".previous-"  # prefix of the folder that holds results moved aside
-    MOVED = ("results.parquet", "results.csv", "rates.csv", "rates.md", "sequences")
+    """The store of one output folder, repaired when opened (``repair``). With ``overwrite``
+    the earlier results are set aside (``set_aside.SetAsideFolder``), not deleted: ``keep_new``
+    deletes them once the new run has finished a sequence, ``restore_previous`` puts them back
+    when it ends before that (and the next run does, if the process was killed)."""
 
     def __init__(self, out: str | Path, overwrite: bool = False):
         self.out = Path(out)
         self.out.mkdir(parents=True, exist_ok=True)
         self.csv, self.parquet = self.out / "results.csv", self.out / "results.parquet"
         self.partitions = self.out / "sequences"
-        self.previous: Path | None = None
+        self.previous: SetAsideFolder | None = None
         with folder_lock(self.out):
-            self._note_leftovers()
-            if overwrite:
-                self._move_aside()
             self.partitions.mkdir(exist_ok=True)
-            self._adopt_tables()
+            self.repair()
+            if overwrite:
+                self.previous = SetAsideFolder.create(self.out)
+                self.partitions.mkdir(exist_ok=True)
         self.writers: dict[str, SequenceWriter] = {}
 
-    def _note_leftovers(self) -> None:
-        for folder in sorted(self.out.glob(f"{self.PREVIOUS}*")):
-            print(f"note: {folder} holds results that an earlier --overwrite run moved aside "
-                  "and did not finish replacing; move its files back into "
-                  f"{self.out} to keep them, or delete it", file=sys.stderr)
-
-    def _move_aside(self) -> None:
-        present = [name for name in self.MOVED if (self.out / name).exists()]
-        if not present:
-            return
-        self.previous = self.out / f"{self.PREVIOUS}{os.getpid()}-{time.time_ns()}"
-        self.previous.mkdir()
-        for name in present:
-            os.replace(self.out / name, self.previous / name)
+    def repair(self) -> None:
+        """Make the record hold every row the folder holds: set-aside folders whose run has
+        ended come back, a damaged partition is set aside (``*.damaged``), and rows that only
+        the tables hold become partitions again; each said in one line."""
+        state = FolderState.read(self.out)
+        found = notes(state, writing=True)
+        for line in found:
+            print(line, file=sys.stderr)
+        ended = [aside.path for aside in state.set_aside if not aside.alive]
+        for path in ended:
+            restore_into(self.out, path, state)
+        for path in state.damaged:
+            os.replace(path, path.with_name(path.name + ".damaged"))
+        self._adopt(state.orphans())
+        for path in ended:
+            discard_folder(path)
+        discard(self.out)
+        if found:
+            self.consolidate(locked=True)
 
     def keep_new(self) -> None:
-        """The new run has finished a sequence: the results moved aside are deleted."""
+        """The new run has finished a sequence: the results set aside are deleted."""
         if self.previous is not None:
-            shutil.rmtree(self.previous, ignore_errors=True)
+            self.previous.discard()
             self.previous = None
 
     def restore_previous(self) -> None:
-        """The new run failed before finishing a sequence: the results moved aside come back
-        (the new run's own partitions, rows it finished, are kept beside them)."""
+        """The new run ended before finishing a sequence: the results set aside come back (the
+        new run's own partitions, rows it finished, are kept beside them)."""
         if self.previous is None:
             return
         with folder_lock(self.out):
-            self.partitions.mkdir(exist_ok=True)
-            for path in sorted(self.previous.glob("sequences/*.parquet")):
-                if not (self.partitions / path.name).exists():
-                    os.replace(path, self.partitions / path.name)
-            for name in ("rates.csv", "rates.md"):
-                if (self.previous / name).exists() and not (self.out / name).exists():
-                    os.replace(self.previous / name, self.out / name)
-            if not (self.previous / "sequences").exists():  # tables of an older version
-                self._adopt(read_results(self.previous))
-            shutil.rmtree(self.previous, ignore_errors=True)
+            restore_into(self.out, self.previous.path, FolderState.read(self.out))
+            self._adopt(FolderState.read(self.out).orphans())
+            self.previous.release()
             self.previous = None
-        self.consolidate()
+            self.consolidate(locked=True)
 
-    def _adopt_tables(self) -> None:
-        """Tables without partitions (an older version wrote them) become one partition."""
-        if not any(self.partitions.glob("*.parquet")):
-            self._adopt(read_results(self.out))
-
-    def _adopt(self, previous: pd.DataFrame | None) -> None:
-        if previous is not None and len(previous):
-            digest = hashlib.sha256(previous.to_csv().encode()).hexdigest()[:12]
-            frame = with_labels(previous.reindex(columns=COLUMNS))
-            atomic_write(frame, self.partitions / f"adopted-{digest}.parquet", "parquet")
+    def _adopt(self, rows: pd.DataFrame) -> None:
+        """Rows that only a table holds, written back as one partition per sequence (those of
+        an older version, without a key, as one ``adopted-*`` partition)."""
+        if not len(rows):
+            return
+        rows = with_labels(rows.reindex(columns=COLUMNS))
+        for key, frame in rows.groupby(rows["sequence_key"].astype(str), sort=True):
+            if not key:
+                digest = hashlib.sha256(frame.to_csv().encode()).hexdigest()[:12]
+                key = f"adopted-{digest}"
+            atomic_write(frame.reset_index(drop=True), self.partitions / f"{key}.parquet",
+                         "parquet")
 
     def sequence(self, key: str) -> SequenceWriter:
         return SequenceWriter(self.partitions / f"{key}.parquet")
 
     def append(self, row: ResultRow) -> None:
-        """Store one finished row in its sequence's partition, the durable record; the tables
-        are consolidated when the sequence ends (``finish``). Consolidating after every row
-        re-read every partition each time, quadratic in the run; meanwhile a reader finds the
-        tables stale by their checksums and rebuilds them (``read_results``)."""
+        """Store one finished row in its sequence's partition, the record; the tables are
+        consolidated when the sequence ends (``finish``): consolidating after every row would
+        re-read every partition each time, quadratic in the run."""
         key = row.sequence_key or "unkeyed"
         if key not in self.writers:
             self.writers[key] = self.sequence(key)
         self.writers[key].append(row)
 
     def finish(self, key: str, end: str) -> None:
-        """Record why the sequence ``key`` ended, in its partition."""
+        """Record why the sequence ``key`` ended, in its partition (a worker's partition
+        records it itself); once one has finished, what an ``--overwrite`` set aside goes."""
         if key in self.writers:
             self.writers[key].finish(end)
+        if end in FINISHED:
+            self.keep_new()
         self.consolidate()
 
     def table(self) -> pd.DataFrame:
-        """All rows in the folder, from every partition: earlier runs and this run's."""
-        return partition_table(self.partitions)
+        """All rows in the folder's partitions: earlier runs' and this run's (what the folder
+        held beside them was written back when it was opened)."""
+        return FolderState.read(self.out).record()
 
-    def consolidate(self) -> pd.DataFrame:
+    def consolidate(self, locked: bool = False) -> pd.DataFrame:
         """results.parquet and results.csv from every partition (under the folder's lock)."""
-        with folder_lock(self.out):
-            # partitions' checksums first: one that a worker replaces meanwhile then fails
-            # them, and the tables are rebuilt when next read (never trusted while stale)
-            before = checksums(self.out, tables=False)
-            table = self.table().sort_values(["run_id"], kind="stable")
-            atomic_write(table, self.parquet, "parquet")
-            atomic_write(table, self.csv, "csv")
-            written = {**before, **{path.name: hashlib.sha256(path.read_bytes()).hexdigest()
-                                    for path in (self.parquet, self.csv)}}
-            manifest = self.out / f".{MANIFEST}.{os.getpid()}.tmp"
-            manifest.write_text(json.dumps(written, indent=1))
-            os.replace(manifest, self.out / MANIFEST)
+        if not locked:
+            with folder_lock(self.out):
+                return self.consolidate(locked=True)
+        # partitions' checksums first: one that a worker replaces meanwhile then fails them,
+        # and the tables are read from the partitions until the next consolidation
+        before = checksums(self.out, tables=False)
+        table = self.table()
+        atomic_write(table, self.parquet, "parquet")
+        atomic_write(table, self.csv, "csv")
+        written = {**before, **{path.name: hashlib.sha256(path.read_bytes()).hexdigest()
+                                for path in (self.parquet, self.csv)}}
+        atomic_text(json.dumps(written, indent=1), self.out / MANIFEST)
         return table
 
     def finished_keys(self) -> set[str]:
@@ -251,3 +254,4 @@ class ResultStore:
         table = self.table()
         done = table[table["sequence_end"].isin(FINISHED)]
         return set(done["sequence_key"]) - {""}
+

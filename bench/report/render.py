@@ -15,6 +15,7 @@ from bench.hard import LOSS_TOLERANCE, PRESSURE_TOLERANCE, check_expected, hard_
 from bench.hard.matrix import matrix_html, matrix_markdown, verdict_matrix
 from bench.hard.registry import CASE_FIGURES
 from bench.matrix.artifacts import file_stem
+from bench.matrix.files import atomic_text
 from bench.matrix.rates import RATE_LEVELS, judged_levels, rates_table
 from bench.matrix.scene_files import load_scene_files
 from bench.report.estimator_figures import ESTIMATOR_CAPTION, estimator_effectivity
@@ -93,9 +94,9 @@ def _render(context: dict, out: Path) -> Path:
                              lstrip_blocks=True)
     env.filters["markdown_table"] = lambda t: t.to_markdown(index=False) if len(t) else "None."
     env.filters["records"] = lambda t: t.to_dict("records")
-    (out / "index.html").write_text(env.get_template("report.html.j2").render(**context))
+    atomic_text(env.get_template("report.html.j2").render(**context), out / "index.html")
     path = out / "README.md"
-    path.write_text(env.get_template("report.md.j2").render(**context))
+    atomic_text(env.get_template("report.md.j2").render(**context), path)
     return path
 
 

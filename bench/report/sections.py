@@ -10,6 +10,7 @@ import numpy as np
 import pandas as pd
 
 from bench.matrix.artifacts import artifact_path, file_stem, load_artifact
+from bench.matrix.files import atomic_bytes
 from bench.report import figures, figures_3d, friction_figures, panels
 from bench.sequence.rows import KEYS
 from scenes import get_scene
@@ -29,7 +30,7 @@ class Figures:
         buffer = io.BytesIO()
         figure.savefig(buffer, format="png", dpi=110)
         data = buffer.getvalue()
-        (self.out / f"{name}.png").write_bytes(data)
+        atomic_bytes(data, self.out / f"{name}.png")
         item = {"file": f"figures/{name}.png", "caption": caption,
                 "data": base64.b64encode(data).decode("ascii")}
         self.items.append(item)

@@ -13,6 +13,7 @@ import pytest
 from bench.cli import main
 from bench.matrix.distributed import SchedulerError, check_scheduler
 from bench.matrix.store import read_results
+from conftest import folder_bytes
 from scenes import SceneError
 from scenes.expressions import Expression, ExpressionError
 from scenes.mesh_file import read_mesh_file
@@ -22,15 +23,22 @@ def damage(path) -> None:
     path.write_bytes(path.read_bytes()[:100])
 
 
-def test_a_damaged_sequence_file_is_restored_from_intact_tables(results_copy, tmp_path,
-                                                                capsys):
+def test_a_damaged_sequence_file_is_read_from_intact_tables_and_restored_by_a_run(
+        results_copy, tmp_path, capsys):
     partition = sorted((results_copy / "sequences").glob("*.parquet"))[0]
     rows = len(pd.read_parquet(partition))
+    total = len(pd.read_parquet(results_copy / "results.parquet"))
     damage(partition)
+    before = folder_bytes(results_copy)
     assert main(["report", "--results", str(results_copy), "--out", str(tmp_path / "rep")]) == 0
     err = capsys.readouterr().err
-    assert f"restored its {rows} rows" in err and "Traceback" not in err
-    assert len(pd.read_parquet(partition)) == rows
+    assert f"its {rows} rows are in the folder's results table" in err and "Traceback" not in err
+    assert f"{total} result rows" in (tmp_path / "rep" / "README.md").read_text()
+    assert folder_bytes(results_copy) == before  # the reader wrote nothing
+    assert main(["run", "--scene", "free-boundary", "--formulation", "vi,mixed", "--solver",
+                 "active-set", "--max-dofs", "300", "--out", str(results_copy)]) == 0
+    assert "written back" in capsys.readouterr().err
+    assert len(pd.read_parquet(partition)) == rows  # the writer restored it, nothing rerun
 
 
 def test_a_damaged_sequence_file_without_a_copy_is_set_aside_and_rerun(results_copy, capsys):
