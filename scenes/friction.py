@@ -69,6 +69,9 @@ class FrictionLaw:
 NO_FRICTION = FrictionLaw()
 
 
+MU_MAX = 100.0  # a Coulomb coefficient beyond it adds nothing but round-off (docs/friction.md)
+
+
 def friction_law(friction: str = "none", mu: float = 0.0, slip_bound: float = 0.0,
                  tresca_bound: PointFunction | None = None, slide: float = 0.0) -> FrictionLaw:
     """The law from a scene's parameters: ``tresca`` takes the constant ``slip_bound`` (a
@@ -91,8 +94,10 @@ def friction_law(friction: str = "none", mu: float = 0.0, slip_bound: float = 0.
         raise SceneError(f"slide={slide!r} needs a friction law (friction='none': a "
                          "frictionless obstacle slides without effect)")
     if friction == "coulomb":
-        if mu <= 0:
-            raise SceneError(f"mu={mu!r} is not > 0 (friction='coulomb')")
+        if not 0 < mu <= MU_MAX:
+            raise SceneError(f"mu={mu!r} is not in (0, {MU_MAX:g}] (friction='coulomb'): "
+                             "measured friction coefficients lie below about 2, and at "
+                             f"{MU_MAX:g} the contact already sticks wherever it can")
         return FrictionLaw("coulomb", coefficient=float(mu), slide=float(slide))
     if friction == "tresca":
         if tresca_bound is None:

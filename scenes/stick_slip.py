@@ -29,7 +29,7 @@ import numpy as np
 
 from scenes.base import ExactSolution, Material, Scene, SceneError
 from scenes.budget import tensor_mesh
-from scenes.friction import FrictionLaw
+from scenes.friction import MU_MAX, FrictionLaw
 from scenes.registry import register_scene
 
 _TOL = 1e-10
@@ -56,9 +56,10 @@ def check_zones(half_width: float, stick_half_width: float, friction: str, mu: f
     if not (0 < stick_half_width < half_width < 1):
         raise SceneError(f"stick_half_width={stick_half_width!r}, half_width={half_width!r}: "
                          "need 0 < stick_half_width < half_width < 1")
-    if friction not in ("tresca", "coulomb") or not mu > 0:
+    if friction not in ("tresca", "coulomb") or not 0 < mu <= MU_MAX:
         raise SceneError(f"friction={friction!r}, mu={mu!r}: need 'tresca' or 'coulomb' and "
-                         "mu > 0")
+                         f"mu in (0, {MU_MAX:g}] (measured friction coefficients lie below "
+                         "about 2)")
 
 
 def profiles(material: Material, push: float, half_width: float, stick_half_width: float,

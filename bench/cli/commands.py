@@ -14,10 +14,16 @@ import pandas as pd
 from bench.cli.compare_block import check_readme, write_compare_block
 from bench.cli.diff import diff_command
 from bench.cli.generated import run_values
-from bench.cli.guards import InputError, check_compare_out, check_output_folders
+from bench.cli.guards import (
+    InputError,
+    check_compare_out,
+    check_output_folder,
+    check_output_folders,
+)
 from bench.cli.listing import list_command
 from bench.cli.parser import build_parser, with_negative_values
 from bench.cli.progress import Progress
+from bench.cli.run_files import checked_run_file
 from bench.cli.scaling_commands import scaling_command
 from bench.cli.signals import ending_signals, exit_status, signal_name
 from bench.cli.study import study_command
@@ -32,6 +38,7 @@ from bench.hard import (
 from bench.matrix import RunConfig, run
 from bench.matrix.config_files import (
     COMPARE_KEYS,
+    RunFileError,
     compare_settings,
     read_run_file,
     save_run_file,
@@ -48,6 +55,7 @@ from bench.sequence.loop import LevelResult
 from bench.sequence.rows import KEYS, level_time
 from bench.study.run import StudyConfig, read_study_file
 from bench.verify import load_expected, verdict_table, verify
+from bench.verify.expected import ExpectedError
 from estimators import estimator_names
 from formulations import formulation_names
 from scenes import get_scene, scene_names
@@ -108,11 +116,23 @@ def command_line(args) -> str:
 def save_config(config: RunConfig | None, args) -> None:
     """``--save-config FILE``: the run's full configuration as a run file."""
     if config is not None and getattr(args, "save_config", None):
-        print(f"wrote {save_run_file(config, args.save_config, command_line(args))}")
+        try:
+            written = save_run_file(config, args.save_config, command_line(args))
+        except RunFileError as error:
+            raise InputError(str(error)) from None
+        print(f"wrote {written}")
+
+
+def overwrite_of(args, default: bool) -> bool:
+    """``--overwrite`` or ``--no-overwrite`` (not both), else ``default``."""
+    if args.overwrite and args.no_overwrite:
+        raise InputError("--overwrite and --no-overwrite contradict each other; give one")
+    return False if args.no_overwrite else (args.overwrite or default)
 
 
 def run_command(args) -> int:
-    config = configured(**run_values(args, RunConfig), command=command_line(args))
+    values = {**run_values(args, RunConfig), "overwrite": overwrite_of(args, False)}
+    config = configured(**values, command=command_line(args))
     save_config(config, args)
     return run_config(config)
 
@@ -171,7 +191,8 @@ def compare_fields(args) -> dict:
     fields.setdefault("formulations", formulation_names())
     fields.setdefault("estimators", estimator_names())
     fields["reference_dofs"] = compare_reference_dofs(fields.get("reference_dofs"), args.dim)
-    return {**fields, "overwrite": True}  # its own folder: check_compare_out decided
+    # its own folder (check_compare_out decided): replaced unless --no-overwrite
+    return {**fields, "overwrite": overwrite_of(args, True)}
 
 
 def compare_command(args) -> int:
@@ -223,6 +244,7 @@ def report_command(args) -> int:
 def export_command(args) -> int:
     if args.out is None:
         args.out = str(Path(args.results) / "fields")
+    check_output_folder(args.out, "out")
     if not (Path(args.results) / "artifacts").is_dir():
         raise InputError(f"--results={args.results!r} holds no artifacts/ (written by run and "
                          "compare); give a results folder")
@@ -263,7 +285,8 @@ def run_file_defaults(argv: list[str]) -> dict:
     if command == "study":
         return {"study": StudyConfig(**read_study_file(path)[0])}
     fields = read_run_file(path, COMPARE_KEYS if command == "compare" else ())
-    load_scene_files(fields.get("scene_files", ()))
+    load_scene_files(fields.get("scene_files", ()))  # before the names are checked
+    fields = checked_run_file(fields, path, RunConfig)
     return {command: fields}
 
 
@@ -287,7 +310,7 @@ def main(argv: list[str] | None = None) -> int:
         with ending_signals():
             check_output_folders(args.command, args)
             return COMMANDS[args.command](args)
-    except (InputError, ResultsError, RunRefused) as error:
+    except (InputError, ResultsError, RunRefused, ExpectedError) as error:
         print(f"error: {error}", file=sys.stderr)
         return 2
     except BrokenPipeError:  # the reader went away (e.g. `| head`): stop quietly

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from bench.cli import option_types as options
+from bench.cli.guards import InputError
 from bench.matrix.diff import diff_results
 
 
@@ -22,6 +23,11 @@ def add_diff_parser(sub) -> None:
 def diff_command(args) -> int:
     table = diff_results(args.old, args.new)
     compared = table[table["levels"] > 0]
+    if compared.empty:
+        only_old = int((table["worst_column"] == "only in old").sum())
+        raise InputError(f"{args.old!r} and {args.new!r} have no sequence in common ({only_old} "
+                         f"only in the first, {len(table) - only_old} only in the second); "
+                         "nothing to compare: give two runs of the same settings")
     over = compared[compared["max_relative_difference"] > args.rtol]
     parted = compared[compared["mesh_differs_from_level"] >= 0]
     with_columns = table.assign(max_relative_difference=table["max_relative_difference"].map(

@@ -63,7 +63,14 @@ def _run_parser(sub, defaults: dict) -> None:
                          description="Run every combination of the given comma-separated "
                          "lists and write one row per level to OUT/results.{parquet,csv}.")
     add_run_options(run, RunConfig, defaults)
+    _no_overwrite_option(run, "keep every earlier result in OUT and reuse the sequences "
+                         "finished with the same settings (the default; it wins over a run "
+                         "file)")
     _config_options(run, "run")
+
+
+def _no_overwrite_option(parser, help: str) -> None:
+    parser.add_argument("--no-overwrite", action="store_true", help=help)
 
 
 COMPARE_HELPS = {
@@ -137,6 +144,9 @@ def _compare_parser(sub, defaults: dict) -> None:
     compare.add_argument("--readme", default=settings.get("readme"),
                          help="also replace the figures between the compare markers of this "
                               "README (e.g. README.md): rows, sequences, hard verdicts, time")
+    _no_overwrite_option(compare, "keep the results of compare's own folder and reuse the "
+                         "sequences it finished (resume an interrupted comparison) instead "
+                         "of replacing them")
     _config_options(compare, "comparison")
 
 

@@ -3,10 +3,15 @@
 from __future__ import annotations
 
 from bench.cli.guards import InputError
-from bench.perf.scaling import SIZES, run_scaling, write_scaling
+from bench.perf import scaling, scaling_3d, sequence
+from bench.perf.scaling import SIZES, check_markers, run_scaling, write_scaling
 from bench.perf.scaling_3d import SIZES_3D, run_scaling_3d, write_scaling_3d
 from bench.perf.sequence import SEQUENCES, run_sequences, write_sequences
 from formulations.solvers.backends import check_backend
+
+SCALING_MARKERS = (scaling.README_START, scaling.README_END)
+SCALING_3D_MARKERS = (scaling_3d.README_START_3D, scaling_3d.README_END_3D)
+SEQUENCE_MARKERS = (sequence.README_START, sequence.README_END)
 
 
 def scaling_command(args) -> int:
@@ -19,6 +24,13 @@ def scaling_command(args) -> int:
         check_backend(args.backend)
     except ValueError as error:
         raise InputError(f"--backend: {error}") from None
+    if args.readme is not None:  # before anything is measured
+        start, end = (SEQUENCE_MARKERS if args.sequence else
+                      SCALING_3D_MARKERS if args.dim == 3 else SCALING_MARKERS)
+        try:
+            check_markers(args.readme, start, end)
+        except ValueError as error:
+            raise InputError(f"--{error}") from None
     if args.sequence:
         return sequence_command(args)
     sizes = args.sizes or list(SIZES_3D if args.dim == 3 else SIZES)

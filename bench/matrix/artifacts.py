@@ -5,7 +5,7 @@ recomputing."""
 
 from __future__ import annotations
 
-import os
+import io
 import re
 import shutil
 import sys
@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from bench.matrix.files import atomic_path
+from bench.matrix.files import atomic_bytes, atomic_path
 from bench.measure.contact import contact_zone
 from bench.measure.discretisation_error import element_energy_errors
 from bench.sequence.rows import name_parts
@@ -64,16 +64,17 @@ def save_artifact(path: Path, result, scene=None) -> Path | None:
     gap = (np.asarray(scene.gap(mesh.p[:, trace.vertices].reshape(dim, -1)), dtype=float)
            .reshape(k, -1) if scene is not None else np.full(trace.vertices.shape, np.nan))
     path.parent.mkdir(parents=True, exist_ok=True)
-    with atomic_path(path) as tmp, open(tmp, "wb") as handle:
-        np.savez_compressed(
-            handle, p=mesh.p, t=mesh.t, u=sol.elasticity.nodal(sol.u), stress=stress,
-            von_mises=von_mises(stress), indicators=indicators,
-            error_density=element_error_density(scene, sol, n_elements),
-            trace_vertices=sol.trace.vertices, trace_pressure=ends.T, trace_gap=gap,
-            trace_coordinate=sol.trace.coordinate,
-            pressure=sol.pressure(PRESSURE_SAMPLES) if dim == 2 else ends,
-            zone=np.array(contact_zone(sol)), contact_force=sol.contact_force(),
-            ndofs=sol.elasticity.ndofs, level=result.row.level, **friction_fields(sol))
+    buffer = io.BytesIO()  # in memory first: a full disk then names the size it needed
+    np.savez_compressed(
+        buffer, p=mesh.p, t=mesh.t, u=sol.elasticity.nodal(sol.u), stress=stress,
+        von_mises=von_mises(stress), indicators=indicators,
+        error_density=element_error_density(scene, sol, n_elements),
+        trace_vertices=sol.trace.vertices, trace_pressure=ends.T, trace_gap=gap,
+        trace_coordinate=sol.trace.coordinate,
+        pressure=sol.pressure(PRESSURE_SAMPLES) if dim == 2 else ends,
+        zone=np.array(contact_zone(sol)), contact_force=sol.contact_force(),
+        ndofs=sol.elasticity.ndofs, level=result.row.level, **friction_fields(sol))
+    atomic_bytes(buffer.getvalue(), path)
     return path
 
 
@@ -103,10 +104,9 @@ def publish_last_level(out: str | Path, row) -> Path | None:
     source, target = level_artifact_path(out, row), artifact_path(out, row)
     if not source.exists():
         return None
-    tmp = target.with_suffix(".tmp.npz")
     target.parent.mkdir(parents=True, exist_ok=True)
-    shutil.copyfile(source, tmp)
-    os.replace(tmp, target)
+    with atomic_path(target, source.stat().st_size) as tmp:
+        shutil.copyfile(source, tmp)
     return target
 
 

@@ -13,7 +13,7 @@ from bench.matrix.plugins import load_plugins
 from bench.matrix.scene_files import load_scene_files, source_digest
 from bench.matrix.spec import SequenceSpec, cross_product, parse_item
 from bench.sequence.loop import STRATEGIES, LoopSettings
-from bench.sequence.options import option
+from bench.sequence.options import option, option_fields
 from estimators import estimator_names, guaranteed_estimators
 from formulations import formulation_names, solver_names
 from formulations.cells import DEFAULT_CELL, cell_names, check_cell
@@ -82,7 +82,8 @@ class RunConfig(LoopSettings):
     overwrite: bool = _where(
         False, "delete earlier results in OUT first (kept until the new run has finished a "
         "sequence; without it every sequence an earlier run finished with the same settings "
-        "is reused)", "overwrite", "switch")
+        "is reused); an action of the command line, never read from or saved to a run file",
+        "overwrite", "switch", saved=False)
     workers: int = _where(
         0, "run the sequences on a local Dask cluster of this many processes (one thread "
         "each; 0: in this process)", "workers", "int>=0")
@@ -113,6 +114,11 @@ class RunConfig(LoopSettings):
             raise ValueError(f"out={self.out!r} is empty; give an output folder")
         if self.scheduler is not None:
             scheduler_endpoint(self.scheduler)
+        if self.backend is not None and set(self.solvers) == {REFERENCE_SOLVER}:
+            raise ValueError(f"backend={self.backend!r} applies to the fast solvers "
+                             f"({', '.join(s for s in solver_names() if s != REFERENCE_SOLVER)}"
+                             f"); solver={REFERENCE_SOLVER!r} (Clarabel) uses its own linear "
+                             "algebra: leave out the backend or add a fast solver")
         unsafe = [e for e in self.estimators if e not in guaranteed_estimators()]
         if self.target_error is not None and unsafe:
             raise ValueError(f"target_error={self.target_error!r} needs estimators whose eta is "
@@ -159,4 +165,6 @@ class RunConfig(LoopSettings):
     def record(self) -> dict:
         """The configuration as written to run.json (every field but ``command``; a run file
         holding it repeats the run, ``bench.matrix.config_files``)."""
-        return {f.name: getattr(self, f.name) for f in fields(self) if f.name != "command"}
+        unsaved = {f.name for f, o in option_fields(self) if not o.saved}
+        return {f.name: getattr(self, f.name) for f in fields(self)
+                if f.name != "command" and f.name not in unsaved}

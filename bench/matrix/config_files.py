@@ -6,10 +6,12 @@
 from __future__ import annotations
 
 import json
+import sys
 import tomllib
 from pathlib import Path
 
 from bench.matrix.config import RunConfig
+from bench.matrix.files import FULL, atomic_text
 from bench.sequence.options import SECTIONS, option_fields
 
 COMPARE_SETTINGS = Path(__file__).with_name("compare.toml")
@@ -55,6 +57,15 @@ def run_fields(data: dict, where: str, extra: tuple[str, ...] = ()) -> dict:
         if name in out:
             raise RunFileError(f"{where}: {key!r} sets {name} a second time")
         field, opt = options[name]
+        if not opt.saved:
+            if value:
+                print(f"note: {where} sets {key} = {_toml_value(value)}, which a run file does "
+                      f"not do: a run file describes a run and never deletes results (it would "
+                      f"delete rows other runs added); left out: give --{opt.flag} on the "
+                      "command line to act", file=sys.stderr)
+            continue
+        if opt.kind in ("switch", "switch-off") and not isinstance(value, bool):
+            raise RunFileError(f"{where}: {key} = {value!r} is not true or false")
         if opt.kind == "switch-off" and key == opt.flag:
             value = not value  # cold-start = true is nested = false
         if str(field.type).startswith("tuple") and isinstance(value, (str, int)):
@@ -98,7 +109,7 @@ def run_file_text(config: RunConfig, command: str = "") -> str:
     for section in SECTIONS:
         lines.append(f"\n# {SECTION_TITLES[section]}")
         for field, opt in option_fields(config):
-            if opt.section != section:
+            if opt.section != section or not opt.saved:
                 continue
             value = getattr(config, field.name)
             if opt.kind == "switch-off":
@@ -119,7 +130,18 @@ def _toml_value(value) -> str:
 
 
 def save_run_file(config: RunConfig, path: str | Path, command: str = "") -> Path:
+    """Write ``config`` as a run file to ``path`` (RunFileError when ``path`` is a folder or
+    cannot be written)."""
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(run_file_text(config, command))
+    if path.is_dir():
+        raise RunFileError(f"save_config={str(path)!r} is a folder; give a file name, e.g. "
+                           f"{str(path / 'run.toml')!r}")
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        atomic_text(run_file_text(config, command), path)
+    except OSError as error:
+        if error.errno in FULL:
+            raise
+        raise RunFileError(f"save_config={str(path)!r} cannot be written: "
+                           f"{error.strerror or error}; give a writable file") from None
     return path

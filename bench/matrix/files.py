@@ -28,9 +28,9 @@ class DiskFull(OSError):
         except OSError:
             free = 0
         super().__init__(error.errno, f"no space left on the device of {folder} while writing "
-                         f"{Path(path).name} ({_size(needed)} needed, {_size(free)} free); "
-                         "free some space and run again: every row finished before this is "
-                         "kept")
+                         f"{Path(path).name} (at least {_size(needed)} needed, {_size(free)} "
+                         "free); free some space and run again: every row finished before "
+                         "this is kept")
         self.folder, self.needed = folder, needed
 
     def __str__(self) -> str:

@@ -9,6 +9,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, replace
 
 from bench.matrix.artifacts import level_artifact_path, publish_last_level, save_artifact
+from bench.matrix.files import FULL
 from bench.matrix.spec import SequenceSpec, build_scene, check_formulation_options
 from bench.sequence.loop import LevelResult, run_sequence
 from bench.sequence.rows import ResultRow, identity_columns
@@ -110,14 +111,22 @@ def run_spec(spec: SequenceSpec, run: dict, out, truth_of: Callable[[Scene], obj
             publish_last_level(out, last.row)
         return end
     except Exception as error:  # recorded, never silent: the row carries type and message
-        reason = f"{type(error).__name__}: {error}"
-        record(whole_sequence_row(names, STATUS_FAILED, reason))
-        if isinstance(error, ValueError):  # bad input (a SceneError...): its one line says it
-            print(f"error: {spec.scene}/{spec.formulation}/{spec.solver}/{spec.estimator}/"
-                  f"{spec.strategy}: {reason} (a failed row records it)", file=sys.stderr)
-        else:  # a fault of the code: its traceback is what finds it
-            traceback.print_exc()
-        return STATUS_FAILED
+        if isinstance(error, OSError) and error.errno in FULL:
+            raise  # the folder's fault, not the sequence's: the run stops, said once
+        return failed_sequence(spec, names, record, error)
+
+
+def failed_sequence(spec: SequenceSpec, names: dict, record, error: Exception) -> str:
+    """A sequence that raised: one failed row with the error's type and message, and one
+    line (bad input) or its traceback (a fault of the code)."""
+    reason = f"{type(error).__name__}: {error}"
+    record(whole_sequence_row(names, STATUS_FAILED, reason))
+    if isinstance(error, ValueError):  # bad input (a SceneError...): its one line says it
+        print(f"error: {spec.scene}/{spec.formulation}/{spec.solver}/{spec.estimator}/"
+              f"{spec.strategy}: {reason} (a failed row records it)", file=sys.stderr)
+    else:  # a fault of the code: its traceback is what finds it
+        traceback.print_exception(error)
+    return STATUS_FAILED
 
 
 WARM_UP_LEVELS = 2  # a level and a refinement: every code path a sequence times

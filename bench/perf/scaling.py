@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from bench.matrix.files import atomic_text
 from bench.perf.system_scaling import measure_systems, system_table, warm_up_systems
 from formulations.solvers.registry import FAST_SOLVER, REFERENCE_SOLVER
 
@@ -227,12 +228,25 @@ def write_scaling(frame: pd.DataFrame, out: str | Path, readme: str | Path | Non
     return out / "scaling.md"
 
 
+def check_markers(readme: str | Path, start: str, end: str) -> str:
+    """The text of ``readme``; ValueError when it is not a readable file holding both
+    markers (checked before anything is measured, and again when the block is written)."""
+    readme = Path(readme)
+    try:
+        content = readme.read_text()
+    except (OSError, UnicodeDecodeError) as error:
+        reason = getattr(error, "strerror", None) or type(error).__name__
+        raise ValueError(f"readme={str(readme)!r} cannot be read ({reason}); give a Markdown "
+                         f"file with the markers {start} ... {end}") from None
+    if start not in content or end not in content:
+        raise ValueError(f"readme={str(readme)!r} has no {start} ... {end} markers; add them "
+                         "where the table goes")
+    return content
+
+
 def replace_in_readme(readme: str | Path, start: str, end: str, text: str) -> None:
     """Replace what lies between the markers ``start`` and ``end`` of ``readme`` by ``text``."""
-    readme = Path(readme)
-    content = readme.read_text()
-    if start not in content or end not in content:
-        raise ValueError(f"readme={str(readme)!r} has no {start} ... {end} markers")
+    content = check_markers(readme, start, end)
     head, rest = content.split(start, 1)
     tail = rest.split(end, 1)[1]
-    readme.write_text(f"{head}{start}\n{text}\n{end}{tail}")
+    atomic_text(f"{head}{start}\n{text}\n{end}{tail}", Path(readme))

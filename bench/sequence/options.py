@@ -25,6 +25,7 @@ class Option:
     metavar: str | None = None
     default_text: str | None = None
     choices: Callable[[], list[str]] | None = None
+    saved: bool = True  # part of a run's description (run files, run.json); False: an action
 
 
 def option(default, help: str, *, flag: str, kind: str, section: str, **more) -> Field:

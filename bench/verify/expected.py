@@ -13,9 +13,20 @@ from formulations import formulation_names
 EXPECTED = Path(__file__).with_name("expected.toml")
 
 
+class ExpectedError(ValueError):
+    """The file of expected values cannot be read."""
+
+
 def load_expected(path: str | Path = EXPECTED) -> dict:
-    with open(path, "rb") as handle:
-        expected = tomllib.load(handle)
+    """The gates, claims and hard verdicts of ``path``; ExpectedError, naming the file and
+    what to do, when it is missing or damaged."""
+    try:
+        with open(path, "rb") as handle:
+            expected = tomllib.load(handle)
+    except (OSError, ValueError) as error:  # TOMLDecodeError is a ValueError
+        raise ExpectedError(f"the expected values {path} cannot be read "
+                            f"({type(error).__name__}: {error}); reinstall the package "
+                            "(pip install --force-reinstall .) or restore the file") from None
     for run in [*expected.get("run", []), *expected.get("closed_form", []),
                 expected.get("partial_slip", {})]:
         # a table that names none runs every registered one (one name or a list)
