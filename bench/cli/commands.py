@@ -145,9 +145,10 @@ def hard_command(args, quiet: bool = False) -> int:
               + ", ".join(f"{v} {n}" for v, n in frame["verdict"].value_counts().items()),
               flush=True)
 
+    expected = load_expected().get("hard", [])  # a damaged file is named before any work
     table = run_hard(args.case, on_case=show, cells=args.cell)
     print(f"wrote {write_hard(table, args.out)}")
-    checks = check_expected(table, load_expected().get("hard", []))
+    checks = check_expected(table, expected)
     wrong = [c for c in checks if not c["passed"]]
     if quiet:
         return 1 if wrong else 0
@@ -200,6 +201,7 @@ def compare_command(args) -> int:
     estimator x {uniform, adaptive} with the active-set solver (``compare.toml``), then the
     hard cases into the same folder, then the report."""
     check_compare_out(args.out, args.overwrite)
+    load_expected()  # its hard verdicts and claims: a damaged file is named before any work
     config = configured(**compare_fields(args), command=command_line(args))
     save_config(config, args)
     if args.readme is not None:

@@ -105,20 +105,20 @@ def sequence_task(spec: SequenceSpec, out: str, run: dict, cache: str | None,
 
 
 @contextmanager
-def signals_ignored():
-    """SIGINT, SIGTERM and SIGHUP ignored while worker processes start, which keep it: a
-    Ctrl-C reaches the whole process group, and the driver, not each worker, ends the run
-    (``cluster.close`` stops them) with one line instead of a traceback per worker."""
-    ending = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+def interrupt_ignored():
+    """SIGINT ignored while the worker processes start, which keep it (an ignored signal stays
+    ignored across exec): Ctrl-C reaches the whole process group, and the driver alone ends
+    the run (``cluster.close`` stops the workers), in one line instead of a traceback per
+    worker. SIGTERM and SIGHUP stay the driver's: a Ctrl-C while the cluster starts (about
+    two seconds) is the one signal lost."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
-    saved = {s: signal.signal(s, signal.SIG_IGN) for s in ending}
+    saved = signal.signal(signal.SIGINT, signal.SIG_IGN)
     try:
         yield
     finally:
-        for number, handler in saved.items():
-            signal.signal(number, handler)
+        signal.signal(signal.SIGINT, saved)
 
 
 def client_for(config):
@@ -127,7 +127,7 @@ def client_for(config):
 
     if config.scheduler:
         return Client(config.scheduler, timeout=SCHEDULER_TIMEOUT), None
-    with signals_ignored():  # the workers inherit it: the driver alone answers Ctrl-C
+    with interrupt_ignored():  # the workers inherit it: the driver alone answers Ctrl-C
         cluster = LocalCluster(n_workers=config.workers, threads_per_worker=1,
                                processes=True, env=SINGLE_THREAD, dashboard_address=":0",
                                silence_logs=logging.ERROR)

@@ -14,6 +14,7 @@ from __future__ import annotations
 import fcntl
 import json
 import os
+from contextlib import contextmanager, nullcontext
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -60,6 +61,21 @@ def owner_alive(previous: Path) -> bool:
         os.close(handle)
 
 
+@contextmanager
+def shared_lock(folder: Path):
+    """A shared lock on ``folder/.lock`` when the file exists (a reader creates nothing)."""
+    try:
+        handle = os.open(folder / ".lock", os.O_RDONLY)
+    except OSError:
+        yield
+        return
+    try:
+        fcntl.flock(handle, fcntl.LOCK_SH)
+        yield
+    finally:
+        os.close(handle)
+
+
 def keys_of(frames) -> set[str]:
     return {str(k) for f in frames for k in f.get("sequence_key", pd.Series(dtype=str))}
 
@@ -94,12 +110,16 @@ class FolderState:
     set_aside: list[SetAside] = field(default_factory=list)
 
     @classmethod
-    def read(cls, folder: str | Path) -> FolderState:
+    def read(cls, folder: str | Path, shared: bool = False) -> FolderState:
+        """The folder as it is; ``shared``: under a shared lock of its lock file (if it has
+        one), so that no writer sets results aside or puts them back meanwhile (a writer,
+        which holds the exclusive lock, reads without it)."""
         folder = Path(folder)
-        partitions, damaged = read_partitions(folder)
-        set_aside = [SetAside(p, read_partitions(p)[0], read_table(p), owner_alive(p))
-                     for p in sorted(folder.glob(f"{PREVIOUS}*")) if p.is_dir()]
-        return cls(folder, partitions, damaged, read_table(folder), set_aside)
+        with shared_lock(folder) if shared else nullcontext():
+            partitions, damaged = read_partitions(folder)
+            set_aside = [SetAside(p, read_partitions(p)[0], read_table(p), owner_alive(p))
+                         for p in sorted(folder.glob(f"{PREVIOUS}*")) if p.is_dir()]
+            return cls(folder, partitions, damaged, read_table(folder), set_aside)
 
     def merged(self) -> dict[str, pd.DataFrame]:
         """The partitions with those set aside: a set-aside sequence is taken where the folder

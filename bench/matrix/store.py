@@ -39,7 +39,7 @@ def read_results(folder: str | Path) -> pd.DataFrame | None:
     one note on standard error). Without partitions (an older version's folder) the table,
     or its CSV mirror when the parquet is unreadable; ResultsError when neither can be read."""
     folder = Path(folder)
-    state = FolderState.read(folder)
+    state = FolderState.read(folder, shared=True)
     if state.partitions or state.damaged or state.set_aside:
         if state.tables_current():
             return read_snapshot(folder / "results.parquet")

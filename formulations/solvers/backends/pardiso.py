@@ -67,7 +67,7 @@ class _Handle:
             iparm[index] = value
         if schur is not None:
             perm[schur], iparm[SCHUR] = 1, 2
-        weakref.finalize(self, _call, self.n, self.arrays, -1, np.zeros(1), np.zeros(1))
+        weakref.finalize(self, _release, self.n, self.arrays)
 
     def run(self, phase: int, rhs: np.ndarray, out: np.ndarray) -> None:
         _call(self.n, self.arrays, phase, rhs, out)
@@ -77,6 +77,17 @@ class _Handle:
         out = np.zeros_like(rhs)
         self.run(33, rhs, out)
         return np.ascontiguousarray(out)
+
+
+def _release(n, arrays) -> None:
+    """Free PARDISO's memory of a handle; a handle never factorised (a run ended by a signal
+    between the two) holds none, and a failure to free is no error of the solve."""
+    if not arrays[3].any():  # pt: PARDISO's internal pointers, zero until phase 11 or 12
+        return
+    try:
+        _call(n, arrays, -1, np.zeros(1), np.zeros(1))
+    except FactorisationError:
+        pass
 
 
 def _call(n, arrays, phase, rhs, out) -> None:
