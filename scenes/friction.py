@@ -69,7 +69,7 @@ class FrictionLaw:
 NO_FRICTION = FrictionLaw()
 
 
-MU_MAX = 100.0  # a Coulomb coefficient beyond it adds nothing but round-off (docs/friction.md)
+MU_MAX = 100.0  # beyond it a Coulomb coefficient only costs accuracy (docs/friction.md)
 
 
 def friction_law(friction: str = "none", mu: float = 0.0, slip_bound: float = 0.0,
@@ -96,8 +96,8 @@ def friction_law(friction: str = "none", mu: float = 0.0, slip_bound: float = 0.
     if friction == "coulomb":
         if not 0 < mu <= MU_MAX:
             raise SceneError(f"mu={mu!r} is not in (0, {MU_MAX:g}] (friction='coulomb'): "
-                             "measured friction coefficients lie below about 2, and at "
-                             f"{MU_MAX:g} the contact already sticks wherever it can")
+                             "measured friction coefficients lie below about 2, and a larger "
+                             "one describes no contact and only costs accuracy")
         return FrictionLaw("coulomb", coefficient=float(mu), slide=float(slide))
     if friction == "tresca":
         if tresca_bound is None:

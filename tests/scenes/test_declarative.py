@@ -117,7 +117,7 @@ def test_a_friction_table_reproduces_the_builtin_law(tmp_path, registered, table
     ('law = "tresca"', "[friction] law='tresca' needs slip_bound"),
     ('law = "coulomb"\nmu = 0.3\nslip_bound = "1"', "slip_bound needs law='tresca'"),
     ('mu = 0.3', "[friction] mu=0.3 needs friction='coulomb'"),
-    ('law = "coulomb"', "[friction] mu=0.0 is not > 0"),
+    ('law = "coulomb"', "[friction] mu=0.0 is not in (0, 100]"),
     ('law = "coulomb"\nmu = 0.3\nfriction = 1', "[friction] friction is not one of law"),
 ])
 def test_bad_friction_tables_are_refused_in_one_line(tmp_path, table, message):

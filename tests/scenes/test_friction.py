@@ -20,7 +20,8 @@ def test_the_laws_and_their_labels():
 
 @pytest.mark.parametrize("kwargs, message", [
     (dict(friction="stribeck"), r"friction='stribeck' is not one of none, tresca, coulomb"),
-    (dict(friction="coulomb"), r"mu=0.0 is not > 0"),
+    (dict(friction="coulomb"), r"mu=0.0 is not in \(0, 100\]"),
+    (dict(friction="coulomb", mu=1e300), r"mu=1e\+300 is not in \(0, 100\]"),
     (dict(friction="coulomb", mu=-1.0), r"mu=-1.0 is not a finite number >= 0"),
     (dict(friction="tresca"), r"slip_bound=0.0 is not > 0"),
     (dict(mu=0.3), r"mu=0.3 needs friction='coulomb'"),
