@@ -1,6 +1,6 @@
 """The commands of ``python -m bench``, dispatched from ``COMMANDS`` (the arguments are in
 ``bench.cli.parser``). Exit status: 0 success, 1 a failed row, gate or unexpected verdict,
-2 bad input."""
+2 bad input or a full disk, 128 + N when signal N ended it (docs/reliability.md)."""
 
 from __future__ import annotations
 

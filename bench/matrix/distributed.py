@@ -29,6 +29,7 @@ from bench.truth import truth_for
 
 SINGLE_THREAD = {name: "1" for name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS",
                                         "MKL_NUM_THREADS")}
+WORKER_LOGGING = {"DASK_LOGGING__DISTRIBUTED": "error"}
 SCHEDULER_TIMEOUT = 10.0  # seconds to wait for a scheduler to answer before refusing the run
 SCHEDULER_SCHEMES = ("tcp", "tls")
 EXPECTED_ADDRESS = "SCHEME://HOST:PORT with SCHEME tcp or tls, e.g. tcp://10.0.0.5:8786"
@@ -115,10 +116,19 @@ def interrupt_ignored():
         yield
         return
     saved = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    # the workers read their logging level when they import dask: only errors, so that a
+    # worker ended with the run does not log its closed connections
+    quiet = {name: os.environ.get(name) for name in WORKER_LOGGING}
+    os.environ.update(WORKER_LOGGING)
     try:
         yield
     finally:
         signal.signal(signal.SIGINT, saved)
+        for name, value in quiet.items():
+            if value is None:
+                os.environ.pop(name, None)
+            else:
+                os.environ[name] = value
 
 
 def client_for(config):
@@ -161,7 +171,13 @@ def run_on_dask(specs: list[SequenceSpec], store: ResultStore, run: dict, config
             if on_sequence is not None:
                 on_sequence(futures[future], outcome.end)
         return rows
-    finally:
-        client.close()
-        if cluster is not None:
-            cluster.close()
+    finally:  # closing after a signal logs the connections it cuts: only errors are news
+        logger = logging.getLogger("distributed")
+        level = logger.level
+        logger.setLevel(logging.ERROR)
+        try:
+            client.close()
+            if cluster is not None:
+                cluster.close()
+        finally:
+            logger.setLevel(level)

@@ -9,13 +9,19 @@ import errno
 import hashlib
 import io
 import os
+import re
 import shutil
+import socket
+import time
 from contextlib import contextmanager, suppress
 from pathlib import Path
 
 import pandas as pd
 
 FULL = (errno.ENOSPC, errno.EDQUOT, errno.EFBIG)  # the write did not fit
+HOST = re.sub(r"[^A-Za-z0-9-]", "-", socket.gethostname().split(".")[0]) or "host"
+TEMPORARY = re.compile(r"\.(?P<host>[A-Za-z0-9-]+)~(?P<pid>\d+)\.tmp$")
+ABANDONED_AFTER = 86400.0  # seconds: a temporary file of another machine's process this old
 
 
 class DiskFull(OSError):
@@ -44,6 +50,33 @@ def _size(nbytes: int) -> str:
     return f"{nbytes} bytes"
 
 
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # another user's process
+        return True
+    return True
+
+
+def abandoned_temporaries(folder: Path) -> list[Path]:
+    """Temporary files under ``folder`` whose writer ended before renaming them (a killed
+    process): of this machine, when their process no longer runs; of another (a Dask worker on
+    shared storage), when a day old."""
+    found = []
+    for path in folder.rglob(".*.tmp"):
+        match = TEMPORARY.search(path.name)
+        if match is None:
+            continue
+        if match["host"] == HOST:
+            if not _alive(int(match["pid"])):
+                found.append(path)
+        elif time.time() - path.stat().st_mtime > ABANDONED_AFTER:
+            found.append(path)
+    return found
+
+
 def read_snapshot(path: Path) -> pd.DataFrame:
     """A parquet file read from one open: pyarrow opens a path again for its pages after the
     footer, so a file replaced in between by another writer would be read half old, half new."""
@@ -65,7 +98,7 @@ def atomic_path(path: Path, needed: int = 0):
     ``path`` (synced, then renamed) when the block ends, or nothing at all if it raises; a full
     disk raises DiskFull naming the folder and ``needed`` (or the bytes written so far)."""
     path = Path(path)
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    tmp = path.with_name(f".{path.name}.{HOST}~{os.getpid()}.tmp")
     try:
         yield tmp
         with open(tmp, "rb+") as handle:

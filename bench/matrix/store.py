@@ -23,7 +23,13 @@ from pathlib import Path
 
 import pandas as pd
 
-from bench.matrix.files import atomic_text, atomic_write, checksums, read_snapshot
+from bench.matrix.files import (
+    abandoned_temporaries,
+    atomic_text,
+    atomic_write,
+    checksums,
+    read_snapshot,
+)
 from bench.matrix.folder_state import MANIFEST, FolderState
 from bench.matrix.set_aside import SetAsideFolder, discard, discard_folder, restore_into
 from bench.sequence.rows import COLUMNS, FINISHED, ResultRow, with_labels
@@ -41,8 +47,8 @@ def read_results(folder: str | Path) -> pd.DataFrame | None:
     folder = Path(folder)
     state = FolderState.read(folder, shared=True)
     if state.partitions or state.damaged or state.set_aside:
-        if state.tables_current():
-            return read_snapshot(folder / "results.parquet")
+        if state.tables_current() and state.table is not None:
+            return state.table
         for line in notes(state) or [stale_note(folder)]:
             print(line, file=sys.stderr)
         return state.rows()
@@ -52,7 +58,7 @@ def read_results(folder: str | Path) -> pd.DataFrame | None:
     if state.table is None:
         raise ResultsError(f"{parquet} is unreadable, and so is its CSV mirror {csv}; move the "
                            "folder away or rerun with --overwrite")
-    if "sequence_end" not in state.table.columns or not _parquet_readable(parquet):
+    if not _parquet_readable(parquet):
         print(f"note: {parquet} is unreadable; using its CSV mirror {csv} "
               f"({len(state.table)} rows)", file=sys.stderr)
     return state.table
@@ -85,14 +91,16 @@ def notes(state: FolderState, writing: bool = False) -> list[str]:
                                   "reruns its sequence)"))
     missing = orphans[~by_key.isin({p.stem for p in state.damaged})]
     if len(missing):
-        lines.append(f"note: the results table holds {len(missing)} rows of "
-                     f"{missing['sequence_key'].nunique()} sequences whose files are missing "
-                     f"from {folder / 'sequences'}; {kept}")
+        count = missing["sequence_key"].nunique()
+        lines.append(f"note: the results table holds {len(missing)} rows of {count} "
+                     f"sequence{'s' if count != 1 else ''} whose files are missing from "
+                     f"{folder / 'sequences'}; {kept}")
     for aside in state.set_aside:
         taken = [f for stem, f in state.restored() if stem in aside.partitions]
         if taken and not aside.alive:
             lines.append(f"note: {aside.path} holds {sum(map(len, taken))} rows of "
-                         f"{len(taken)} sequences that an --overwrite run set aside and did not "
+                         f"{len(taken)} sequence{'s' if len(taken) != 1 else ''} that an "
+                         "--overwrite run set aside and did not "
                          f"replace (it ended before finishing a sequence); "
                          + ("they are put back" if writing else
                             f"they are kept (the next run into {folder} puts them back)"))
@@ -117,10 +125,14 @@ def folder_lock(folder: Path):
 
 
 class SequenceWriter:
-    """The partition of one sequence: every row as it finishes, then its end reason."""
+    """The partition of one sequence: every row as it finishes, then its end reason. A rerun
+    of a sequence cut short carries the earlier attempt's levels beyond its own until it
+    passes them, so that a rerun cut shorter still loses no level (docs/reliability.md, "What
+    finished means"); once the sequence ends they go."""
 
     def __init__(self, path: Path):
         self.path, self.rows = path, []
+        self.carried = _earlier_attempt(path)
 
     def append(self, row: ResultRow) -> None:
         self.rows.append(row.as_dict())
@@ -129,10 +141,26 @@ class SequenceWriter:
     def finish(self, end: str) -> None:
         for row in self.rows:
             row["sequence_end"] = end
+        if end in FINISHED:
+            self.carried = []
         self._write()
 
     def _write(self) -> None:
-        atomic_write(pd.DataFrame(self.rows, columns=COLUMNS), self.path, "parquet")
+        reached = max((row["level"] for row in self.rows), default=-1)
+        rows = self.rows + [row for row in self.carried if row["level"] > reached]
+        atomic_write(pd.DataFrame(rows, columns=COLUMNS), self.path, "parquet")
+
+
+def _earlier_attempt(path: Path) -> list[dict]:
+    """The rows of a partition at ``path`` whose sequence was cut short (none if it finished
+    or cannot be read: a finished one is never rerun, a damaged one is set aside)."""
+    try:
+        frame = read_snapshot(path)
+    except Exception:  # missing, or damaged (pyarrow raises several types)
+        return []
+    if frame["sequence_end"].isin(FINISHED).all():
+        return []
+    return frame.reindex(columns=COLUMNS).to_dict("records")
 
 
 class ResultStore:
@@ -172,6 +200,8 @@ class ResultStore:
         for path in ended:
             discard_folder(path)
         discard(self.out)
+        for path in abandoned_temporaries(self.out):
+            path.unlink(missing_ok=True)
         if found:
             self.consolidate(locked=True)
 

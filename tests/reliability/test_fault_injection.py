@@ -34,12 +34,19 @@ LATEST = {"plain": 3.5, "overwrite": 3.5, "workers": 7.0, "resume": 3.5}  # seco
 
 
 def rows_of(table: pd.DataFrame | None) -> set:
+    """(sequence, level) of every row: a level recomputed by the rerun of a sequence cut short
+    replaces the earlier attempt's row of that level (the same result, another run id)."""
     if table is None or not len(table):
         return set()
-    return set(zip(table["sequence_key"], table["level"], table["run_id"], strict=True))
+    return set(zip(table["sequence_key"], table["level"], strict=True))
 
 
-def check_after(folder: Path, before: set, earlier: set, status: int, err: str) -> pd.DataFrame:
+def runs_of(table: pd.DataFrame) -> set:
+    return set(table["run_id"])
+
+
+def check_after(folder: Path, before: set, earlier: set, earlier_runs: set, status: int,
+                err: str) -> pd.DataFrame:
     """What the next command must see after a fault (module docstring)."""
     assert "Traceback" not in err, err
     assert status in (0, 1, -signal.SIGKILL, 128 + signal.SIGTERM, 128 + signal.SIGHUP), err
@@ -48,7 +55,7 @@ def check_after(folder: Path, before: set, earlier: set, status: int, err: str) 
         assert len(ending) == 1, err
     after = read_results(folder)
     seen = rows_of(after)
-    new = after[~after["run_id"].isin({r for _, _, r in earlier})]
+    new = after[~after["run_id"].isin(earlier_runs)]
     committed = new["sequence_end"].isin(FINISHED).any()  # an --overwrite may delete now
     assert before - (earlier if committed else set()) <= seen
     assert not after[["sequence_key", "level"]].duplicated().any()
@@ -60,7 +67,8 @@ def check_after(folder: Path, before: set, earlier: set, status: int, err: str) 
     return after
 
 
-def one_fault(kind: str, folder: Path, logs: Path, rng: random.Random, earlier: set) -> dict:
+def one_fault(kind: str, folder: Path, logs: Path, rng: random.Random,
+              earlier: tuple[set, set]) -> dict:
     """Start a run of ``kind`` into ``folder``, end it at a random moment, check the folder."""
     extra = KINDS.get(kind, [])
     command = start([*COMMAND, *extra, "--out", str(folder)], logs)
@@ -72,7 +80,7 @@ def one_fault(kind: str, folder: Path, logs: Path, rng: random.Random, earlier: 
     command.signal(number)
     status = command.wait()
     _, err = command.output()
-    after = check_after(folder, before, earlier, status, err)
+    after = check_after(folder, before, *earlier, status, err)
     return {"kind": kind, "signal": signal.Signals(number).name, "status": status,
             "rows_before": len(before), "rows_after": len(after)}
 
@@ -82,14 +90,15 @@ def test_runs_ended_at_random_moments_lose_nothing(finished_run, tmp_path, kind)
     rng = random.Random(f"faults-{kind}")
     logs = tmp_path / "logs"
     logs.mkdir()
-    seeded = set(rows_of(pd.read_parquet(finished_run / "results.parquet")))
+    seed = pd.read_parquet(finished_run / "results.parquet")
+    seeded = (rows_of(seed), runs_of(seed))
     outcomes, completed = [], 0
     folder = None
     for trial in range(TRIALS):
         if kind != "resume" or folder is None:
             folder = tmp_path / f"r{trial}"
             shutil.copytree(finished_run, folder)
-        earlier = seeded if kind == "overwrite" else set()
+        earlier = seeded if kind == "overwrite" else (set(), set())
         outcomes.append(one_fault(kind, folder, logs, rng, earlier))
         if kind == "resume" and outcomes[-1]["status"] in (0, 1):  # the chain ran to its end
             check_complete(folder)
