@@ -54,16 +54,33 @@ class Command:
                 pass
 
     def wait(self, timeout: float = 300.0) -> int:
-        """The exit status: the command's own, or -N if signal N ended it."""
+        """The exit status: the command's own, or -N if signal N ended it; returns once no
+        process of its group (its Dask workers) runs any more, as the next command would
+        find it."""
         self.process.join(timeout)
         if self.process.exitcode is None:
             self.signal(signal.SIGKILL)
             self.process.join()
             raise AssertionError(f"the command did not end within {timeout} s")
+        deadline = time.monotonic() + 30.0
+        while group_runs(self.process.pid) and time.monotonic() < deadline:
+            time.sleep(0.05)
         return self.process.exitcode
 
     def output(self) -> tuple[str, str]:
         return self.stdout.read_text(), self.stderr.read_text()
+
+
+def group_runs(group: int) -> bool:
+    """Whether a process of process group ``group`` runs (zombies do not)."""
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except (OSError, IndexError):
+            continue  # ended while we looked
+        if int(fields[2]) == group and fields[0] not in ("Z", "X"):
+            return True
+    return False
 
 
 _context = None
