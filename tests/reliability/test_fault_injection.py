@@ -81,8 +81,12 @@ def one_fault(kind: str, folder: Path, logs: Path, rng: random.Random,
     status = command.wait()
     _, err = command.output()
     after = check_after(folder, before, *earlier, status, err)
+    failed = after[(after["status"] == "failed") & ~after["run_id"].isin(earlier[1])]
+    reasons = sorted(set(failed["reason"].astype(str)))
+    assert not [r for r in reasons if "Interrupt" in r or "Ended" in r], reasons
     return {"kind": kind, "signal": signal.Signals(number).name, "status": status,
-            "rows_before": len(before), "rows_after": len(after)}
+            "rows_before": len(before), "rows_after": len(after),
+            "failed": "; ".join(reasons)[:300]}
 
 
 @pytest.mark.parametrize("kind", [*KINDS, "resume"])
@@ -107,8 +111,11 @@ def test_runs_ended_at_random_moments_lose_nothing(finished_run, tmp_path, kind)
         elif kind != "resume":
             shutil.rmtree(folder)
     summary = pd.DataFrame(outcomes)
+    failed = summary[summary["failed"] != ""]
     print(f"\n{kind}: {len(summary)} faults, by signal and exit status:\n"
           + summary.groupby(["signal", "status"]).size().to_string()
+          + "".join(f"\nfailed rows after {r.signal} (exit {r.status}): {r.failed}"
+                    for r in failed.itertuples())
           + (f"\n{completed} resumed chains completed" if kind == "resume" else ""))
     assert len(summary) == TRIALS
 
