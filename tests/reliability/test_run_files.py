@@ -8,6 +8,8 @@ import pytest
 
 import bench.verify.expected as expected_module
 from bench.cli import main
+from bench.cli.commands import compare_fields
+from bench.cli.parser import build_parser
 from bench.perf import scaling as scaling_module
 
 FAST = ["--scene", "free-boundary", "--solver", "active-set", "--max-dofs", "300"]
@@ -122,3 +124,10 @@ def test_a_damaged_expected_file_is_named_in_one_line(tmp_path, monkeypatch, cap
     assert main(["hard", "--out", str(tmp_path / "h")]) == 2
     line = refusal(capsys)
     assert str(damaged) in line and "cannot be read" in line and "reinstall" in line
+
+
+@pytest.mark.parametrize("flags, overwrite", [([], True), (["--no-overwrite"], False)])
+def test_compare_replaces_its_own_folder_unless_told_to_keep_it(flags, overwrite):
+    args = build_parser({}).parse_args(["compare", *flags])
+    args.file_fields = {}
+    assert compare_fields(args)["overwrite"] is overwrite
