@@ -19,13 +19,14 @@ from bench.cli.guards import (
     check_compare_out,
     check_output_folder,
     check_output_folders,
+    full_disk,
 )
 from bench.cli.listing import list_command
 from bench.cli.parser import build_parser, with_negative_values
-from bench.cli.progress import Progress
-from bench.cli.run_files import checked_run_file
+from bench.cli.progress import Progress, progress, summary
+from bench.cli.run_files import overwrite_of, run_file_defaults
 from bench.cli.scaling_commands import scaling_command
-from bench.cli.signals import ending_signals, exit_status, signal_name
+from bench.cli.signals import ended_line, ending_signals, exit_status
 from bench.cli.study import study_command
 from bench.export import export_results
 from bench.hard import (
@@ -40,10 +41,9 @@ from bench.matrix.config_files import (
     COMPARE_KEYS,
     RunFileError,
     compare_settings,
-    read_run_file,
     save_run_file,
 )
-from bench.matrix.files import FULL, DiskFull
+from bench.matrix.files import FULL
 from bench.matrix.plugins import load_plugins
 from bench.matrix.run import RunRefused, compare_reference_dofs
 from bench.matrix.scene_files import load_scene_files, scene_files_in
@@ -51,35 +51,12 @@ from bench.matrix.store import ResultsError, read_results
 from bench.report import write_report
 from bench.report.console import console_summary
 from bench.report.render import read_json
-from bench.sequence.loop import LevelResult
-from bench.sequence.rows import KEYS, level_time
-from bench.study.run import StudyConfig, read_study_file
 from bench.verify import load_expected, verdict_table, verify
 from bench.verify.expected import ExpectedError
 from estimators import estimator_names
 from formulations import formulation_names
 from scenes import get_scene, scene_names
 from scenes.registry import SCENES, scene_dim
-
-SUMMARY_COLUMNS = ["level", "ndofs", "energy", "contact_force", "active_constraints", "eta",
-                   "eta_0", "eta_geometric", "eta_complementarity", "energy_error",
-                   "effectivity_index", "iterations", "t_solve", "status"]
-
-
-def progress(result: LevelResult) -> None:
-    r = result.row
-    print(f"{r.scene}/{r.formulation}/{r.solver}/{r.estimator}/{r.strategy} "
-          f"level {r.level:2d}  ndofs {r.ndofs:8d}  eta {r.eta:11.5e}  "
-          f"time {level_time(r):7.2f} s  "
-          f"{r.status}{' (' + r.reason + ')' if r.reason else ''}", flush=True)
-
-
-def summary(table: pd.DataFrame) -> str:
-    parts = []
-    for key, group in table.groupby(KEYS, sort=False, dropna=False):
-        parts.append("== " + " / ".join(str(k) for k in key if str(k)))
-        parts.append(group[SUMMARY_COLUMNS].to_string(index=False, float_format="{:.6g}".format))
-    return "\n".join(parts)
 
 
 def configured(**fields) -> RunConfig | None:
@@ -121,13 +98,6 @@ def save_config(config: RunConfig | None, args) -> None:
         except RunFileError as error:
             raise InputError(str(error)) from None
         print(f"wrote {written}")
-
-
-def overwrite_of(args, default: bool) -> bool:
-    """``--overwrite`` or ``--no-overwrite`` (not both), else ``default``."""
-    if args.overwrite and args.no_overwrite:
-        raise InputError("--overwrite and --no-overwrite contradict each other; give one")
-    return False if args.no_overwrite else (args.overwrite or default)
 
 
 def run_command(args) -> int:
@@ -275,23 +245,6 @@ COMMANDS = {"run": run_command, "compare": compare_command, "report": report_com
             "diff": diff_command}
 
 
-def run_file_defaults(argv: list[str]) -> dict:
-    """``--config FILE`` of run or compare, read before the parser is built: the file's values
-    become the command's defaults (so options given override them) and its scene files
-    are loaded (their scenes are valid names)."""
-    command = next((a for a in argv if not a.startswith("-")), None)
-    path = next((argv[k + 1] for k, a in enumerate(argv[:-1]) if a == "--config"),
-                next((a.split("=", 1)[1] for a in argv if a.startswith("--config=")), None))
-    if path is None or command not in ("run", "compare", "study"):
-        return {}
-    if command == "study":
-        return {"study": StudyConfig(**read_study_file(path)[0])}
-    fields = read_run_file(path, COMPARE_KEYS if command == "compare" else ())
-    load_scene_files(fields.get("scene_files", ()))  # before the names are checked
-    fields = checked_run_file(fields, path, RunConfig)
-    return {command: fields}
-
-
 def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     load_plugins()  # before the parser too: its lists include the plugins' units
@@ -321,17 +274,9 @@ def main(argv: list[str] | None = None) -> int:
     except OSError as error:
         if error.errno not in FULL:
             raise
-        print(f"error: {error if isinstance(error, DiskFull) else full_disk(error)}",
-              file=sys.stderr)
+        print(f"error: {full_disk(error)}", file=sys.stderr)
         return 2
     except KeyboardInterrupt as error:
-        print(f"interrupted: every finished row is kept in {getattr(args, 'out', 'the output')}"
-              f" (results.parquet, results.csv); ended by {signal_name(error)}",
-              file=sys.stderr)
+        print(ended_line(error, getattr(args, "out", "the output")), file=sys.stderr)
         return exit_status(error)
 
-
-def full_disk(error: OSError) -> str:
-    where = f" while writing {error.filename}" if error.filename else ""
-    return (f"no space left on the device{where}; free some space and run again: every row "
-            "finished before this is kept")

@@ -7,6 +7,8 @@ import json
 import tempfile
 from pathlib import Path
 
+from bench.matrix.files import DiskFull
+
 # the folder options of each command that will be written to
 OUTPUT_OPTIONS = {"run": ("out",), "compare": ("out", "reports"), "report": ("out",),
                   "export": (),
@@ -64,3 +66,13 @@ def check_compare_out(out: str | Path, overwrite: bool) -> None:
         raise InputError(f"--out={str(out)!r} holds files that compare did not write (it "
                          "replaces the results of its folder); give a new or empty folder, "
                          "or --overwrite to replace them")
+
+
+def full_disk(error: OSError) -> str:
+    """The line that a full disk ends a command with (``DiskFull`` names the folder and the
+    space needed itself)."""
+    if isinstance(error, DiskFull):
+        return str(error)
+    where = f" while writing {error.filename}" if error.filename else ""
+    return (f"no space left on the device{where}; free some space and run again: every row "
+            "finished before this is kept")

@@ -8,8 +8,12 @@ from __future__ import annotations
 import argparse
 
 from bench.cli.generated import TYPES
-from bench.matrix.config_files import RunFileError
+from bench.cli.guards import InputError
+from bench.matrix.config import RunConfig
+from bench.matrix.config_files import COMPARE_KEYS, RunFileError, read_run_file
+from bench.matrix.scene_files import load_scene_files
 from bench.sequence.options import option_fields
+from bench.study.run import StudyConfig, read_study_file
 
 
 def _as_text(value) -> str:
@@ -59,3 +63,27 @@ def checked_run_file(fields: dict, path: str, cls) -> dict:
                                if str(error).startswith("is ") else
                                f"config={path!r}: {opt.flag} = {shown}: {error}") from None
     return out
+
+
+def run_file_defaults(argv: list[str]) -> dict:
+    """``--config FILE`` of run or compare, read before the parser is built: the file's values
+    become the command's defaults (so options given override them) and its scene files
+    are loaded (their scenes are valid names)."""
+    command = next((a for a in argv if not a.startswith("-")), None)
+    path = next((argv[k + 1] for k, a in enumerate(argv[:-1]) if a == "--config"),
+                next((a.split("=", 1)[1] for a in argv if a.startswith("--config=")), None))
+    if path is None or command not in ("run", "compare", "study"):
+        return {}
+    if command == "study":
+        return {"study": StudyConfig(**read_study_file(path)[0])}
+    fields = read_run_file(path, COMPARE_KEYS if command == "compare" else ())
+    load_scene_files(fields.get("scene_files", ()))  # before the names are checked
+    fields = checked_run_file(fields, path, RunConfig)
+    return {command: fields}
+
+
+def overwrite_of(args, default: bool) -> bool:
+    """``--overwrite`` or ``--no-overwrite`` (not both), else ``default``."""
+    if args.overwrite and args.no_overwrite:
+        raise InputError("--overwrite and --no-overwrite contradict each other; give one")
+    return False if args.no_overwrite else (args.overwrite or default)

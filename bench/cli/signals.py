@@ -45,5 +45,8 @@ def exit_status(error: KeyboardInterrupt) -> int:
     return 128 + getattr(error, "signal_number", signal.SIGINT)
 
 
-def signal_name(error: KeyboardInterrupt) -> str:
-    return signal.Signals(getattr(error, "signal_number", signal.SIGINT)).name
+def ended_line(error: KeyboardInterrupt, out) -> str:
+    """The one line a command ended by a signal prints."""
+    name = signal.Signals(getattr(error, "signal_number", signal.SIGINT)).name
+    return (f"interrupted: every finished row is kept in {out} (results.parquet, results.csv);"
+            f" ended by {name}")
