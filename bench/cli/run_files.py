@@ -24,10 +24,9 @@ def _as_text(value) -> str:
 
 def _checked(opt, name: str, value):
     """``value`` of the option ``opt`` (field ``name``) as the command line would parse it;
-    ValueError with what is allowed."""
+    ValueError with what is allowed (a switch's true or false is checked as it is read,
+    ``config_files.run_fields``)."""
     if opt.kind in ("switch", "switch-off"):
-        if not isinstance(value, bool):
-            raise ValueError("is not true or false")
         return value
     if opt.kind == "files":
         items = [value] if isinstance(value, str) else value

@@ -37,7 +37,6 @@ class DiskFull(OSError):
                          f"{Path(path).name} (at least {_size(needed)} needed, {_size(free)} "
                          "free); free some space and run again: every row finished before "
                          "this is kept")
-        self.folder, self.needed = folder, needed
 
     def __str__(self) -> str:
         return self.strerror

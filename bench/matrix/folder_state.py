@@ -159,8 +159,8 @@ class FolderState:
         return table_of([*self.merged().values(), self.orphans()])
 
     def record(self) -> pd.DataFrame:
-        """The rows of the folder's own partitions (what the writer consolidates, once it has
-        written back what it found beside them)."""
+        """The rows of the folder's own partitions, the record (``ResultStore.table`` reads
+        just these)."""
         return table_of(list(self.partitions.values()))
 
     def tables_current(self) -> bool:

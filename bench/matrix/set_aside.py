@@ -46,15 +46,11 @@ class SetAsideFolder:
         return cls(path, handle)
 
     def discard(self) -> None:
-        """The new results stand: delete the earlier ones."""
+        """Delete what is left in the folder (all of it once the new results stand, what was
+        not moved back otherwise) and let go of its lock."""
         discard_folder(self.path)
-        self.release()
-
-    def release(self) -> None:
         with suppress(OSError):
             os.close(self.handle)
-        if self.path.exists():
-            discard_folder(self.path)
 
 
 def discard_folder(path: Path) -> None:
@@ -71,25 +67,23 @@ def discard(out: Path) -> None:
         shutil.rmtree(path, ignore_errors=True)
 
 
-def restore_into(out: Path, aside: Path, state: FolderState) -> int:
+def restore_into(out: Path, aside: Path, state: FolderState) -> None:
     """Move back from ``aside`` every partition that ``state.merged`` takes from it (one the
     folder lacks, or finished where the folder's was cut short), the damaged ones the folder
-    lacks and the rates; the number of partitions moved. The caller writes back the rows that
-    only its tables hold (``state.orphans``) and then discards it."""
+    lacks and the rates. The caller writes back the rows that only its tables hold
+    (``state.orphans``) and then discards it."""
     mine = next((a for a in state.set_aside if a.path == aside), None)
     if mine is None:
-        return 0
-    merged, moved = state.merged(), 0
+        return
+    merged = state.merged()
     (out / "sequences").mkdir(exist_ok=True)
     for stem, frame in mine.partitions.items():
         if merged.get(stem) is frame:
             os.replace(aside / "sequences" / f"{stem}.parquet", out / "sequences" /
                        f"{stem}.parquet")
-            moved += 1
     for path in sorted(aside.glob("sequences/*.damaged")):
         if not (out / "sequences" / path.name).exists():
             os.replace(path, out / "sequences" / path.name)
     for name in ("rates.csv", "rates.md"):
         if (aside / name).exists() and not (out / name).exists():
             os.replace(aside / name, out / name)
-    return moved

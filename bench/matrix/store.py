@@ -30,7 +30,7 @@ from bench.matrix.files import (
     checksums,
     read_snapshot,
 )
-from bench.matrix.folder_state import MANIFEST, FolderState
+from bench.matrix.folder_state import MANIFEST, FolderState, read_partitions, table_of
 from bench.matrix.set_aside import SetAsideFolder, discard, discard_folder, restore_into
 from bench.sequence.rows import COLUMNS, FINISHED, ResultRow, with_labels
 
@@ -219,7 +219,7 @@ class ResultStore:
         with folder_lock(self.out):
             restore_into(self.out, self.previous.path, FolderState.read(self.out))
             self._adopt(FolderState.read(self.out).orphans())
-            self.previous.release()
+            self.previous.discard()
             self.previous = None
             self.consolidate(locked=True)
 
@@ -260,7 +260,7 @@ class ResultStore:
     def table(self) -> pd.DataFrame:
         """All rows in the folder's partitions: earlier runs' and this run's (what the folder
         held beside them was written back when it was opened)."""
-        return FolderState.read(self.out).record()
+        return table_of(list(read_partitions(self.out)[0].values()))
 
     def consolidate(self, locked: bool = False) -> pd.DataFrame:
         """results.parquet and results.csv from every partition (under the folder's lock)."""
