@@ -10,7 +10,8 @@ Gamma_C, ||sigma_nt(u_h)|| + ||sigma_nn(u_h) - [P_gamma(u_h)]_-|| = ||sigma_nn(u
 (lambda_h = -[P_gamma(u_h)]_- is Nitsche's pressure). These are the terms of the residual
 estimator's eta_0; what differs is that the eq. (8) contact terms are not added: Nitsche's
 method is consistent, and its reliability proof (under a saturation assumption) needs only the
-Nitsche residual on Gamma_C. It applies to ``nitsche`` only.
+Nitsche residual on Gamma_C. It applies to a formulation that declares the trait
+``nitsche-contact`` (``nitsche``; a plugin may too).
 """
 
 from __future__ import annotations
@@ -20,13 +21,17 @@ import numpy as np
 from estimators.base import Estimate, register_estimator
 from estimators.residual import volume_terms
 from formulations import DiscreteSolution
+from formulations.registry import formulation_traits
 
 
 def nitsche_only(scene=None, formulation: str = "", **_) -> str | None:
-    if formulation == "nitsche":
+    """A formulation qualifies by declaring the trait ``nitsche-contact`` (docs/plugins.md,
+    "Traits"), not by its name."""
+    if "nitsche-contact" in formulation_traits(formulation):
         return None
     return (f"nitsche-residual estimates Nitsche's method only (its contact term is the "
-            f"Nitsche residual sigma_nn(u_h) - [P_gamma(u_h)]_-), not {formulation!r}")
+            f"Nitsche residual sigma_nn(u_h) - [P_gamma(u_h)]_-), not {formulation!r}, which "
+            "does not declare the trait nitsche-contact")
 
 
 @register_estimator("nitsche-residual", "Chouly-Fabre-Hild-Pousin-Renard residual estimator "

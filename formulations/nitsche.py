@@ -156,7 +156,7 @@ def check_friction(scene: Scene, theta: float) -> None:
                                  "(option theta), gamma = gamma_0 E / h_F (option gamma_0, "
                                  f"default {DEFAULT_GAMMA_0:g}), lambda_h = -[P_gamma(u_h)]_-; "
                                  "Tresca or Coulomb friction with theta = 1 (2D and 3D)",
-                      friction=(2, 3))
+                      friction=(2, 3), traits=("nitsche-contact",))
 def discretise(scene: Scene, mesh: MeshTri, theta: float = 1.0,
                gamma_0: float = DEFAULT_GAMMA_0, order: int = 1) -> Discretisation:
     check_options(theta, gamma_0)

@@ -31,12 +31,30 @@ def frictionless_only(kind: str, name: str, applies=None, dims: tuple[int, ...] 
 
 
 def register_formulation(name: str, description: str, applies=None, *,
-                         friction: bool | tuple[int, ...] = False):
+                         friction: bool | tuple[int, ...] = False, traits: tuple[str, ...] = ()):
     """Register ``discretise(scene, mesh, **options)`` under ``name``; ``applies(scene=...)``
     says why a scene is refused (optional); ``friction``: whether it models a scene's
     friction law (True: in 2D; or the dimensions, e.g. (2, 3)), else a scene with friction is
-    refused with that reason."""
+    refused with that reason; ``traits``: what an estimator may ask of it (TRAITS)."""
+    unknown = [t for t in traits if t not in TRAITS]
+    if unknown:
+        raise ValueError(f"traits={list(traits)!r}: unknown {', '.join(unknown)}; valid: "
+                         f"{', '.join(TRAITS)}")
     dims = friction_dims(friction)
     check = frictionless_only("formulation", name, applies, dims)
     return FORMULATIONS.register(name, description, check,
-                                 meta={"friction": bool(dims), "friction_dims": dims})
+                                 meta={"friction": bool(dims), "friction_dims": dims,
+                                       "traits": tuple(traits)})
+
+
+# what a formulation may declare of itself, for estimators whose theory needs it
+# (docs/plugins.md, "Traits")
+TRAITS = {
+    "nitsche-contact": "its pressure is Nitsche's lambda_h = -[P_gamma(u_h)]_- and its contact "
+                       "residual sigma_nn(u_h) + lambda_h (nitsche-residual applies)",
+}
+
+
+def formulation_traits(name: str) -> tuple[str, ...]:
+    """The traits the formulation ``name`` declared (none for an unknown name)."""
+    return tuple(FORMULATIONS.meta(name, "traits", ()) if name in FORMULATIONS.names() else ())

@@ -7,13 +7,14 @@ from __future__ import annotations
 import os
 import sys
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import pandas as pd
 
 from bench.cli.compare_block import check_readme, write_compare_block
 from bench.cli.diff import diff_command
-from bench.cli.generated import run_values
+from bench.cli.generated import given_options, run_values
 from bench.cli.guards import (
     InputError,
     check_compare_out,
@@ -45,11 +46,11 @@ from bench.matrix.config_files import (
 )
 from bench.matrix.files import FULL
 from bench.matrix.plugins import load_plugins
-from bench.matrix.run import RunRefused, compare_reference_dofs
+from bench.matrix.run import RunRefused, cached_reference_dofs, compare_reference_dofs
 from bench.matrix.scene_files import load_scene_files, scene_files_in
 from bench.matrix.store import ResultsError, read_results
 from bench.report import write_report
-from bench.report.console import console_summary
+from bench.report.console import console_summary, duration
 from bench.report.render import read_json
 from bench.verify import load_expected, verdict_table, verify
 from bench.verify.expected import ExpectedError
@@ -68,21 +69,35 @@ def configured(**fields) -> RunConfig | None:
         return None
 
 
-def run_config(config: RunConfig | None, quiet: bool = False) -> int:
-    """Run ``config``; ``quiet``: without the per-sequence tables (compare prints its own
-    summary)."""
+def run_config(config: RunConfig | None, compare: bool = False, quiet: bool = False) -> int:
+    """Run ``config``: a progress bar on a terminal; ``run`` prints a line per level and a
+    table per sequence, ``compare`` (``compare``) only its progress (and nothing with
+    ``quiet``), then prints its own summary."""
     if config is None:
         return 2
-    live = Progress(len(config.specs()))
-    result = run(config, on_level=live.level(progress), on_sequence=live.sequence)
-    live.close()
+    live = Progress(len(config.specs()), quiet=quiet, what="matrix")
+    timing: list[Progress] = []
+
+    def timed(spec, total: int) -> None:  # the candidates to be the cheapest, timed again
+        if not timing:
+            live.close()
+            timing.append(Progress(total, quiet=quiet, what="timing the cheapest again"))
+        timing[0].sequence(spec)
+
+    try:
+        result = run(config, on_level=live.level(lambda r: None if compare else progress(r)),
+                     on_sequence=live.sequence, on_timed=timed)
+    finally:
+        for bar in [live, *timing]:
+            bar.close()
+    say = (lambda *a: None) if quiet else print
     if result.reused:
-        print(f"reused {len(result.reused)} sequences finished by an earlier run in "
-              f"{result.store.out}")
-    print(f"wrote {result.store.out / 'rates.md'}")
-    if not quiet:
+        say(f"reused {len(result.reused)} sequences finished by an earlier run in "
+            f"{result.store.out}")
+    if not compare:
+        print(f"wrote {result.store.out / 'rates.md'}")
         print("\n" + summary(result.table) + "\n")
-    print(f"wrote {len(result.rows)} rows to {result.store.parquet} and {result.store.csv}")
+    say(f"wrote {len(result.rows)} rows to {result.store.parquet} and {result.store.csv}")
     return 1 if result.failed else 0
 
 
@@ -103,25 +118,41 @@ def save_config(config: RunConfig | None, args) -> None:
 def run_command(args) -> int:
     values = {**run_values(args, RunConfig), "overwrite": overwrite_of(args, False)}
     config = configured(**values, command=command_line(args))
+    if config is not None and config.reference_dofs is None:
+        try:
+            cached = cached_reference_dofs(config)
+        except ValueError:  # a bad scene parameter: the run refuses it, naming it
+            cached = None
+        if cached is not None:
+            print(f"note: errors measured against the references compare cached (as with "
+                  f"--reference-dofs {cached}; give --reference-dofs to choose another)",
+                  file=sys.stderr)
+            config = replace(config, reference_dofs=cached)
     save_config(config, args)
     return run_config(config)
 
 
-def hard_command(args, quiet: bool = False) -> int:
-    """Run the hard cases; ``quiet``: one line per case and the file written (compare prints
-    the verdict counts and the unexpected rows last)."""
+def hard_command(args, compare: bool = False) -> int:
+    """Run the hard cases; ``compare``: one line for them all (compare prints the verdict
+    counts and the unexpected rows last)."""
     def show(name, frame):
-        print(f"hard case {name}: {len(frame)} rows, verdicts "
-              + ", ".join(f"{v} {n}" for v, n in frame["verdict"].value_counts().items()),
-              flush=True)
+        if not compare:
+            print(f"hard case {name}: {len(frame)} rows, verdicts "
+                  + ", ".join(f"{v} {n}" for v, n in frame["verdict"].value_counts().items()),
+                  flush=True)
 
     expected = load_expected().get("hard", [])  # a damaged file is named before any work
+    start = time.perf_counter()
     table = run_hard(args.case, on_case=show, cells=args.cell)
-    print(f"wrote {write_hard(table, args.out)}")
+    written = write_hard(table, args.out)
     checks = check_expected(table, expected)
     wrong = [c for c in checks if not c["passed"]]
-    if quiet:
+    if compare:
+        if not getattr(args, "quiet", False):
+            print(f"ran {table['case'].nunique()} hard cases ({len(table)} rows) in "
+                  f"{duration(time.perf_counter() - start)} into {written}", flush=True)
         return 1 if wrong else 0
+    print(f"wrote {written}")
     print("\n" + hard_markdown(table))
     for c in wrong:
         print(f"UNEXPECTED: {c['case']}/{c['formulation']}/{c['solver']}/{c['variant']}: "
@@ -155,9 +186,13 @@ def compared_scenes(dim: int) -> list[str]:
 def compare_fields(args) -> dict:
     """compare's run: its package settings, then the run file's keys (``--config``), then
     its options; scenes, formulations and estimators not given are every registered one."""
-    fields = {k: v for k, v in {**compare_settings(), **args.file_fields}.items()
+    fields = {k: v for k, v in {**compare_settings(dim=args.dim), **args.file_fields}.items()
               if k not in COMPARE_KEYS}
     fields.update(run_values(args, RunConfig))
+    given = given_options(args, RunConfig)  # the command line's last word, over the parts too
+    fields["parts"] = tuple(tuple((k, v) for k, v in (part.items() if isinstance(part, dict)
+                                                      else part) if k not in given)
+                            for part in fields.get("parts", ()))
     fields.setdefault("scenes", compared_scenes(args.dim))
     fields.setdefault("formulations", formulation_names())
     fields.setdefault("estimators", estimator_names())
@@ -170,6 +205,8 @@ def compare_command(args) -> int:
     """The default comparison: every scene not tagged hard x every formulation x every
     estimator x {uniform, adaptive} with the active-set solver (``compare.toml``), then the
     hard cases into the same folder, then the report."""
+    if args.reports is None:
+        args.reports = str(Path(args.out) / "report")
     check_compare_out(args.out, args.overwrite)
     load_expected()  # its hard verdicts and claims: a damaged file is named before any work
     config = configured(**compare_fields(args), command=command_line(args))
@@ -180,11 +217,11 @@ def compare_command(args) -> int:
         except ValueError as error:
             raise InputError(str(error)) from None
     start = time.perf_counter()
-    status = run_config(config, quiet=True)
+    status = run_config(config, compare=True, quiet=args.quiet)
     if config is None:
         return status
     args.case = None
-    hard_status = hard_command(args, quiet=True) if args.dim == 2 else 0  # the hard cases: 2D
+    hard_status = hard_command(args, compare=True) if args.dim == 2 else 0  # the hard cases: 2D
     table = read_results(args.out)
     readme = write_report(table, args.reports, args.out)
     if args.readme is not None:
@@ -199,7 +236,7 @@ def print_summary(readme: Path, table: pd.DataFrame, results, seconds: float | N
     hard_csv = Path(results) / "hard.csv"
     hard = pd.read_csv(hard_csv) if hard_csv.exists() else None
     truth = read_json(Path(results), "truth.json")
-    print("\n" + "\n".join(console_summary(readme, table, hard, seconds, truth)))
+    print("\n" + "\n".join(console_summary(readme, table, hard, seconds, truth, Path(results))))
 
 
 def report_command(args) -> int:

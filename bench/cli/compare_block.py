@@ -9,15 +9,21 @@ from pathlib import Path
 import pandas as pd
 
 from bench.hard import check_expected
+from bench.matrix.cost import read_timings
 from bench.matrix.store import read_results
 from bench.perf.scaling import replace_in_readme
+from bench.report.ranking import spread_text
+from bench.report.render import read_json
+from bench.report.summary import scene_answers
 from bench.verify import load_expected
 
 README_START, README_END = "<!-- compare:start -->", "<!-- compare:end -->"
 
 
-def compare_block(table: pd.DataFrame, hard: pd.DataFrame | None, seconds: float) -> str:
-    """One Markdown paragraph: rows by status, sequences, hard verdicts and wall time."""
+def compare_block(table: pd.DataFrame, hard: pd.DataFrame | None, seconds: float,
+                  results: Path | None = None) -> str:
+    """One Markdown paragraph (rows by status, sequences, hard verdicts and wall time), then the
+    recommendation per scene and the measured timing spread when ``results`` is given."""
     statuses = table["status"].value_counts()
     by_status = ", ".join(f"{statuses[s]} {s}" for s in sorted(statuses.index))
     sequences = table["sequence_key"].nunique()
@@ -28,7 +34,14 @@ def compare_block(table: pd.DataFrame, hard: pd.DataFrame | None, seconds: float
         checks = check_expected(hard, load_expected().get("hard", []))
         passed = sum(c["passed"] for c in checks)
         text += f"; {passed} of {len(checks)} hard verdicts as expected"
-    return text + f"; {seconds:.0f} s wall time in all (run, hard cases and report)."
+    text += f"; {seconds:.0f} s wall time in all (references, run, timings, hard cases, report)."
+    if results is None:
+        return text
+    truth = read_json(Path(results), "truth.json")
+    rows = table[table["level"] >= 0]
+    sentences = [f"- {a.sentence}" for a in scene_answers(rows, truth, Path(results))]
+    spread = spread_text(read_timings(results))
+    return "\n".join([text, "", *sentences, "", spread[0].upper() + spread[1:] + "."])
 
 
 def write_compare_block(readme: str | Path, results: str | Path, seconds: float) -> None:
@@ -36,7 +49,7 @@ def write_compare_block(readme: str | Path, results: str | Path, seconds: float)
     hard_csv = Path(results) / "hard.csv"
     hard = pd.read_csv(hard_csv) if hard_csv.exists() else None
     replace_in_readme(readme, README_START, README_END,
-                      compare_block(read_results(results), hard, seconds))
+                      compare_block(read_results(results), hard, seconds, Path(results)))
 
 
 def check_readme(readme: str | Path) -> None:

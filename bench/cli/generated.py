@@ -107,3 +107,11 @@ def run_values(args: argparse.Namespace, cls) -> dict:
                 value = not value
             values[field.name] = tuple(value) if isinstance(value, list) else value
     return values
+
+
+def given_options(args: argparse.Namespace, cls) -> set[str]:
+    """The fields of ``cls`` whose options the command line itself gave (``args.argv``), not
+    a run file's or the package's defaults."""
+    argv = getattr(args, "argv", [])
+    return {field.name for field, opt in option_fields(cls)
+            if any(a == f"--{opt.flag}" or a.startswith(f"--{opt.flag}=") for a in argv)}

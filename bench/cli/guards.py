@@ -41,8 +41,10 @@ def check_output_folder(path: str | Path, option: str) -> Path:
 
 
 def check_output_folders(command: str, args) -> None:
+    """Every output folder option of ``command`` (one left unset takes its default later)."""
     for option in OUTPUT_OPTIONS.get(command, ()):
-        check_output_folder(getattr(args, option), option)
+        if getattr(args, option) is not None:
+            check_output_folder(getattr(args, option), option)
 
 
 

@@ -127,11 +127,13 @@ def _export_parser(sub) -> None:
 def _compare_parser(sub, defaults: dict) -> None:
     compare = sub.add_parser(
         "compare", help="the default comparison (the README's main job): run, hard, report",
-        description="Run every scene not tagged hard x formulation x estimator x {uniform, "
-        "adaptive} with the active-set solver (cross-checked by the reference on small "
-        "levels), errors against exact solutions or cached overkill references, then every "
-        "hard case into the same folder, then render the report. Its settings are the run "
-        "file bench/matrix/compare.toml; --config FILE reads another.")
+        description="Run the default comparison: every scene not tagged hard x formulation x "
+        "estimator, P1 uniform and adaptive, P2 and P3 adaptive (the parts of "
+        "bench/matrix/compare.toml; --dim 3: compare-3d.toml) with the active-set solver "
+        "(cross-checked by the reference on small levels), errors against exact solutions or "
+        "cached overkill references; time the candidates to be the cheapest again; run every "
+        "hard case into the same folder; render the report and print the recommendation per "
+        "scene. --config FILE reads another run file.")
     settings = {**compare_settings(), **defaults}
     add_run_options(compare, RunConfig, settings, COMPARE_OPTIONS, COMPARE_HELPS)
     compare.add_argument("--dim", type=int, choices=(2, 3), default=settings["dim"],
@@ -139,8 +141,11 @@ def _compare_parser(sub, defaults: dict) -> None:
                               "tetrahedral scenes only, errors against exact solutions or P2 "
                               f"references (reference budget: {COMPARE_REFERENCE_DOFS} in 2D, "
                               f"{COMPARE_REFERENCE_DOFS_3D} in 3D, unless given)")
-    compare.add_argument("--reports", default=settings["reports"],
-                         help="report folder (default: %(default)s)")
+    compare.add_argument("--reports", default=settings.get("reports"),
+                         help="report folder (default: OUT/report, inside the results "
+                              "folder; give reports to regenerate the published report)")
+    compare.add_argument("--quiet", action="store_true",
+                         help="print nothing but the closing lines (no progress)")
     compare.add_argument("--readme", default=settings.get("readme"),
                          help="also replace the figures between the compare markers of this "
                               "README (e.g. README.md): rows, sequences, hard verdicts, time")

@@ -1,7 +1,8 @@
-"""What a run prints as it goes: one line per level (``progress``), a table per sequence at
-the end (``summary``), and a live progress line for the whole matrix on standard error
-(sequences done, running and left, the most DOFs reached, elapsed and estimated remaining
-time; quiet when standard error is not a terminal)."""
+"""What a run prints as it goes (docs/command-line.md, "What a run prints"): on a terminal a
+progress bar on standard error (sequences done of all, the current scene, elapsed and estimated
+remaining time); elsewhere at most PROGRESS_LINES lines for the whole matrix; with ``quiet``
+nothing. ``run`` also prints one line per level (``progress``) and a table per sequence at
+the end (``summary``)."""
 
 from __future__ import annotations
 
@@ -9,44 +10,55 @@ import sys
 import time
 
 import pandas as pd
+from tqdm import tqdm
 
+from bench.report.console import duration
 from bench.sequence.loop import LevelResult
 from bench.sequence.rows import KEYS, level_time
 
+PROGRESS_LINES = 10  # lines a whole matrix prints when standard error is not a terminal
+
 
 class Progress:
-    def __init__(self, total: int, stream=None):
+    """Sequences done of ``total``: a bar on a terminal, a line at every tenth elsewhere."""
+
+    def __init__(self, total: int, stream=None, quiet: bool = False, what: str = "sequences"):
         self.stream = sys.stderr if stream is None else stream
-        self.live = self.stream.isatty()
-        self.total, self.done, self.dofs = total, 0, 0
+        self.quiet, self.what = quiet, what
+        self.total, self.done, self.shown = total, 0, 0
         self.start = time.perf_counter()
+        self.bar = None
+        if not quiet and self.stream.isatty():
+            self.bar = tqdm(total=total, file=self.stream, unit=" seq", dynamic_ncols=True,
+                            desc=what, bar_format="{desc}: {n_fmt}/{total_fmt} |{bar}| "
+                            "{elapsed} elapsed, ~{remaining} left{postfix}")
 
     def level(self, then):
-        """A per-level callback that also updates the line (``then``: the per-level printer)."""
-        def on_level(result) -> None:
-            then(result)
-            self.dofs = max(self.dofs, int(result.row.ndofs))
-            self.show()
+        """A per-level callback that prints through the bar (``then``: the printer)."""
+        def on_level(result: LevelResult) -> None:
+            if self.bar is not None:
+                self.bar.set_postfix_str(str(result.row.scene), refresh=False)
+            if not self.quiet:
+                then(result)
         return on_level
 
-    def sequence(self, spec, end: str) -> None:
+    def sequence(self, spec, end: str = "") -> None:
         self.done += 1
-        self.show()
-
-    def show(self) -> None:
-        if not self.live:
-            return
-        elapsed = time.perf_counter() - self.start
-        left = self.total - self.done
-        eta = f"{elapsed / self.done * left:6.0f} s" if self.done else "     ?"
-        self.stream.write(f"\r[matrix] {self.done}/{self.total} sequences done, {left} left, "
-                          f"max {self.dofs} DOFs, {elapsed:6.0f} s elapsed, ~{eta} to go ")
-        self.stream.flush()
+        if self.bar is not None:
+            self.bar.set_postfix_str(str(spec.scene), refresh=False)
+            self.bar.update(1)
+        elif not self.quiet and self.total and (
+                self.done * PROGRESS_LINES // self.total > self.shown or self.done == self.total):
+            self.shown = self.done * PROGRESS_LINES // self.total
+            elapsed = time.perf_counter() - self.start
+            left = elapsed / self.done * (self.total - self.done)
+            print(f"[{self.what}] {self.done} of {self.total} done, {duration(elapsed)} "
+                  f"elapsed, ~{duration(left)} left", file=self.stream, flush=True)
 
     def close(self) -> None:
-        if self.live:
-            self.stream.write("\n")
-            self.stream.flush()
+        if self.bar is not None:
+            self.bar.close()
+            self.bar = None
 
 
 SUMMARY_COLUMNS = ["level", "ndofs", "energy", "contact_force", "active_constraints", "eta",
@@ -56,10 +68,11 @@ SUMMARY_COLUMNS = ["level", "ndofs", "energy", "contact_force", "active_constrai
 
 def progress(result: LevelResult) -> None:
     r = result.row
-    print(f"{r.scene}/{r.formulation}/{r.solver}/{r.estimator}/{r.strategy} "
-          f"level {r.level:2d}  ndofs {r.ndofs:8d}  eta {r.eta:11.5e}  "
-          f"time {level_time(r):7.2f} s  "
-          f"{r.status}{' (' + r.reason + ')' if r.reason else ''}", flush=True)
+    tqdm.write(f"{r.scene}/{r.formulation}/{r.solver}/{r.estimator}/{r.strategy} "
+               f"level {r.level:2d}  ndofs {r.ndofs:8d}  eta {r.eta:11.5e}  "
+               f"time {level_time(r):7.2f} s  "
+               f"{r.status}{' (' + r.reason + ')' if r.reason else ''}", file=sys.stdout)
+    sys.stdout.flush()
 
 
 def summary(table: pd.DataFrame) -> str:

@@ -6,7 +6,7 @@ loop's ``LoopSettings``, inherited, so declared once) and where it runs."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, fields, replace
 
 from bench.matrix.distributed import scheduler_endpoint
 from bench.matrix.plugins import load_plugins
@@ -73,6 +73,10 @@ class RunConfig(LoopSettings):
     crosscheck_dofs: int = _what(
         0, "also solve levels with at most this many DOFs with the reference solver and "
         "record the differences (0: never)", "crosscheck-dofs", "int>=0")
+    timing_repeats: int = _what(
+        0, "time again, this many times more each, the sequences that may be the cheapest to "
+        "a relative error of 1e-2 or 1e-3, for a cost that ranks (docs/report.md, \"Cost and "
+        "ties\"); compare: 3", "timing-repeats", "int>=0")
     scene_files: tuple[str, ...] = _what(
         (), "a Python file that registers scenes with scenes.register_scene, or a TOML scene "
         "(docs/scenes.md) (repeatable); its scenes join --scene's choices", "scene-file",
@@ -96,6 +100,10 @@ class RunConfig(LoopSettings):
         None, "folder of the cached overkill references", "cache", "text", metavar="DIR",
         default_text="$SIGNORINI_BENCH_CACHE or .cache/references")
     command: str = ""  # how the run was asked for, recorded in run.json
+    # the run as a union of matrices (docs/command-line.md, "Runs in parts"): each part is this
+    # run with the part's fields (pairs of field name and value) in place of its own; empty:
+    # the run is its own one matrix
+    parts: tuple[tuple[tuple[str, object], ...], ...] = ()
 
     def __post_init__(self):
         super().__post_init__()  # the loop's settings
@@ -106,7 +114,7 @@ class RunConfig(LoopSettings):
             self._check_names(name, valid())
         self._check_axis("orders", "order", list(map(str, ORDERS)), check_order)
         self._check_axis("cells", "cell", cell_names(), check_cell)
-        for name in ("reference_dofs", "crosscheck_dofs", "workers"):
+        for name in ("reference_dofs", "crosscheck_dofs", "workers", "timing_repeats"):
             value = getattr(self, name)
             if value is not None and not (is_integer(value) and value >= 0):
                 raise ValueError(f"{name}={value!r} is not an integer >= 0")
@@ -119,6 +127,7 @@ class RunConfig(LoopSettings):
                              f"({', '.join(s for s in solver_names() if s != REFERENCE_SOLVER)}"
                              f"); solver={REFERENCE_SOLVER!r} (Clarabel) uses its own linear "
                              "algebra: leave out the backend or add a fast solver")
+        self._check_parts()
         unsafe = [e for e in self.estimators if e not in guaranteed_estimators()]
         if self.target_error is not None and unsafe:
             raise ValueError(f"target_error={self.target_error!r} needs estimators whose eta is "
@@ -154,6 +163,14 @@ class RunConfig(LoopSettings):
             check(value)
 
     def specs(self) -> list[SequenceSpec]:
+        """Every sequence of the run: its one matrix, or the union of its parts' (a sequence
+        two parts share runs once, in the first part's place)."""
+        if self.parts:
+            unique = {}
+            for part in self.part_configs():
+                for spec in part.specs():
+                    unique.setdefault(spec.key, spec)
+            return list(unique.values())
         return cross_product(
             [s for item in self.scenes for s in parse_item(item, "scenes")],
             [f for item in self.formulations for f in parse_item(item, "formulations")],
@@ -162,9 +179,30 @@ class RunConfig(LoopSettings):
             reference_dofs=self.reference_dofs, crosscheck_dofs=self.crosscheck_dofs,
             scene_source=source_digest(self.scene_files))
 
+    def part_configs(self) -> list[RunConfig]:
+        """Each part as a run of its own (what runs and how; never where)."""
+        return [replace(self, **dict(part), parts=(), command="") for part in self.parts]
+
+    def _check_parts(self) -> None:
+        """Parts name what runs and how each sequence runs, never where (one folder, one
+        cluster); each is checked as a run of its own."""
+        own = {f.name: o for f, o in option_fields(self)}
+        parts = tuple(tuple(sorted((dict(part) if not isinstance(part, dict) else part).items()))
+                      for part in self.parts)
+        object.__setattr__(self, "parts", parts)
+        for k, part in enumerate(parts):
+            bad = [name for name, _ in part if name not in own or own[name].section == "where"]
+            if bad or not part:
+                allowed = ", ".join(o.flag for o in own.values() if o.section != "where")
+                raise ValueError(f"parts[{k}] sets {', '.join(bad) or 'nothing'}; a part sets "
+                                 f"one or more of: {allowed}")
+        self.part_configs()  # each part's names and values checked as a run's
+
     def record(self) -> dict:
         """The configuration as written to run.json (every field but ``command``; a run file
         holding it repeats the run, ``bench.matrix.config_files``)."""
         unsaved = {f.name for f, o in option_fields(self) if not o.saved}
-        return {f.name: getattr(self, f.name) for f in fields(self)
-                if f.name != "command" and f.name not in unsaved}
+        record = {f.name: getattr(self, f.name) for f in fields(self)
+                  if f.name != "command" and f.name not in unsaved}
+        record["parts"] = [dict(part) for part in self.parts]
+        return record

@@ -15,7 +15,9 @@ from bench.matrix.files import FULL, atomic_text
 from bench.sequence.options import SECTIONS, option_fields
 
 COMPARE_SETTINGS = Path(__file__).with_name("compare.toml")
+COMPARE_SETTINGS_3D = Path(__file__).with_name("compare-3d.toml")
 COMPARE_KEYS = ("dim", "reports", "readme")  # compare's own keys beside run's
+PART_KEYS = ("part", "parts")  # a run file's [[part]] tables; run.json's "parts"
 SECTION_TITLES = {"what": "what runs", "how": "how each sequence runs",
                   "where": "where it runs"}
 
@@ -47,6 +49,9 @@ def run_fields(data: dict, where: str, extra: tuple[str, ...] = ()) -> dict:
     by_flag = {o.flag: name for name, (_, o) in options.items()}
     out: dict = {}
     for key, value in data.items():
+        if key in PART_KEYS:  # [[part]] tables, or run.json's "parts"
+            out["parts"] = part_fields(value, where)
+            continue
         name = by_flag.get(key, key if key in options else None)
         if name is None and key in extra:
             out[key] = value
@@ -74,6 +79,15 @@ def run_fields(data: dict, where: str, extra: tuple[str, ...] = ()) -> dict:
     return out
 
 
+def part_fields(parts, where: str) -> tuple:
+    """The ``[[part]]`` tables of a run file as ``RunConfig.parts`` (docs/command-line.md,
+    "Runs in parts")."""
+    if not isinstance(parts, list) or not all(isinstance(p, dict) for p in parts):
+        raise RunFileError(f"{where}: part must be a list of tables ([[part]]), got {parts!r}")
+    return tuple(tuple(sorted(run_fields(part, f"{where} part {k + 1}").items()))
+                 for k, part in enumerate(parts))
+
+
 def dataclass_fields(data: dict, names: list[str], where: str) -> dict:
     """``data``'s keys as the field ``names`` of a dataclass (``uniform-max-dofs`` or
     ``uniform_max_dofs``); an unknown key is refused naming the valid ones. Lists become
@@ -95,8 +109,11 @@ def read_toml(path: str | Path, what: str) -> dict:
         raise RunFileError(f"config={str(path)!r} cannot be read as {what}: {error}") from None
 
 
-def compare_settings(path: str | Path = COMPARE_SETTINGS) -> dict:
-    """The settings of ``compare`` (fields, plus ``dim``, ``reports`` and ``readme``)."""
+def compare_settings(path: str | Path | None = None, dim: int = 2) -> dict:
+    """The settings of ``compare`` (fields, plus ``dim``, ``reports`` and ``readme``): the
+    package's for ``dim`` unless ``path``."""
+    if path is None:
+        path = COMPARE_SETTINGS_3D if dim == 3 else COMPARE_SETTINGS
     return read_run_file(path, extra=COMPARE_KEYS)
 
 
@@ -116,7 +133,20 @@ def run_file_text(config: RunConfig, command: str = "") -> str:
                 value = not value
             lines.append(f"# {opt.flag}: not set" if value is None
                          else f"{opt.flag} = {_toml_value(value)}")
-    return "\n".join(lines) + "\n"
+    return "\n".join(lines + part_tables(config)) + "\n"
+
+
+def part_tables(config: RunConfig) -> list[str]:
+    """The run's parts as ``[[part]]`` tables (keys as the command line's options)."""
+    options = {f.name: o for f, o in option_fields(config)}
+    lines = ["\n# the run is the union of these matrices, each the settings above with its own"
+             ] if config.parts else []
+    for part in config.parts:
+        lines.append("[[part]]")
+        lines += [f"{options[name].flag} = "
+                  f"{_toml_value(not value if options[name].kind == 'switch-off' else value)}"
+                  for name, value in part]
+    return lines
 
 
 def _toml_value(value) -> str:

@@ -26,6 +26,7 @@ from bench.matrix.store import ResultStore, SequenceWriter
 from bench.matrix.task import Outcome, run_spec
 from bench.sequence.memory import available_gib
 from bench.truth import truth_for
+from estimators import guaranteed_estimators
 
 SINGLE_THREAD = {name: "1" for name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS",
                                         "MKL_NUM_THREADS")}
@@ -146,6 +147,13 @@ def client_for(config):
     return client, cluster
 
 
+def expected_work(spec: SequenceSpec) -> tuple:
+    """A rough order of a sequence's cost, so that the longest start first and the last
+    minutes of a run are not one worker finishing a long sequence alone: the order, then a
+    guaranteed bound's estimator (its local problems dominate), then the DOF budget."""
+    return (spec.order, spec.estimator in guaranteed_estimators(), spec.max_dofs)
+
+
 def run_on_dask(specs: list[SequenceSpec], store: ResultStore, run: dict, config,
                 on_sequence=None) -> list:
     """Run ``specs`` as Dask tasks; returns the rows they computed."""
@@ -162,7 +170,7 @@ def run_on_dask(specs: list[SequenceSpec], store: ResultStore, run: dict, config
         files = tuple(str(Path(f).expanduser().resolve()) for f in config.scene_files)
         futures = {client.submit(sequence_task, spec, str(store.out), run, cache, memory, files,
                                  key=f"sequence-{spec.key}-{run['run_id']}", pure=False): spec
-                   for spec in specs}
+                   for spec in sorted(specs, key=expected_work, reverse=True)}
         rows = []
         for future in as_completed(futures):
             outcome = future.result()

@@ -19,18 +19,29 @@ import numpy as np
 import pandas as pd
 
 from bench.matrix.files import atomic_text, atomic_write
+from bench.measure.slope import SlopeFit, fit_slope
 from bench.sequence.rows import KEYS, with_labels
 from formulations import STATUS_OK
 
 RATE_LEVELS = 4
 
 
-def slope(group: pd.DataFrame, column: str, levels: int = RATE_LEVELS) -> float:
+def slope_fit(group: pd.DataFrame, column: str, levels: int = RATE_LEVELS) -> SlopeFit:
+    """The slope of ``column`` over the DOFs on the last ``levels`` ok levels with a value > 0,
+    with its 95 % interval (``bench.measure.slope``)."""
     ok = group[(group["status"] == STATUS_OK) & (group[column] > 0)].sort_values("ndofs")
     ok = ok.tail(levels)
-    if len(ok) < 2:
-        return float("nan")
-    return float(np.polyfit(np.log(ok["ndofs"]), np.log(ok[column]), 1)[0])
+    return fit_slope(ok["ndofs"], ok[column])
+
+
+def slope(group: pd.DataFrame, column: str, levels: int = RATE_LEVELS) -> float:
+    return slope_fit(group, column, levels).slope
+
+
+def slope_columns(group: pd.DataFrame, column: str, name: str, levels: int) -> dict:
+    """``name`` (the slope) and ``name_low``, ``name_high`` (its 95 % interval)."""
+    fit = slope_fit(group, column, levels)
+    return {name: fit.slope, f"{name}_low": fit.low, f"{name}_high": fit.high}
 
 
 def judged_levels(rows: pd.DataFrame) -> pd.DataFrame:
@@ -76,8 +87,8 @@ def rates_table(table: pd.DataFrame, levels: int = RATE_LEVELS) -> pd.DataFrame:
             "dim": int(group["dim"].iloc[0]) if "dim" in group else 2,
             "levels": len(group), "fit_levels": len(tail),
             "ndofs_last": int(group["ndofs"].iloc[-1]),
-            "error_rate": slope(group, "energy_error", levels),
-            "eta_rate": slope(group, "eta", levels),
+            **slope_columns(group, "energy_error", "error_rate", levels),
+            **slope_columns(group, "eta", "eta_rate", levels),
             "pressure_error_rate": slope(group, "pressure_error", levels),
             "effectivity_last": float(tail["effectivity_index"].iloc[-1]) if len(tail) else
             float("nan"),

@@ -10,11 +10,13 @@ from __future__ import annotations
 
 import sys
 from collections.abc import Callable
+from contextlib import suppress
 from dataclasses import dataclass
 
 import pandas as pd
 
 from bench.matrix.config import RunConfig
+from bench.matrix.cost import time_again, truth_record, write_timings
 from bench.matrix.distributed import SchedulerError, check_scheduler
 from bench.matrix.local import new_run_identity, run_specs, truth_name, write_truth_summary
 from bench.matrix.provenance import write_run_record
@@ -29,14 +31,42 @@ from bench.matrix.store import ResultStore
 from bench.sequence.loop import LevelResult
 from bench.sequence.rows import COLUMNS, ResultRow
 from bench.truth import truth_for
-from bench.truth.cache import check_cache_folder
+from bench.truth.cache import CorruptCache, cache_folder, check_cache_folder, load_reference
+from bench.truth.kinds import check_reference
+from bench.truth.references import TruthError, reference_key
 from formulations import STATUS_FAILED
 
-COMPARE_REFERENCE_DOFS = 200000  # the default comparison's reference budget
+# the default comparison's reference budget: 10 x its P3 part's 20 000 DOFs (measured on 2
+# cores: paper 256 038 DOFs in 16 s, hertz about 220 000; the time of every error measured
+# against a reference grows with its size, so no larger)
+COMPARE_REFERENCE_DOFS = 260000
 # ... and in 3D, where the reference is P2 (docs/theory.md, section 14.6): measured, 268 806
 # and 206 736 DOFs on paper-3d and hertz-3d, error bars 0.98 % and 1.47 % of the energy norm,
 # 117 s and 77 s; 10 x compare's 20 000 DOFs is what a P2 run would require
 COMPARE_REFERENCE_DOFS_3D = 300000
+
+
+def cached_reference_dofs(config: RunConfig) -> int | None:
+    """The budget of the references ``compare`` caches (``COMPARE_REFERENCE_DOFS``, or the 3D
+    one) when every scene of ``config`` without an exact solution has one cached there, so
+    that ``run`` measures the errors ``compare`` measures without being told the budget;
+    None when a scene has none (or no scene needs one)."""
+    budgets, specs = set(), config.specs()
+    for spec in {(s.scene, s.scene_parameters): s for s in specs}.values():
+        scene = build_scene(spec)
+        if scene.exact is not None:
+            continue
+        budget = compare_reference_dofs(None, scene.dim)
+        key = reference_key(scene, budget)
+        path = cache_folder(config.cache) / f"{key}.npz"
+        try:  # one that could not judge these runs is not taken
+            check_reference(load_reference(path, key), scene,
+                            max(s.max_dofs for s in specs if s.scene == spec.scene),
+                            max(s.order for s in specs if s.scene == spec.scene))
+        except (OSError, CorruptCache, TruthError):
+            return None
+        budgets.add(budget)
+    return budgets.pop() if len(budgets) == 1 else None
 
 
 def compare_reference_dofs(given: int | None, dim: int) -> int:
@@ -120,12 +150,15 @@ def check_before_running(config: RunConfig, specs: list[SequenceSpec]) -> dict:
 
 
 def run(config: RunConfig, on_level: Callable[[LevelResult], None] | None = None,
-        on_sequence: Callable[[SequenceSpec, str], None] | None = None) -> RunResult:
+        on_sequence: Callable[[SequenceSpec, str], None] | None = None,
+        on_timed: Callable[[SequenceSpec, int], None] | None = None) -> RunResult:
     """Run every sequence of ``config`` into ``config.out``: sequences/ (a partition per
     sequence), results.{parquet,csv}, run.json, truth.json, artifacts/ and rates.{csv,md}.
     Raises RunRefused, with the folder untouched, for a bad parameter, a starting mesh over
     the budgets or an untrustworthy reference. With ``overwrite`` the earlier results are
-    deleted only once a sequence of this run has finished, and kept if it fails before."""
+    deleted only once a sequence of this run has finished, and kept if it fails before. With
+    ``timing_repeats`` the candidates to be the cheapest are timed again (``bench.matrix.cost``,
+    ``on_timed`` after each) into timings.parquet."""
     specs = config.specs()
     truths = check_before_running(config, specs)
     store = ResultStore(config.out, overwrite=config.overwrite)
@@ -133,12 +166,18 @@ def run(config: RunConfig, on_level: Callable[[LevelResult], None] | None = None
         rows, reused = _run_into(store, config, specs, truths, on_level, on_sequence)
     except BaseException:  # a crash, Ctrl-C: the results moved aside come back
         store.restore_previous()
+        with suppress(Exception):  # the tables say what the partitions hold (best effort)
+            store.consolidate()
         raise
     store.keep_new()
     table = store.consolidate()
     write_rates(table, store.out)  # every sequence in the folder, earlier runs' too
     keys = {s.key for s in specs} | set(reused)
     table = table[table["sequence_key"].isin(keys)].reindex(columns=COLUMNS)
+    if config.timing_repeats:
+        write_timings(store.out, time_again(specs, table, truth_record(store.out),
+                                            config.timing_repeats, on_timed,
+                                            config.scene_files))
     return RunResult(rows, table.reset_index(drop=True), store, reused)
 
 

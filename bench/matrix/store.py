@@ -4,8 +4,9 @@ from them.
 
 Each sequence writes only its own partition, ``sequences/<sequence key>.parquet``, whole or not
 at all (``files.atomic_write``) after every finished level, so concurrent runs and Dask workers
-never write the same file and an ended process loses no finished level. ``consolidate`` (when
-a sequence ends) rewrites the two tables from all partitions under a file lock. Readers
+never write the same file and an ended process loses no finished level. ``consolidate`` (every
+CONSOLIDATE_SECONDS while a run lasts, as its sequences end, and at its end) rewrites the two
+tables from all partitions under a file lock. Readers
 (``read_results``: ``report``, ``diff``, ``compare``'s report) never write into a folder; the
 writer repairs what ``FolderState`` found when it opens the folder: a set-aside folder whose run
 has ended comes back, rows the tables hold and the partitions lost become partitions again, a
@@ -18,6 +19,7 @@ import hashlib
 import json
 import os
 import sys
+import time
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -33,6 +35,8 @@ from bench.matrix.files import (
 from bench.matrix.folder_state import MANIFEST, FolderState, read_partitions, table_of
 from bench.matrix.set_aside import SetAsideFolder, discard, discard_folder, restore_into
 from bench.sequence.rows import COLUMNS, FINISHED, ResultRow, with_labels
+
+CONSOLIDATE_SECONDS = 30.0  # how often a run refreshes its tables from the partitions
 
 
 class ResultsError(ValueError):
@@ -182,6 +186,7 @@ class ResultStore:
                 self.previous = SetAsideFolder.create(self.out)
                 self.partitions.mkdir(exist_ok=True)
         self.writers: dict[str, SequenceWriter] = {}
+        self.consolidated_at = time.monotonic()
 
     def repair(self) -> None:
         """Make the record hold every row the folder holds: set-aside folders whose run has
@@ -255,7 +260,11 @@ class ResultStore:
             self.writers[key].finish(end)
         if end in FINISHED:
             self.keep_new()
-        self.consolidate()
+        # the tables are derived from the partitions (which readers merge anyway): refreshed
+        # every CONSOLIDATE_SECONDS while a run lasts, and by its end, since each refresh
+        # reads every partition (quadratic in the run if done after each sequence)
+        if time.monotonic() - self.consolidated_at >= CONSOLIDATE_SECONDS:
+            self.consolidate()
 
     def table(self) -> pd.DataFrame:
         """All rows in the folder's partitions: earlier runs' and this run's (what the folder
@@ -269,6 +278,7 @@ class ResultStore:
                 return self.consolidate(locked=True)
         # partitions' checksums first: one that a worker replaces meanwhile then fails them,
         # and the tables are read from the partitions until the next consolidation
+        self.consolidated_at = time.monotonic()
         before = checksums(self.out, tables=False)
         table = self.table()
         atomic_write(table, self.parquet, "parquet")

@@ -9,15 +9,7 @@ from pathlib import Path
 import pandas as pd
 
 from bench.hard import check_expected
-from bench.report.norms import scene_norm
-from bench.report.verdict import (
-    MAIN_TARGET,
-    TimingNoise,
-    cheapest,
-    sharpest_text,
-    sig3,
-    timing_noise,
-)
+from bench.report.summary import scene_answers
 from bench.sequence.rows import with_labels
 from bench.verify import load_expected
 
@@ -28,25 +20,6 @@ def duration(seconds: float) -> str:
     """'7 min 12 s', '42.0 s'."""
     minutes, rest = divmod(float(seconds), 60.0)
     return f"{int(minutes)} min {rest:.0f} s" if minutes else f"{rest:.1f} s"
-
-
-def headline(scene: str, group: pd.DataFrame, norm: float | None,
-             noise: TimingNoise | None) -> str:
-    """The scene's cheapest combination to a relative error of 1e-2 (its ties counted) and its
-    sharpest estimator, as in the report's verdict box."""
-    target = MAIN_TARGET
-    best = cheapest(group, norm, target, noise) if norm else None
-    if best is None:
-        first = "no truth, errors not measured"
-    elif best["ranking"]:
-        top = best["ranking"][0]
-        first = (f"cheapest to {sig3(target)}: {top['combination']} {sig3(top['seconds'])} s"
-                 + (f" ({best['ties']} tied)" if best["ties"] else ""))
-    elif best["smallest"] is not None:
-        first = f"none reached {sig3(target)} (smallest {sig3(best['smallest'][0])})"
-    else:
-        first = "no error measured against a sharp enough truth"
-    return f"{scene}: {first}; sharpest {sharpest_text(group).split(',')[0]}"
 
 
 def hard_lines(hard: pd.DataFrame, room: int) -> list[str]:
@@ -64,9 +37,11 @@ def hard_lines(hard: pd.DataFrame, room: int) -> list[str]:
 
 
 def console_summary(readme: Path, table: pd.DataFrame, hard: pd.DataFrame | None = None,
-                    seconds: float | None = None, truth: dict | None = None) -> list[str]:
+                    seconds: float | None = None, truth: dict | None = None,
+                    results: Path | None = None) -> list[str]:
     """The last lines of ``compare`` (with its wall time) and ``report``; ``truth`` is the
-    results' truth.json (the scale of relative errors)."""
+    results' truth.json (the scale of relative errors), ``results`` the folder (its
+    timings)."""
     readme = Path(readme)
     lines = [f"report: {readme.parent / 'index.html'} (open in a browser), {readme}"]
     rows = with_labels(table)
@@ -74,9 +49,7 @@ def console_summary(readme: Path, table: pd.DataFrame, hard: pd.DataFrame | None
     if seconds is not None:
         lines.append(f"{len(table)} rows, {rows['sequence_key'].nunique()} sequences; "
                      f"wall time {duration(seconds)}")
-    noise = timing_noise(rows)
-    for scene, group in rows.groupby("scene", sort=True):
-        lines.append(headline(scene, group, scene_norm(scene, truth or {}), noise))
+    lines += [answer.sentence for answer in scene_answers(rows, truth or {}, results)]
     if hard is not None and len(hard):
         lines += hard_lines(hard, MAX_LINES - len(lines))
     return lines[:MAX_LINES]

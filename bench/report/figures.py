@@ -56,21 +56,26 @@ def cell_polygons(p: np.ndarray, t: np.ndarray) -> np.ndarray:
     return np.transpose(p[:2, t], (2, 1, 0))
 
 
+MESH_PANEL = 4.0  # inches: a final mesh is read at this size, not as a thumbnail
+
+
 def meshes(artifacts: dict):
     """Final adaptive mesh per formulation (the paper's Figure 1b): each cell coloured by its
     size h_T on one log scale for every panel, so that where the refinement went reads at a
     glance at any mesh size (edges of 10^4 cells would fill the panel)."""
-    # the residual estimator's mesh where it ran (the seed's), else the first estimator's
+    # one mesh per formulation (and cell): the residual estimator's where it ran (the seed's)
+    # at the lowest order, else the first estimator's
     chosen: dict = {}
-    for key, data in sorted(artifacts.items(), key=lambda kv: (kv[0][1] != "residual", kv[0])):
+    for key, data in sorted(artifacts.items(),
+                            key=lambda kv: (kv[0][1] != "residual", kv[0][3:], kv[0])):
         if key[2] == "adaptive":
-            chosen.setdefault((key[0], *key[3:]), (key, data))
+            chosen.setdefault((key[0], *key[4:]), (key, data))
     items = sorted(chosen.values(), key=lambda kv: kv[0])
     if not items:
         return None
     cols = min(4, len(items))
     rows = int(np.ceil(len(items) / cols))
-    fig = Figure(figsize=(3.2 * cols + 1.0, 3.2 * rows))
+    fig = Figure(figsize=(MESH_PANEL * cols + 1.0, MESH_PANEL * rows))
     axes = fig.subplots(rows, cols, squeeze=False)
     for ax in axes.ravel():
         ax.set_axis_off()

@@ -7,9 +7,9 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from bench.report.figures import marker
-from bench.report.norms import exact_energy_norm
-from bench.report.verdict import cheapest
+from bench.report.ranking import rank
 from bench.sequence.rows import phase_time
+from bench.truth.norms import exact_energy_norm
 from formulations import STATUS_OK
 
 TARGET = 1e-3  # relative energy-norm error
@@ -48,16 +48,16 @@ def order_work_precision(table: pd.DataFrame, norm: float | None = None):
 
 def first_to_target(rows: pd.DataFrame, norm: float) -> pd.DataFrame:
     """Per order and strategy, the sequence whose relative error first falls to TARGET in the
-    least cumulative wall time (``bench.report.verdict.cheapest``), with its DOFs; 'not
+    least cumulative wall time (``bench.report.ranking.rank``), with its DOFs; 'not
     reached' within the budget otherwise."""
     out = []
     for (order, strategy), group in rows.groupby(["order", "strategy"], sort=True):
-        ranking = cheapest(group, norm, TARGET, None)["ranking"]
+        ranking = rank(group, norm, TARGET, None).ranked
         best = ranking[0] if ranking else None
         out.append({"order": int(order), "strategy": strategy,
-                    "first to 1e-3": best["combination"] if best else "not reached",
-                    "ndofs": best["ndofs"] if best else "",
-                    "wall time [s]": f"{best['seconds']:.2f}" if best else "",
+                    "first to 1e-3": best.combination if best else "not reached",
+                    "ndofs": best.ndofs if best else "",
+                    "wall time [s]": f"{best.seconds:.2f}" if best else "",
                     "smallest relative error": f"{(group['energy_error'] / norm).min():.2e}"})
     return pd.DataFrame(out)
 

@@ -9,7 +9,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
-from matplotlib.ticker import LogLocator, NullFormatter
+from matplotlib.ticker import LogFormatterSciNotation, LogLocator, NullFormatter
 
 from bench.report.figures import _slope_triangle, marker
 from bench.sequence.rows import phase_time
@@ -27,10 +27,15 @@ def estimator_colour(estimator: str) -> str:
 
 
 def decades(ax, x: bool = True, y: bool = True) -> None:
-    """Label only the powers of ten of a log axis (no minor tick labels)."""
-    for on, axis in ((x, ax.xaxis), (y, ax.yaxis)):
+    """Label the powers of ten of a log axis (no minor tick labels); an axis spanning less
+    than two decades also labels 2 and 5 times them, so that it has more than one label."""
+    for on, axis, limits in ((x, ax.xaxis, ax.get_xlim()), (y, ax.yaxis, ax.get_ylim())):
         if on:
-            axis.set_major_locator(LogLocator(base=10.0, numticks=12))
+            low, high = sorted(limits)
+            narrow = low > 0 and high / low < 100
+            axis.set_major_locator(LogLocator(base=10.0, numticks=12,
+                                              subs=(1.0, 2.0, 5.0) if narrow else (1.0,)))
+            axis.set_major_formatter(LogFormatterSciNotation(labelOnlyBase=False))
             axis.set_minor_formatter(NullFormatter())
 
 
@@ -135,10 +140,44 @@ def effectivity(table: pd.DataFrame):
     return fig
 
 
+def formulation_colour(formulation: str) -> str:
+    names = formulation_names()
+    index = names.index(formulation) if formulation in names else len(names) + len(formulation)
+    return ESTIMATOR_COLOURS[index % len(ESTIMATOR_COLOURS)]
+
+
 def work_precision(table: pd.DataFrame):
-    """The error (eta without a truth) against the cumulative wall time of the sequence, per
-    formulation."""
+    """The error (eta without a truth) against the cumulative wall time of the sequence: one
+    panel per polynomial order, colour = formulation, marker = strategy (one line per
+    estimator); with one order, one panel per formulation, colour = estimator."""
     y = "energy_error" if table["energy_error"].gt(0).any() else "eta"
+    orders = sorted(table["order"].unique()) if "order" in table else [1]
+    if len(orders) < 2:
+        return _work_precision_by_formulation(table, y)
+    fig = Figure(figsize=(PANEL * len(orders) + 2.2, 3.2))
+    axes = fig.subplots(1, len(orders), squeeze=False, sharey=True)[0]
+    for ax, order in zip(axes, orders, strict=True):
+        mine = table[table["order"] == order]
+        for (formulation, _, strategy), group in mine.groupby(["formulation", "estimator",
+                                                                "strategy"]):
+            ok = group[group["status"] == STATUS_OK].sort_values("level")
+            ax.loglog(phase_time(ok).cumsum(), ok[y], color=formulation_colour(formulation),
+                      marker=marker(strategy), markersize=2.5, linewidth=0.8)
+        ax.set_title(f"P{order}", fontsize=10)
+        ax.set_xlabel("cumulative wall time [s]")
+        ax.grid(True, which="major", alpha=0.3)
+        decades(ax)
+    axes[0].set_ylabel("||u - u_h||" if y == "energy_error" else "eta (no truth)")
+    handles = [Line2D([], [], color=formulation_colour(f), label=f)
+               for f in sorted(table["formulation"].unique())]
+    handles += [Line2D([], [], color="0.3", marker=marker(s), linestyle="", label=s)
+                for s in sorted(table["strategy"].unique())]
+    fig.legend(handles=handles, loc="center right", fontsize=8, frameon=False)
+    fig.tight_layout(rect=(0, 0, 1 - 2.0 / fig.get_figwidth(), 1))
+    return fig
+
+
+def _work_precision_by_formulation(table: pd.DataFrame, y: str):
     fig, panels = panel_grid(table, height=3.0)
     for name, mine, ax in panels:
         for (estimator, strategy), group in mine.groupby(["estimator", "strategy"]):
@@ -149,6 +188,6 @@ def work_precision(table: pd.DataFrame):
         ax.set_xlabel("cumulative wall time [s]")
         ax.grid(True, which="major", alpha=0.3)
         decades(ax)
-    panels[0][2].set_ylabel(y)
+    panels[0][2].set_ylabel("||u - u_h||" if y == "energy_error" else "eta (no truth)")
     legend(fig, sorted(table["estimator"].unique()), sorted(table["strategy"].unique()))
     return fig

@@ -46,13 +46,13 @@ def rate_question(rates: pd.DataFrame) -> Question:
     if claimed.empty:
         return Question("Do the seed paper's rates hold?", "No claimed rate was measured.",
                         "rates", "rates")
-    kind = claimed["verdict"].map(lambda v: "too coarse" if v.startswith("too coarse")
-                                  else "agrees" if v == "agrees" else "disagrees")
+    kind = claimed["verdict"]
     counts = pd.crosstab([claimed["scene"], claimed["strategy"]], kind).reset_index()
-    judged = kind[kind != "too coarse"]
+    judged = kind[kind != "too coarse to judge"]
     answer = (f"{int((judged == 'agrees').sum())} of {len(judged)} judged slopes agree with "
-              f"the claimed one within the tolerance; {int((kind == 'too coarse').sum())} "
-              "sequences are too coarse to judge.")
+              "the claimed one (their 95 % interval meets it); "
+              f"{int((kind == 'too coarse to judge').sum())} are too coarse to judge (too few "
+              "or too coarse levels, or an interval wider than 0.1).")
     return Question("Do the seed paper's rates hold?", answer, "rates",
                     "rates: every slope beside its claim", counts)
 

@@ -29,6 +29,7 @@ from bench.report.tables import (
     effectivity_table,
     estimator_summary,
     failure_table,
+    rate_counts,
     rate_verdicts,
     timing_table,
 )
@@ -127,8 +128,8 @@ def write_report(table: pd.DataFrame, out: str | Path, results: str | Path | Non
         "pressure_tolerance": PRESSURE_TOLERANCE, "missing_columns": missing,
         "scenes": [scene_section(name, group, results, figs, truth)
                    for name, group in rows.groupby("scene", sort=True)],
-        "tables": tables,
-        "summary": first_screen(everything, rows, tables["rates"], truth),
+        "tables": tables, "rate_counts": rate_counts(tables["rates"]),
+        "summary": first_screen(everything, rows, tables["rates"], truth, results),
         "effectivity_from": EFFECTIVITY_FROM_DOFS,
         "questions": questions(tables, hard_verdicts(results), orders),
         "hard_verdicts": hard_verdicts(results),

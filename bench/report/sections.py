@@ -100,14 +100,18 @@ def field_figures(scene, name: str, artifacts: dict, preferred) -> tuple:
     return (
         (figures.meshes(artifacts), "meshes",
          "Final adaptive meshes per formulation, refined by the residual estimator where it "
-         "ran, each cell coloured by its size h_T (the paper's Figure 1b)."),
+         "ran at the lowest order run, each cell coloured by its size h_T (the paper's "
+         "Figure 1b)."),
         (figures.deformed(preferred, name), "deformed",
          "Deformed body coloured by von Mises stress; the colour scale is clipped at the "
-         f"{figures.VON_MISES_PERCENTILE:g}th percentile because the stress is singular at "
-         "the clamped corners (the paper's Figure 1a)."),
+         f"{figures.VON_MISES_PERCENTILE:g}th percentile so that a few peaks (where the "
+         "stress concentrates, e.g. at the paper scene's clamped corners) do not hide the "
+         "field (the paper's Figure 1a)."),
         (figures.pressures(artifacts, _pressure_curve(scene, artifacts)), "pressure",
          "Contact pressure lambda_h along Gamma_C (adaptive, last level) per formulation; "
-         "dotted lines are the contact-zone end points."),
+         "dotted lines are the contact-zone end points. The penalty's pressure "
+         "(u_hn - g_h)_+ / eps is a pointwise formula: its spikes at the peak and at the "
+         "zone's ends are the formulation's, not noise (Known limitations)."),
         (friction_figures.shear_traction(artifacts, _shear_curve(scene, artifacts)), "shear",
          "Shear traction sigma_t,h along Gamma_C (adaptive, last level) per formulation, "
          "dotted: the friction bound; below, where each friction point sticks, slips or is "
@@ -156,8 +160,9 @@ def scene_section(name: str, group: pd.DataFrame, results: Path | None, figs: Fi
              "Effectivity index eta / ||u - u_h|| per formulation, colour = estimator, marker = "
              "strategy; crosses mark rows whose reference is too coarse."),
             (panels.work_precision(group), "work-precision",
-             "Work-precision per formulation: the error (eta without a truth) against the "
-             "cumulative wall time of the sequence."),
+             "Work-precision: the error (eta without a truth) against the cumulative wall time "
+             "of each sequence (as the matrix timed it), one panel per polynomial order, "
+             "colour = formulation, marker = strategy, one line per estimator."),
             *(field_figures(scene, name, artifacts, preferred) if scene is None
               or scene.dim == 2 else field_figures_3d(artifacts, scene))):
         item = figs.add(figure, file_stem(name, suffix), caption)

@@ -1,19 +1,16 @@
-"""The report's first screen: the verdict box per scene (``bench.report.verdict``), the
-verdicts on the seed paper's claimed rates, and any failure or flag."""
+"""The report's first screen: one recommendation per scene (``bench.report.verdict``), then its
+evidence table, the verdicts on the seed paper's claimed rates, and any failure or flag."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pandas as pd
 
-from bench.report.norms import scene_norm
-from bench.report.verdict import (
-    cheapest,
-    noise_text,
-    shown_targets,
-    sig3,
-    timing_noise,
-    verdict_row,
-)
+from bench.matrix.cost import read_timings
+from bench.report.ranking import sig3, spread_text
+from bench.report.verdict import SceneAnswer, evidence_row, scene_answer
+from bench.truth.norms import scene_norm
 from formulations import STATUS_FAILED
 
 
@@ -27,7 +24,7 @@ def claim_verdicts(rates: pd.DataFrame, scene: str) -> str:
     coarse = mine["verdict"].str.startswith("too coarse")
     judged = mine[~coarse]
     agree = int((judged["verdict"] == "agrees").sum())
-    text = f"{agree} of {len(judged)} slopes agree"
+    text = f"{agree} of {len(judged)} judged slopes agree"
     return text + (f" ({int(coarse.sum())} too coarse to judge)" if coarse.any() else "")
 
 
@@ -41,23 +38,27 @@ def flags(everything: pd.DataFrame) -> str:
     return ", ".join(p for p in parts if p) or "none"
 
 
+def scene_answers(rows: pd.DataFrame, truth: dict, results: Path | None) -> list[SceneAnswer]:
+    """Every scene's answer, its cost from the results folder's timings when there are any."""
+    timings = read_timings(results)
+    return [scene_answer(str(scene), group, scene_norm(str(scene), truth), timings)
+            for scene, group in rows.groupby("scene", sort=True)]
+
+
 def first_screen(everything: pd.DataFrame, rows: pd.DataFrame, rates: pd.DataFrame,
-                 truth: dict) -> dict:
-    """The verdict box (one row per scene, ``bench.report.verdict``), the timing noise its ties
-    use, and per scene the cheapest combinations to each relative error (the detail)."""
-    noise = timing_noise(rows)
-    norms = {scene: scene_norm(scene, truth) for scene in rows["scene"].unique()}
-    targets = shown_targets(rows, norms)
+                 truth: dict, results: Path | None = None) -> dict:
+    """The recommendations, the evidence table (one row per scene), how cost was measured,
+    and per scene the five cheapest combinations to each relative error (the detail)."""
+    answers = scene_answers(rows, truth, results)
     table, detail = [], []
-    for scene, group in rows.groupby("scene", sort=True):
-        norm = norms[scene]
-        table.append({**verdict_row(scene, group, norm, noise, targets),
-                      "seed paper's rates": claim_verdicts(rates, scene),
-                      "failures and flags": flags(everything[everything["scene"] == scene])})
-        for target in targets if norm else ():
-            ranking = pd.DataFrame(cheapest(group, norm, target, noise)["ranking"][:5])
-            if len(ranking):
-                ranking["seconds"] = ranking["seconds"].map(sig3)
-            detail.append({"scene": scene, "target": sig3(target), "norm": sig3(norm),
-                           "ranking": ranking})
-    return {"table": pd.DataFrame(table), "detail": detail, "noise": noise_text(noise)}
+    for answer in answers:
+        table.append({**evidence_row(answer),
+                      "seed paper's rates": claim_verdicts(rates, answer.scene),
+                      "failures and flags":
+                      flags(everything[everything["scene"] == answer.scene])})
+        for ranking in answer.rankings:
+            if ranking.ranked:
+                detail.append({"scene": answer.scene, "target": sig3(ranking.target),
+                               "norm": sig3(answer.norm), "ranking": ranking.frame()})
+    return {"sentences": [a.sentence for a in answers], "table": pd.DataFrame(table),
+            "detail": detail, "noise": spread_text(read_timings(results))}

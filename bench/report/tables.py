@@ -8,6 +8,7 @@ import numpy as np
 import pandas as pd
 
 from bench.matrix.rates import judged_levels
+from bench.measure.slope import SlopeFit
 from bench.report.verdict import EFFECTIVITY_FROM_DOFS
 from bench.sequence.rows import KEYS, LABELS, phase_time
 from bench.verify import claims
@@ -15,12 +16,15 @@ from estimators import guaranteed_estimators
 from estimators.base import BoundTerms
 from formulations import STATUS_OK
 
-CLAIM_TOLERANCE = 0.1  # |measured - claimed| slope within which we say "agrees"
+CLAIM_TOLERANCE = 0.05  # "about" a claimed slope: a verdict agrees if its interval meets this band
+MAX_INTERVAL = 0.1  # a 95 % interval wider than this is too coarse to judge
 # a slope is a verdict only from this many levels whose last has at least this many DOFs:
 # fewer, coarser levels are pre-asymptotic (a 3-level fit under 600 DOFs says nothing)
 MIN_FIT_LEVELS = 4
 MIN_VERDICT_DOFS = 2000
 TIME_SHIFT = 1.0  # s, shift of the shifted geometric mean of times
+VERDICTS = ("agrees", "steeper than claimed", "shallower than claimed", "error grows",
+            "too coarse to judge", "not measured")
 
 
 def _fmt(value, spec=".3g") -> str:
@@ -30,42 +34,50 @@ def _fmt(value, spec=".3g") -> str:
         else str(value)
 
 
-def _verdict(measured: float, claimed: float, levels: int = MIN_FIT_LEVELS,
-             ndofs: int = MIN_VERDICT_DOFS, pressure_rate: float = np.nan) -> str:
-    """The measured slope against the claimed one; no verdict from too few or too coarse
-    levels; a growing error never agrees (nor a row whose pressure error grows)."""
-    if not np.isfinite(measured):
+def rate_verdict(fit: SlopeFit, claimed: float, levels: int = MIN_FIT_LEVELS,
+                 ndofs: int = MIN_VERDICT_DOFS) -> str:
+    """One of VERDICTS for a fitted slope and its 95 % interval against the claimed slope:
+    "agrees" only where the interval meets claimed +- CLAIM_TOLERANCE, "too coarse to judge"
+    from too few or too coarse levels or an interval wider than MAX_INTERVAL, "error grows"
+    where the whole interval is above 0."""
+    if not np.isfinite(fit.slope):
         return "not measured"
-    if levels < MIN_FIT_LEVELS or ndofs < MIN_VERDICT_DOFS:
-        return f"too coarse to judge ({levels} levels to {ndofs} DOFs)"
-    if measured >= 0:
+    if levels < MIN_FIT_LEVELS or ndofs < MIN_VERDICT_DOFS or not fit.width <= MAX_INTERVAL:
+        return "too coarse to judge"
+    if fit.low > 0:
         return "error grows"
-    if abs(measured - claimed) <= CLAIM_TOLERANCE:
-        verdict = "agrees"
-    else:
-        verdict = "steeper than claimed" if measured < claimed else "shallower than claimed"
-    if np.isfinite(pressure_rate) and pressure_rate > 0:
-        verdict += f", but the pressure error grows (slope {pressure_rate:+.2f})"
-    return verdict
+    if fit.meets(claimed - CLAIM_TOLERANCE, claimed + CLAIM_TOLERANCE):
+        return "agrees"
+    return "steeper than claimed" if fit.high < claimed else "shallower than claimed"
+
+
+def _fit(r: pd.Series, name: str) -> SlopeFit:
+    return SlopeFit(r[name], np.nan, r.get(f"{name}_low", np.nan),
+                    r.get(f"{name}_high", np.nan), int(r.get("fit_levels", 0)))
 
 
 def rate_verdicts(rates: pd.DataFrame) -> pd.DataFrame:
-    """Measured slopes beside the claimed ones (``[[claim]]`` in expected.toml)."""
+    """Measured slopes with their 95 % intervals beside the claimed ones (``[[claim]]`` in
+    expected.toml), one verdict each (``rate_verdict``) from the error's slope (eta's where
+    no error was measured)."""
     rows, claimed_slopes = [], claims()
     for _, r in rates.iterrows():
         claimed, source = claimed_slopes.get((r["scene"], r["strategy"], int(r.get("order", 1))),
                                              (np.nan, "no claim"))
-        measured = r["error_rate"] if np.isfinite(r["error_rate"]) else r["eta_rate"]
+        fit = _fit(r, "error_rate" if np.isfinite(r["error_rate"]) else "eta_rate")
+        pressure = r.get("pressure_error_rate", np.nan)
         rows.append({"scene": r["scene"], "formulation": r["formulation"],
                      "estimator": r["estimator"], "strategy": r["strategy"],
                      "order": int(r.get("order", 1)), **{c: r.get(c, "") for c in LABELS},
-                     "error rate": _fmt(r["error_rate"]), "eta rate": _fmt(r["eta_rate"]),
-                     "pressure error rate": _fmt(r["pressure_error_rate"]),
+                     "error rate [95 % interval]": _fit(r, "error_rate").text(),
+                     "eta rate [95 % interval]": _fit(r, "eta_rate").text(),
+                     "pressure error rate": _fmt(pressure),
                      "claimed": _fmt(claimed), "source": source,
-                     "verdict": _verdict(measured, claimed, int(r.get("fit_levels", 0)),
-                                         int(r.get("ndofs_last", 0)),
-                                         r.get("pressure_error_rate", np.nan))
-                     if np.isfinite(claimed) else ""})
+                     "verdict": rate_verdict(fit, claimed, int(r.get("fit_levels", 0)),
+                                             int(r.get("ndofs_last", 0)))
+                     if np.isfinite(claimed) else "",
+                     "note": "the pressure error grows" if np.isfinite(pressure)
+                     and pressure > 0 else ""})
     return without_empty_labels(pd.DataFrame(rows))
 
 
@@ -213,6 +225,26 @@ def agreement_table(rows: pd.DataFrame) -> pd.DataFrame:
 
 
 def failure_table(everything: pd.DataFrame) -> pd.DataFrame:
+    """Every row not ok, identical ones (same status and reason) in one line with their count
+    and the first combinations."""
     bad = everything[everything["status"].fillna("missing") != STATUS_OK]
-    cols = [*KEYS, "level", "status", "reason"]
-    return without_empty_labels(bad[cols].astype(str)) if len(bad) else pd.DataFrame()
+    if bad.empty:
+        return pd.DataFrame()
+    bad = bad.assign(reason=bad["reason"].fillna("").astype(str),
+                     combination=bad[KEYS[:5]].astype(str).agg("/".join, axis=1))
+    out = []
+    for (status, reason), group in bad.groupby(["status", "reason"], sort=True):
+        names = list(dict.fromkeys(group["combination"]))
+        shown = ", ".join(names[:3]) + (f" and {len(names) - 3} more" if len(names) > 3 else "")
+        out.append({"status": status, "rows": len(group), "reason": reason,
+                    "combinations": shown})
+    return pd.DataFrame(out).sort_values("rows", ascending=False)
+
+
+def rate_counts(rates: pd.DataFrame) -> str:
+    """'Verdicts: 20 agree, 3 steeper than claimed, ...' over the slopes with a claim."""
+    if rates.empty or "verdict" not in rates:
+        return ""
+    counts = rates.loc[rates["verdict"] != "", "verdict"].value_counts()
+    return ("Verdicts: " + ", ".join(f"{n} {v}" for v, n in counts.items()) + ".") \
+        if len(counts) else ""

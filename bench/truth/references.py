@@ -173,7 +173,8 @@ class TruthError(ValueError):
 
 class LevelProgress:
     """Progress of a long sequence on standard error: one line rewritten in place on a
-    terminal, one line per level otherwise (level, DOFs, elapsed seconds)."""
+    terminal (level, DOFs, elapsed seconds), nothing otherwise (its caller says when it
+    starts and ends)."""
 
     def __init__(self, title: str, max_dofs: int, stream=None):
         self.stream = sys.stderr if stream is None else stream
@@ -181,9 +182,10 @@ class LevelProgress:
         self.title, self.max_dofs, self.start = title, max_dofs, time.perf_counter()
 
     def __call__(self, level: int, ndofs: int) -> None:
-        line = (f"[{self.title}] level {level:2d}: {ndofs:9d} DOFs (budget {self.max_dofs}), "
-                f"{time.perf_counter() - self.start:6.1f} s elapsed")
-        self.stream.write(f"\r{line} " if self.live else f"{line}\n")
+        if not self.live:
+            return
+        self.stream.write(f"\r[{self.title}] level {level:2d}: {ndofs:9d} DOFs (budget "
+                          f"{self.max_dofs}), {time.perf_counter() - self.start:6.1f} s elapsed ")
         self.stream.flush()
 
     def close(self) -> None:

@@ -62,6 +62,17 @@ def gate_names(expected: dict, quick: bool = False) -> list[str]:
     return sorted({g["name"] for g in expected["gate"] if not (quick and g.get("full"))})
 
 
+def gate_passes(row: pd.Series, quantity: str, low: float, high: float) -> bool:
+    """A value in [low, high]; a slope with a 95 % interval (``quantity_low``,
+    ``quantity_high``: the rates table) passes where its interval meets [low, high], the
+    report's reading of the same slope (docs/report.md, "Slopes and their intervals")."""
+    value = float(row[quantity])
+    if f"{quantity}_low" in row and np.isfinite(row[f"{quantity}_low"]):
+        return bool(np.isfinite(value) and row[f"{quantity}_low"] <= high
+                    and row[f"{quantity}_high"] >= low)
+    return bool(low <= value <= high)
+
+
 def check_gates(expected: dict, tables: list[pd.DataFrame], quick: bool = False,
                 only_present: bool = False) -> list[Verdict]:
     """Every gate against the first of ``tables`` with a column of its quantity
@@ -83,7 +94,7 @@ def check_gates(expected: dict, tables: list[pd.DataFrame], quick: bool = False,
             label = row["label"] if "label" in row else "/".join(
                 str(row[k]) for k in KEYS if k in row and str(row[k]))
             verdicts.append(Verdict(gate["name"], label, value, low, high,
-                                    bool(low <= value <= high), source))
+                                    gate_passes(row, gate["quantity"], low, high), source))
     return verdicts
 
 

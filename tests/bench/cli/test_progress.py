@@ -1,32 +1,35 @@
-"""The live progress line: counts, DOFs and times on a terminal; silent otherwise."""
+"""What a run prints as it goes (bench.cli.progress): at most PROGRESS_LINES lines for a whole
+matrix when not on a terminal, none with quiet, a bar on a terminal."""
 
 import io
 from types import SimpleNamespace
 
-from bench.cli.progress import Progress
+from bench.cli.progress import PROGRESS_LINES, Progress
 
 
 class Terminal(io.StringIO):
-    def isatty(self):
+    def isatty(self) -> bool:
         return True
 
 
-def test_progress_line_counts_sequences_and_dofs_on_a_terminal():
-    stream, printed = Terminal(), []
-    progress = Progress(3, stream)
-    on_level = progress.level(printed.append)
-    on_level(SimpleNamespace(row=SimpleNamespace(ndofs=544)))
-    progress.sequence(None, "budget")
-    on_level(SimpleNamespace(row=SimpleNamespace(ndofs=2112)))
-    progress.close()
-    text = stream.getvalue()
-    assert "1/3 sequences done, 2 left, max 2112 DOFs" in text and "to go" in text
-    assert len(printed) == 2 and text.endswith("\n")
-
-
-def test_progress_is_quiet_when_not_a_terminal():
+def test_a_long_matrix_prints_at_most_ten_lines_off_a_terminal():
     stream = io.StringIO()
-    progress = Progress(2, stream)
-    progress.sequence(None, "budget")
-    progress.close()
+    live = Progress(224, stream=stream, what="matrix")
+    for _ in range(224):
+        live.sequence(SimpleNamespace(scene="paper"))
+    live.close()
+    lines = stream.getvalue().splitlines()
+    assert len(lines) <= PROGRESS_LINES and lines[-1].startswith("[matrix] 224 of 224 done")
+
+
+def test_quiet_prints_nothing_and_a_terminal_gets_a_bar():
+    stream = io.StringIO()
+    live = Progress(5, stream=stream, quiet=True)
+    for _ in range(5):
+        live.sequence(SimpleNamespace(scene="paper"))
     assert stream.getvalue() == ""
+    terminal = Terminal()
+    bar = Progress(5, stream=terminal, what="matrix")
+    bar.sequence(SimpleNamespace(scene="hertz"))
+    bar.close()
+    assert "matrix: 1/5" in terminal.getvalue() and "hertz" in terminal.getvalue()

@@ -154,22 +154,26 @@ def test_html_renders_in_headless_chromium(report, tmp_path):
 
 LAYOUT_PROBE = """<script>
 window.addEventListener('load', () => {
-  const summary = document.getElementById('summary').getBoundingClientRect();
+  const advice = document.querySelector('#summary ul.recommendations').getBoundingClientRect();
   const cut = [...document.querySelectorAll('table')].filter(
     t => !t.parentElement.classList.contains('table-scroll')
          && t.scrollWidth > t.parentElement.clientWidth).length;
   document.body.setAttribute('data-layout', JSON.stringify({
-    summaryTop: summary.top, summaryBottom: summary.bottom, viewport: window.innerHeight,
-    cut: cut, headers: [...document.querySelectorAll('#summary th')].map(t => t.textContent),
-    pageOverflow: document.documentElement.scrollWidth - window.innerWidth,
-    rows: document.querySelectorAll('#summary tbody tr').length}));
+    adviceTop: advice.top, adviceBottom: advice.bottom, viewport: window.innerHeight,
+    cut: cut, height: document.documentElement.scrollHeight,
+    sentences: [...document.querySelectorAll('#summary ul.recommendations li')].map(
+      li => li.textContent),
+    headers: [...document.querySelectorAll('#summary th')].map(t => t.textContent),
+    pageOverflow: document.documentElement.scrollWidth - window.innerWidth}));
 });
 </script>"""
+SCREEN = (1400, 900)  # the window the first screen is measured in
+MAX_SCREENS = 15  # the page's height, folded details closed
 
 
 @pytest.mark.skipif(CHROMIUM is None, reason="Debian's chromium is not installed "
                                              "(.ci/run installs it)")
-def test_first_screen_shows_the_verdict_box_and_no_table_overflows(report, tmp_path):
+def test_first_screen_holds_every_recommendation_and_no_table_overflows(report, tmp_path):
     import json
     import re
 
@@ -178,19 +182,19 @@ def test_first_screen_shows_the_verdict_box_and_no_table_overflows(report, tmp_p
                                                                  LAYOUT_PROBE + "</body>"))
     browser = [CHROMIUM, "--headless", "--no-sandbox", "--disable-gpu", "--no-first-run",
                "--disable-background-networking", "--disable-component-update",
-               f"--user-data-dir={tmp_path / 'profile'}", "--window-size=1280,900",
-               "--virtual-time-budget=10000"]
+               f"--user-data-dir={tmp_path / 'profile'}",
+               f"--window-size={SCREEN[0]},{SCREEN[1]}", "--virtual-time-budget=10000"]
     dom = subprocess.run([*browser, "--dump-dom", probe.as_uri()], capture_output=True,
                          text=True, timeout=120).stdout
     layout = json.loads(re.search(r"data-layout=\"([^\"]*)\"", dom).group(1)
                         .replace("&quot;", '"'))
-    # the verdict box, whole, on the first screen of a 1280 x 900 window
-    assert 0 <= layout["summaryTop"] and layout["summaryBottom"] <= layout["viewport"]
-    assert layout["rows"] == 2  # one row per scene
-    assert any(h.startswith("sharpest estimator") for h in layout["headers"])
-    assert any(h.startswith("guaranteed bound") for h in layout["headers"])
-    assert any(h.startswith("cheapest to relative error 0.01") for h in layout["headers"])
+    # one recommendation per scene, whole, on the first screen
+    assert 0 <= layout["adviceTop"] and layout["adviceBottom"] <= layout["viewport"]
+    assert [s.split(":")[0] for s in layout["sentences"]] == ["free-boundary", "paper"]
+    assert any(h.startswith("cheapest to 0.01") for h in layout["headers"])
+    assert any(h.startswith("stop on") for h in layout["headers"])
     assert layout["cut"] == 0 and layout["pageOverflow"] <= 0  # wide tables scroll in a box
+    assert layout["height"] <= MAX_SCREENS * SCREEN[1]
     shot = tmp_path / "first-screen.png"
     subprocess.run([*browser, f"--screenshot={shot}", (report / "index.html").as_uri()],
                    capture_output=True, timeout=120)

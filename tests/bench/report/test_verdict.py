@@ -1,30 +1,31 @@
-"""The verdict box, worked by hand on small tables: the cheapest combinations to a relative
-error and their ties, the timing noise measured from identical work, the sharpest estimator and
-the guaranteed one's range."""
+"""The recommendation and its evidence, worked by hand on small tables: the cheapest
+combinations to a relative error, their ties from the repeated timings, the bound to stop on
+and what the heuristic estimators cost."""
 
 import numpy as np
 import pandas as pd
-import pytest
 
+from bench.report.ranking import rank, spread_text
 from bench.report.verdict import (
-    TimingNoise,
-    cheapest,
-    guaranteed_text,
-    sharpest_text,
-    timing_noise,
+    estimator_records,
+    heuristic_text,
+    recommendation,
+    stop_on,
+    stop_text,
 )
 from bench.sequence.rows import COLUMNS, PHASE_TIMES
 
 
 def sequence(formulation, errors, seconds_per_level, estimator="residual",
-             strategy="adaptive", effectivity=None):
+             strategy="adaptive", effectivity=None, order=1):
     rows = []
+    key = f"{formulation}-{estimator}-{strategy}-{order}"
     for level, error in enumerate(errors):
         row = {c: np.nan for c in COLUMNS} | dict(
             scene="s", formulation=formulation, solver="active-set", estimator=estimator,
-            strategy=strategy, order=1, cell="tri", level=level, ndofs=1000 * 2**level,
+            strategy=strategy, order=order, cell="tri", level=level, ndofs=1000 * 2**level,
             status="ok", energy_error=error, eta=2 * error, scene_parameters="",
-            formulation_options="", reference_too_coarse=False,
+            formulation_options="", reference_too_coarse=False, sequence_key=key,
             effectivity_index=(effectivity or [2.0] * len(errors))[level])
         row.update({phase: 0.0 for phase in PHASE_TIMES})
         row[PHASE_TIMES[0]] = seconds_per_level
@@ -32,58 +33,86 @@ def sequence(formulation, errors, seconds_per_level, estimator="residual",
     return rows
 
 
-def test_the_cheapest_first_reaches_the_relative_error_and_near_times_tie():
-    table = pd.DataFrame(sequence("fast", [1.0, 0.1, 0.01], 1.0)
-                         + sequence("slow", [1.0, 0.5, 0.02], 0.5)
-                         + sequence("close", [1.0, 0.05], 1.6))
+def timings(samples: dict) -> pd.DataFrame:
+    """Repeated samples: {(key, level): [seconds, ...]}."""
+    return pd.DataFrame([{"sequence_key": key, "level": level, "sample": k + 1, "seconds": s}
+                         for (key, level), values in samples.items()
+                         for k, s in enumerate(values)])
+
+
+def three() -> pd.DataFrame:
     # with ||u|| = 10 the target 1e-2 is an error of 0.1: "slow" reaches it at level 2 after
     # 3 x 0.5 = 1.5 s, "fast" at level 1 after 2 x 1 = 2 s, "close" at level 1 after 3.2 s
-    best = cheapest(pd.DataFrame(table), 10.0, 1e-2, None)
-    assert [(r["combination"], r["seconds"]) for r in best["ranking"]] == [
-        ("slow/active-set/residual/adaptive P1", 1.5),
-        ("fast/active-set/residual/adaptive P1", 2.0),
-        ("close/active-set/residual/adaptive P1", 3.2)]
-    assert best["ties"] == 0 and best["compared"] == 3
-    # a noise of 0.1 s + 40 % around 1.5 s is 0.7 s: 2.0 s ties, 3.2 s does not
-    assert cheapest(table, 10.0, 1e-2, TimingNoise(0.1, 0.4, 1))["ties"] == 1
+    return pd.DataFrame(sequence("fast", [1.0, 0.1, 0.01], 1.0)
+                        + sequence("slow", [1.0, 0.5, 0.02], 0.5)
+                        + sequence("close", [1.0, 0.05], 1.6))
+
+
+def test_without_repeats_the_single_times_rank_and_nothing_ties():
+    ranking = rank(three(), 10.0, 1e-2, None)
+    assert [(r.combination, r.seconds, r.samples) for r in ranking.ranked] == [
+        ("slow/active-set/residual/adaptive P1", 1.5, 1),
+        ("fast/active-set/residual/adaptive P1", 2.0, 1),
+        ("close/active-set/residual/adaptive P1", 3.2, 1)]
+    assert ranking.ties == 0 and ranking.compared == 3
+    assert "measured once" in spread_text(None)
+
+
+def test_repeats_rank_by_their_best_and_ties_fall_within_the_two_best():
+    samples = timings({("slow-residual-adaptive-1", 2): [1.9, 2.0, 2.6],
+                       ("fast-residual-adaptive-1", 1): [1.8, 1.95, 2.1],
+                       ("close-residual-adaptive-1", 1): [2.2, 3.0, 3.1]})
+    ranking = rank(three(), 10.0, 1e-2, samples)
+    # best 1.8 (fast), 1.9 (slow), 2.2 (close); fast's two best are 1.8 and 1.95: slow's
+    # best 1.9 lies within (a tie), close's 2.2 does not
+    assert [r.combination.split("/")[0] for r in ranking.ranked] == ["fast", "slow", "close"]
+    assert (ranking.ranked[0].seconds, ranking.ranked[0].high) == (1.8, 1.95)
+    assert ranking.ties == 1
+    # second best over best: 0.15 / 1.8 = 8.3 %, 0.1 / 1.9 = 5.3 %, 0.8 / 2.2 = 36 %
+    assert "8.3 % above the best in the median (36 % at most)" in spread_text(samples)
+
+
+def test_a_combination_timed_once_ranks_after_the_timed_ones_and_never_ties():
+    samples = timings({("fast-residual-adaptive-1", 1): [1.8, 1.9, 2.0]})
+    ranking = rank(three(), 10.0, 1e-2, samples)
+    # slow's single 1.5 s (the matrix's) is not comparable with repeated samples
+    assert [r.combination.split("/")[0] for r in ranking.ranked] == ["fast", "slow", "close"]
+    assert ranking.ties == 0 and ranking.ranked[1].samples == 1
 
 
 def test_a_row_whose_reference_is_too_coarse_reaches_nothing():
     table = pd.DataFrame(sequence("a", [1.0, 0.01], 1.0))
     table.loc[1, "reference_too_coarse"] = True
-    assert cheapest(table, 1.0, 1e-1, None)["ranking"] == []
+    assert rank(table, 1.0, 1e-1, None).ranked == ()
 
 
-def test_timing_noise_is_the_spread_of_identical_uniform_work():
-    # two estimators on the same uniform sequence: level times 0.05/0.06 s (short) and then
-    # 1.0/1.2 s, cumulative 0.05/0.06 and 1.05/1.26
-    table = pd.DataFrame(sequence("vi", [1.0, 0.5], 0.05, "residual", "uniform")
-                         + sequence("vi", [1.0, 0.5], 0.06, "averaging", "uniform"))
-    table.loc[[1, 3], PHASE_TIMES[0]] = [1.0, 1.2]
-    noise = timing_noise(table)
-    assert noise.samples == 2
-    assert noise.absolute == pytest.approx(0.01, rel=1e-9)  # 0.06 - 0.05 (one short level)
-    assert noise.relative == pytest.approx(0.21 / 1.05, rel=1e-9)  # (1.26 - 1.05) / 1.05
-    alone = pd.DataFrame(sequence("vi", [1.0, 0.5], 0.05, "residual", "uniform"))
-    assert timing_noise(alone) is None  # no twin: nothing measured
+def test_the_bound_to_stop_on_is_the_sharpest_that_never_fell_below():
+    table = pd.DataFrame(
+        sequence("vi", [1.0, 0.5, 0.2], 1.0, "averaging", effectivity=[0.9, 1.1, 0.95])
+        + sequence("vi", [1.0, 0.5, 0.2], 1.0, "residual", effectivity=[3.0, 3.5, 4.0])
+        + sequence("vi", [1.0, 0.5, 0.2], 1.0, "equilibrated", effectivity=[1.2, 1.3, 1.4])
+        + sequence("mixed", [1.0, 0.5, 0.2], 1.0, "equilibrated-local",
+                   effectivity=[1.1, 1.15, 1.2]))
+    records = estimator_records(table)
+    assert stop_on(records).name == "equilibrated-local"  # median 1.15 < 1.3
+    assert stop_text(records) == "equilibrated-local 1.1..1.2, never below the error"
+    assert heuristic_text(records) == ("averaging: below on 2 of 3 levels, up to 1.1 x the "
+                                       "error; residual: below on 0 of 3 levels, up to 4 x "
+                                       "the error")
+    table.loc[(table["estimator"] == "equilibrated-local") & (table["level"] == 2),
+              "effectivity_index"] = 0.99
+    assert stop_on(estimator_records(table)).name == "equilibrated"
 
 
-def test_the_sharpest_estimator_is_the_one_nearest_one_and_counts_its_misses():
-    table = pd.DataFrame(sequence("vi", [1.0, 0.5, 0.2], 1.0, "averaging",
-                                  effectivity=[0.9, 1.1, 0.95])
-                         + sequence("vi", [1.0, 0.5, 0.2], 1.0, "residual",
-                                    effectivity=[3.0, 3.5, 4.0]))
-    assert sharpest_text(table) == ("averaging: 0.9..1.1, below the error on 2 of 3 levels "
-                                    "(67 %)")
-
-
-def test_the_guaranteed_range_names_the_combination_at_each_end():
-    table = pd.DataFrame(sequence("vi", [1.0, 0.5], 1.0, "equilibrated",
-                                  effectivity=[1.4, 1.2])
-                         + sequence("mixed", [1.0, 0.5], 1.0, "equilibrated", "uniform",
-                                    effectivity=[2.5, 1.9]))
-    assert guaranteed_text(table) == (
-        "equilibrated: 1.2 (vi/active-set/adaptive P1, 2000 DOFs) .. "
-        "2.5 (mixed/active-set/uniform P1, 1000 DOFs)")
-    table.loc[1, "effectivity_index"] = 0.99
-    assert guaranteed_text(table).endswith("BELOW 1: the bound failed")
+def test_the_recommendation_names_the_cheapest_to_the_finest_target_reached():
+    table = pd.DataFrame(sequence("vi", [1.0, 0.09, 0.009], 1.0, order=3)
+                         + sequence("mixed", [1.0, 0.5, 0.08], 0.2, order=2)
+                         + sequence("vi", [1.0, 0.5, 0.2, 0.1], 1.0, "equilibrated",
+                                    effectivity=[1.2, 1.3, 1.4, 1.5]))
+    rankings = [rank(table, 10.0, t, None) for t in (1e-2, 1e-3)]
+    # 1e-2 (error 0.1): mixed P2 after 0.6 s, vi P3 after 2 s; 1e-3 (0.01): vi P3 only
+    assert rankings[0].ranked[0].combination.startswith("mixed")
+    sentence = recommendation("s", rankings, estimator_records(table))
+    assert sentence == ("s: use vi adaptive P3 steered by residual: 0.01 in 2 s (2000 DOFs), "
+                        "0.001 in 3 s (4000 DOFs); stop on equilibrated (effectivity 1.2..1.5, "
+                        "never below the error).")
