@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -128,17 +128,28 @@ def dense_block_size(discretisation: Discretisation, solver: str, backend: str |
 def solve(discretisation: Discretisation, solver: str, **options) -> DiscreteSolution:
     """Solve with the named solver, compute the residuals (KKT for a QP, the nonlinear
     residual for a system) from the returned arrays, and give the final status. A failed
-    solve carries status ``failed`` and NaN arrays (never silently)."""
+    solve carries status ``failed`` and NaN arrays (never silently). A semismooth system whose
+    Newton iteration fails is solved as the formulation's QP where it has one (the same
+    problem; that method has its own safeguards, the reference solver last)."""
     why = why_unsolvable(discretisation, solver)
     if why is not None:
         raise ValueError(why)
     system = discretisation.system if uses_system(discretisation, solver) else None
-    if system is not None:
-        answer = SYSTEM_SOLVERS.get(solver)(system, **options)
-        n, m = system.n, system.nq
-    else:
+    answer = SYSTEM_SOLVERS.get(solver)(system, **options) if system is not None else None
+    if answer is not None and answer.status == STATUS_FAILED \
+            and discretisation.qp is not None and solver in SOLVERS.names():
+        failed, system = answer, None
+        answer = SOLVERS.get(solver)(discretisation.qp, **{
+            k: v for k, v in options.items() if k != "warm_start"})  # a system's start
+        answer = replace(answer, reason="; ".join(filter(None, (
+            f"semismooth Newton failed ({failed.reason}); answered by {solver} on the "
+            "formulation's QP (safeguard)", answer.reason))), diagnostics=replace(
+            answer.diagnostics, safeguard=", then ".join(filter(None, (
+                "the QP method", answer.diagnostics.safeguard)))))
+    elif answer is None:
         answer = SOLVERS.get(solver)(discretisation.qp, **options)
-        n, m = discretisation.qp.n, discretisation.qp.m
+    n, m = (system.n, system.nq) if system is not None else (discretisation.qp.n,
+                                                            discretisation.qp.m)
     if answer.u is None or answer.multipliers is None:
         answer = QPSolution(np.full(n, np.nan), np.full(m, np.nan), answer.status or
                             STATUS_FAILED, answer.reason, answer.iterations, answer.solve_time,

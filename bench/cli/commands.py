@@ -81,7 +81,8 @@ def run_config(config: RunConfig | None, compare: bool = False, quiet: bool = Fa
     def timed(spec, total: int) -> None:  # the candidates to be the cheapest, timed again
         if not timing:
             live.close()
-            timing.append(Progress(total, quiet=quiet, what="timing the cheapest again"))
+            timing.append(Progress(total, quiet=quiet, what="timing the cheapest again",
+                                   lines=3))
         timing[0].sequence(spec)
 
     try:

@@ -20,11 +20,13 @@ PROGRESS_LINES = 10  # lines a whole matrix prints when standard error is not a 
 
 
 class Progress:
-    """Sequences done of ``total``: a bar on a terminal, a line at every tenth elsewhere."""
+    """Sequences done of ``total``: a bar on a terminal, elsewhere a line each time another
+    1/``lines`` of them is done."""
 
-    def __init__(self, total: int, stream=None, quiet: bool = False, what: str = "sequences"):
+    def __init__(self, total: int, stream=None, quiet: bool = False, what: str = "sequences",
+                 lines: int = PROGRESS_LINES):
         self.stream = sys.stderr if stream is None else stream
-        self.quiet, self.what = quiet, what
+        self.quiet, self.what, self.lines = quiet, what, lines
         self.total, self.done, self.shown = total, 0, 0
         self.start = time.perf_counter()
         self.bar = None
@@ -48,8 +50,8 @@ class Progress:
             self.bar.set_postfix_str(str(spec.scene), refresh=False)
             self.bar.update(1)
         elif not self.quiet and self.total and (
-                self.done * PROGRESS_LINES // self.total > self.shown or self.done == self.total):
-            self.shown = self.done * PROGRESS_LINES // self.total
+                self.done * self.lines // self.total > self.shown or self.done == self.total):
+            self.shown = self.done * self.lines // self.total
             elapsed = time.perf_counter() - self.start
             left = elapsed / self.done * (self.total - self.done)
             print(f"[{self.what}] {self.done} of {self.total} done, {duration(elapsed)} "

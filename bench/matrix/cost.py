@@ -4,8 +4,8 @@ timed again for the candidates to be the cheapest so that each has several sampl
 
 A single sub-second timing is noisier than the differences between the combinations it ranks,
 so after the matrix the sequences whose first time to a target is within CANDIDATE_FACTOR of
-the fastest (at most MAX_CANDIDATES of them) are run ``repeats`` more times, one after the
-other in one fresh single-threaded process (the matrix may have run them beside other
+the fastest (at most MAX_CANDIDATES of them) are run ``repeats`` more times (twice if one
+takes LONG_SAMPLE seconds or more), one after the other in one fresh single-threaded process (the matrix may have run them beside other
 workers), without errors or cross-checks (only what a user's run does: assemble, solve,
 estimate, refine), up to that level. Their cost is the best of these samples (interference
 only ever adds time), and two combinations tie when the best of one is within the other's two
@@ -39,8 +39,9 @@ from formulations import STATUS_OK
 
 # relative energy-norm errors the combinations are ranked to
 RELATIVE_TARGETS = (1e-2, 1e-3)
-CANDIDATE_FACTOR = 1.5  # a sequence is timed again when within this factor of the fastest
-MAX_CANDIDATES = 5  # per scene and target
+CANDIDATE_FACTOR = 1.3  # a sequence is timed again when within this factor of the fastest
+MAX_CANDIDATES = 3  # per scene and target
+LONG_SAMPLE = 2.0  # seconds: a candidate this long gets two samples, not ``repeats``
 TIMINGS = "timings.parquet"  # in the results folder: one row per candidate, level and sample
 
 
@@ -148,13 +149,16 @@ def time_again(specs: list[SequenceSpec], table: pd.DataFrame, truth: dict, repe
     after each of the ``total`` candidates."""
     by_key = {spec.key: spec for spec in specs}
     last: dict[str, int] = {}
+    seconds: dict[str, float] = {}
     for r in candidates(table, truth):
         if r.sequence_key in by_key:
             last[r.sequence_key] = max(r.level, last.get(r.sequence_key, 0))
+            seconds[r.sequence_key] = max(r.seconds, seconds.get(r.sequence_key, 0.0))
     samples = []
     with timing_process(scene_files) as pool:
         for key, level in last.items():
-            samples.append(pool.submit(sample_rows, by_key[key], level, repeats).result())
+            times = min(repeats, 2) if seconds[key] >= LONG_SAMPLE else repeats
+            samples.append(pool.submit(sample_rows, by_key[key], level, times).result())
             if on_sequence is not None:
                 on_sequence(by_key[key], len(last))
     return pd.concat(samples, ignore_index=True) if samples else pd.DataFrame(

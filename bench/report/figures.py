@@ -46,8 +46,10 @@ def _slope_triangle(ax, x0: float, y0: float, slope: float, text: str):
     x1 = x0 * 10
     y1 = y0 * 10**slope
     ax.loglog([x0, x1, x1, x0], [y0, y0, y1, y0], color="k", linewidth=0.7)
+    # on a white box above the data, so that no line crosses the label
     ax.annotate(text, (x1, np.sqrt(y0 * y1)), fontsize=7, xytext=(3, 0),
-                textcoords="offset points")
+                textcoords="offset points", zorder=5,
+                bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.85})
 
 
 def cell_polygons(p: np.ndarray, t: np.ndarray) -> np.ndarray:

@@ -15,6 +15,8 @@ from bench.report import figures, figures_3d, friction_figures, panels
 from bench.sequence.rows import KEYS
 from scenes import get_scene
 
+FIGURE_DPI = 100  # the page holds every figure inline: 1400 px wide at most, under 5 MB in all
+
 
 class Figures:
     """Saves each figure as PNG under ``out/figures`` and keeps its base64 for the HTML."""
@@ -28,7 +30,7 @@ class Figures:
         if figure is None:
             return None
         buffer = io.BytesIO()
-        figure.savefig(buffer, format="png", dpi=110)
+        figure.savefig(buffer, format="png", dpi=FIGURE_DPI)
         data = buffer.getvalue()
         atomic_bytes(data, self.out / f"{name}.png")
         item = {"file": f"figures/{name}.png", "caption": caption,
