@@ -5,12 +5,12 @@ timed again for the candidates to be the cheapest so that each has several sampl
 A single sub-second timing is noisier than the differences between the combinations it ranks,
 so after the matrix the sequences whose first time to a target is within CANDIDATE_FACTOR of
 the fastest (at most MAX_CANDIDATES of them) are run ``repeats`` more times (twice if one
-takes LONG_SAMPLE seconds or more), one after the other in one fresh single-threaded process (the matrix may have run them beside other
-workers), without errors or cross-checks (only what a user's run does: assemble, solve,
-estimate, refine), up to that level. Their cost is the best of these samples (interference
-only ever adds time), and two combinations tie when the best of one is within the other's two
-best (``bench.report.ranking``); the samples' spread is the measured run-to-run noise that
-the report states."""
+takes LONG_SAMPLE seconds or more), one after the other in one fresh single-threaded process
+(the matrix may have run them beside other workers), without errors or cross-checks (only what
+a user's run does: assemble, solve, estimate, refine), up to that level. Their cost is the
+best of these samples (interference only ever adds time), and two combinations tie when the
+best of one is within the other's two best (``bench.report.ranking``); the samples' spread is
+the measured run-to-run noise that the report states."""
 
 from __future__ import annotations
 
