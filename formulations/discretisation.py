@@ -125,6 +125,27 @@ def dense_block_size(discretisation: Discretisation, solver: str, backend: str |
     return 0 if size is None or problem is None else int(size(problem, backend))
 
 
+def qp_safeguard(discretisation: Discretisation, solver: str, options: dict,
+                 failed: QPSolution) -> tuple[QPSolution, SemismoothSystem | None]:
+    """The formulation's QP solved by ``solver`` after its semismooth Newton iteration
+    ``failed``: (the answer, None); where that method fails too (an indefinite K, say), the
+    Newton failure with both reasons, and the system (the row is about the system)."""
+    try:
+        answer = SOLVERS.get(solver)(discretisation.qp, **{
+            k: v for k, v in options.items() if k != "warm_start"})  # a system's start
+    except Exception as error:  # noqa: BLE001 - said in the reason, the row stays failed
+        return replace(failed, reason=f"{failed.reason}; the QP method failed too: "
+                       f"{type(error).__name__}: {error}"), discretisation.system
+    if answer.status == STATUS_FAILED:
+        return replace(failed, reason=f"{failed.reason}; the QP method failed too: "
+                       f"{answer.reason}"), discretisation.system
+    return replace(answer, reason="; ".join(filter(None, (
+        f"semismooth Newton failed ({failed.reason}); answered by {solver} on the "
+        "formulation's QP (safeguard)", answer.reason))), diagnostics=replace(
+        answer.diagnostics, safeguard=", then ".join(filter(None, (
+            "the QP method", answer.diagnostics.safeguard))))), None
+
+
 def solve(discretisation: Discretisation, solver: str, **options) -> DiscreteSolution:
     """Solve with the named solver, compute the residuals (KKT for a QP, the nonlinear
     residual for a system) from the returned arrays, and give the final status. A failed
@@ -138,14 +159,7 @@ def solve(discretisation: Discretisation, solver: str, **options) -> DiscreteSol
     answer = SYSTEM_SOLVERS.get(solver)(system, **options) if system is not None else None
     if answer is not None and answer.status == STATUS_FAILED \
             and discretisation.qp is not None and solver in SOLVERS.names():
-        failed, system = answer, None
-        answer = SOLVERS.get(solver)(discretisation.qp, **{
-            k: v for k, v in options.items() if k != "warm_start"})  # a system's start
-        answer = replace(answer, reason="; ".join(filter(None, (
-            f"semismooth Newton failed ({failed.reason}); answered by {solver} on the "
-            "formulation's QP (safeguard)", answer.reason))), diagnostics=replace(
-            answer.diagnostics, safeguard=", then ".join(filter(None, (
-                "the QP method", answer.diagnostics.safeguard)))))
+        answer, system = qp_safeguard(discretisation, solver, options, answer)
     elif answer is None:
         answer = SOLVERS.get(solver)(discretisation.qp, **options)
     n, m = (system.n, system.nq) if system is not None else (discretisation.qp.n,

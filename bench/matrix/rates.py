@@ -1,8 +1,9 @@
 """The rates table: convergence slopes and effectivity per combination.
 
-The slope of log(y) against log(ndofs) is fitted by least squares (``np.polyfit``) over the last
-``RATE_LEVELS`` ok levels that have y > 0 (earlier levels are pre-asymptotic: on the paper scene
-nothing touches on the first two). In 2D, O(h^1/2) is slope -1/4 and O(h) is slope -1/2.
+The slope of log(y) against log(ndofs) is fitted by least squares (``bench.measure.slope``,
+with its 95 % interval: columns ``*_rate_low`` and ``*_rate_high``) over the last
+``RATE_LEVELS`` ok levels that have y > 0 (earlier levels are pre-asymptotic: on the paper
+scene nothing touches on the first two). In 2D, O(h^1/2) is slope -1/4 and O(h) is slope -1/2.
 Effectivity statistics use the same levels and skip rows whose reference is too coarse;
 ``effectivity_all_min`` is the minimum over every level (for a guaranteed bound).
 ``target_dofs_ratio`` prices ``--target-error`` against an oracle that knew the true error: for

@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from bench.measure.slope import fit_slope
 from bench.sequence.rows import KEYS, with_labels
 from formulations import STATUS_OK
 from scenes import get_scene
@@ -49,14 +50,8 @@ def fitted_slope(ndofs, values, levels: int = FIT_LEVELS) -> tuple[float, float]
     (NaN with fewer than 3 points: a line through two points has no spread)."""
     ndofs, values = np.asarray(ndofs, float), np.asarray(values, float)
     keep = values > 0
-    x, y = np.log(ndofs[keep])[-levels:], np.log(values[keep])[-levels:]
-    if x.size < 2:
-        return float("nan"), float("nan")
-    if x.size < 3:
-        return float(np.polyfit(x, y, 1)[0]), float("nan")
-    coefficients, residuals = np.polyfit(x, y, 1, full=True)[:2]
-    spread = float(residuals[0]) / (x.size - 2) if residuals.size else 0.0
-    return float(coefficients[0]), float(np.sqrt(spread / ((x - x.mean()) ** 2).sum()))
+    fit = fit_slope(ndofs[keep][-levels:], values[keep][-levels:])  # the suite's one fit
+    return fit.slope, fit.stderr if np.isfinite(fit.stderr) else float("nan")
 
 
 def predictions(scenes, orders=(1,)) -> pd.DataFrame:

@@ -10,6 +10,7 @@ import pandas as pd
 from matplotlib.collections import PolyCollection
 from matplotlib.figure import Figure
 
+from bench.measure.slope import fit_slope
 from bench.report.figures import VON_MISES_PERCENTILE, _slope_triangle
 from bench.sequence.marking import mark
 from estimators.quad_residual import QuadStress, quad_residual_estimate
@@ -89,7 +90,7 @@ def estimated_error(table: pd.DataFrame, scene_name: str = "paper",
             good = group[np.isfinite(group[column]) & (group[column] > 0)]
             if len(good) < 2:
                 continue
-            slope = np.polyfit(np.log(good["ndofs"]), np.log(good[column]), 1)[0]
+            slope = fit_slope(good["ndofs"], good[column]).slope
             ax.loglog(good["ndofs"], good[column], style, markersize=3, alpha=alpha,
                       label=f"{name}, {strategy} (slope {slope:.2f})")
     if not rows.empty:

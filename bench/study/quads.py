@@ -20,6 +20,7 @@ from bench.measure.discretisation_error import energy_density
 from bench.measure.fields import GradientField
 from bench.measure.nonnested import energy_difference
 from bench.measure.quad_fields import quad_gradient_field
+from bench.measure.slope import fit_slope
 from bench.sequence.marking import mark
 from estimators.quad_residual import quad_residual_estimate
 from formulations.cells import family_for
@@ -156,19 +157,19 @@ def hex_sequence(scene_name: str, max_dofs: int) -> list[QuadRow]:
 
 def slopes(table: pd.DataFrame, column: str, last: int = 4) -> pd.DataFrame:
     """Per sequence, the slope of log(column) against log(ndofs) over its last ``last``
-    levels (np.polyfit), and over all levels."""
+    levels, and over all levels (``bench.measure.slope``)."""
     out = []
     keys = ["scene", "method", "order", "strategy"]
     for key, group in table.groupby(keys, sort=False):
         group = group[np.isfinite(group[column]) & (group[column] > 0)]
         if len(group) < 3:
             continue
-        x, y = np.log(group["ndofs"].to_numpy(float)), np.log(group[column].to_numpy(float))
+        x, y = group["ndofs"].to_numpy(float), group[column].to_numpy(float)
         tail = slice(-min(last, len(group)), None)
         out.append(dict(zip(keys, key, strict=True), levels=len(group),
                         dofs=f"{group['ndofs'].iloc[0]}..{group['ndofs'].iloc[-1]}",
-                        slope_all=np.polyfit(x, y, 1)[0],
-                        slope_last=np.polyfit(x[tail], y[tail], 1)[0]))
+                        slope_all=fit_slope(x, y).slope,
+                        slope_last=fit_slope(x[tail], y[tail]).slope))
     return pd.DataFrame(out)
 
 
@@ -234,7 +235,7 @@ def write_quad_report(table: pd.DataFrame, folder, command: str = "",
                          suffixes=("_error", "_eta"))
     text = ["# Quadrilaterals: the seed's own discretisation", "",
             f"`{command}`" if command else "", "",
-            "Slopes of the energy error and of eta against the DOFs N (np.polyfit over all "
+            "Slopes of the energy error and of eta against the DOFs N (least squares over all "
             "levels and over the last four); N^(-1/4) is the seed's \"nearly O(h^1/2)\", "
             "N^(-1/2) is O(h).", "",
             merged.to_markdown(index=False, floatfmt=".3f"), "",
@@ -272,7 +273,7 @@ def write_hex_report(table: pd.DataFrame, folder, command: str = "") -> str:
     folder.mkdir(parents=True, exist_ok=True)
     table.to_csv(folder / "hexes.csv", index=False)
     text = ["# Hexahedra: Q1, uniform", "", f"`{command}`" if command else "", "",
-            "Slopes of the energy error against the DOFs N (np.polyfit); O(h) is N^(-1/3) in "
+            "Slopes of the energy error against the DOFs N (least squares); O(h) is N^(-1/3) in "
             "3D.", "", slopes(table, "energy_error").to_markdown(index=False, floatfmt=".3f"),
             "", table.dropna(axis=1, how="all").to_markdown(index=False, floatfmt=".4g"), ""]
     (folder / "hexes.md").write_text("\n".join(text))

@@ -18,6 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from bench.measure.slope import fit_slope
+
 RATE_LEVELS = 4  # differences fitted for the rate
 MIN_RATE, MAX_RATE = 0.25, 2.5  # N^-1/4 (a uniform P1 rate near a crack) .. N^-5/2
 
@@ -40,8 +42,8 @@ def fitted_rate(ndofs, differences) -> float:
     d = np.asarray(differences, dtype=float)[-RATE_LEVELS:]
     if d.size < 2:
         return 0.5
-    slope = np.polyfit(np.log(n), np.log(d), 1)[0]
-    return float(np.clip(-slope, MIN_RATE, MAX_RATE))
+    slope = fit_slope(n, d).slope  # the suite's one slope fit
+    return float(np.clip(-slope, MIN_RATE, MAX_RATE)) if np.isfinite(slope) else 0.5
 
 
 def error_bar(ndofs, differences) -> ErrorBar:

@@ -7,6 +7,7 @@ import pytest
 
 from bench.matrix.task import why_skipped
 from bench.measure.discretisation_error import exact_errors
+from bench.measure.slope import fit_slope
 from formulations import get_formulation, solve
 from formulations.contact import contact_trace
 from formulations.contact_surface import triangle_rule
@@ -106,7 +107,7 @@ def test_uniform_p1_converges_against_the_exact_3d_solution(formulation):
         sol = solve(get_formulation(formulation)(scene, scene.mesh.refined(k)), "active-set")
         n.append(sol.elasticity.ndofs)
         errors.append(exact_errors(scene, sol).energy_error)
-    slope = np.polyfit(np.log(n), np.log(errors), 1)[0]
+    slope = fit_slope(n, errors).slope
     assert slope < -0.15
 
 

@@ -6,6 +6,7 @@ import pandas as pd
 import pytest
 
 from bench.hard import check_expected
+from bench.measure.slope import fit_slope
 from bench.verify import load_expected
 from formulations import formulation_names, get_formulation, solve
 from formulations.registry import FORMULATIONS
@@ -144,7 +145,7 @@ def test_extreme_penalty_fast_solver_stays_exact_and_penetration_scales(penalty_
     # penetration = eps lambda, lambda converges: linear in eps_0 (measured 1.050e-3 ..
     # 1.060e-14, max|u| = 0.15)
     pen = np.array([_penetration(s) for s in fast])
-    slope = np.polyfit(np.log(EPSILONS), np.log(pen), 1)[0]
+    slope = fit_slope(EPSILONS, pen).slope
     assert slope == pytest.approx(1.0, abs=0.01)
     # the limit eps_0 -> 0 is the nodal VI (u_hn <= g_h at two Gauss points per facet means
     # at both end points): measured |E - E_vi| / E_vi = 1.4e-7 at 1e-6, 1.4e-13 at 1e-12

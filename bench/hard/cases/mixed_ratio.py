@@ -4,12 +4,12 @@ oscillation under refinement (docs/theory.md, section 8)."""
 from __future__ import annotations
 
 import matplotlib.ticker
-import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
 from bench.hard.registry import case_figure, hard_case
 from bench.hard.verdicts import solve_both
+from bench.measure.slope import fit_slope
 from formulations.solvers.registry import FAST_SOLVER
 from scenes import get_scene
 
@@ -28,7 +28,7 @@ def mixed_ratio() -> list[dict]:
     for ratio in (1.0, 0.5, 0.25):
         part = frame[(frame["variant"] == f"h/H={ratio:g}") & (frame["solver"] == FAST_SOLVER)]
         # h ~ ndofs^(-1/2): the slope of log beta against log h
-        slope = -2 * np.polyfit(np.log(part["ndofs"]), np.log(part["inf_sup"]), 1)[0]
+        slope = -2 * fit_slope(part["ndofs"], part["inf_sup"]).slope
         text = (f"beta_h {part['inf_sup'].iloc[0]:.3g} -> {part['inf_sup'].iloc[-1]:.3g} "
                 f"(~ h^{slope:.2f}); oscillation {part['pressure_oscillation'].iloc[-1]:.2f}")
         for record in records:

@@ -5,6 +5,7 @@ import pytest
 
 from bench.hard import check_expected, hard_case_names, hard_markdown, run_hard
 from bench.hard.registry import case_seconds
+from bench.measure.slope import fit_slope
 from bench.verify import load_expected
 from formulations import formulation_names, get_formulation
 from formulations.solvers.backends import condenses
@@ -109,7 +110,7 @@ def test_h_over_H_one_loses_inf_sup_stability(hard):
     fast = rows(hard, "mixed-h/H", solver="active-set")
 
     def slope_in_h(part):  # h ~ ndofs^(-1/2)
-        return -2 * np.polyfit(np.log(part["ndofs"]), np.log(part["inf_sup"]), 1)[0]
+        return -2 * fit_slope(part["ndofs"], part["inf_sup"]).slope
 
     half, quarter, one = (fast[fast["variant"] == f"h/H={r}"] for r in ("0.5", "0.25", "1"))
     # h/H <= 1/2 (the paper's choice): bounded below, measured 0.557 -> 0.529 and 0.761 -> 0.66
@@ -144,7 +145,7 @@ def test_penalty_penetration_and_conditioning_scale_like_eps(hard):
     eps = np.array([float(v.split("=")[1]) for v in fast["variant"]])
     usable = eps >= 1e-10  # at 1e-12 the penetration is round-off (1.05e-14, see the finding)
     # penetration = eps lambda with lambda converged: slope 1 (measured 1.00)
-    slope = np.polyfit(np.log(eps[usable]), np.log(fast["penetration"][usable]), 1)[0]
+    slope = fit_slope(eps[usable], fast["penetration"][usable]).slope
     assert slope == pytest.approx(1.0, abs=0.02)
     # conditioning: the condensed S_AA (pardiso, cholmod) has the penalty's D^-1 ~ eps_0 beside O(1)
     # entries, so cond ~ 1/eps_0 (measured 218 at 1e-1 to 2.1e13 at 1e-12: slope -1); the
@@ -153,7 +154,7 @@ def test_penalty_penetration_and_conditioning_scale_like_eps(hard):
     # at 1e-10: slope -2)
     condensed = fast["backend"].map(condenses).all()
     fit = usable if condensed else usable & (eps <= 1e-4)
-    slope = np.polyfit(np.log(eps[fit]), np.log(fast["condition_estimate"][fit]), 1)[0]
+    slope = fit_slope(eps[fit], fast["condition_estimate"][fit]).slope
     assert slope == pytest.approx(-1.0 if condensed else -2.0, abs=0.05)
 
 
