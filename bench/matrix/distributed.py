@@ -138,11 +138,16 @@ def client_for(config):
 
     if config.scheduler:
         return Client(config.scheduler, timeout=SCHEDULER_TIMEOUT), None
-    with interrupt_ignored():  # the workers inherit it: the driver alone answers Ctrl-C
-        cluster = LocalCluster(n_workers=config.workers, threads_per_worker=1,
-                               processes=True, env=SINGLE_THREAD, dashboard_address=":0",
-                               silence_logs=logging.ERROR)
-    client = Client(cluster)
+    try:
+        with interrupt_ignored():  # the workers inherit it: the driver alone answers Ctrl-C
+            cluster = LocalCluster(n_workers=config.workers, threads_per_worker=1,
+                                   processes=True, env=SINGLE_THREAD, dashboard_address=":0",
+                                   silence_logs=logging.ERROR)
+        client = Client(cluster)
+    except BaseException:  # a signal while the cluster starts: its half-started tasks'
+        # errors would print as tracebacks when collected; the run ends in one line instead
+        logging.getLogger("asyncio").setLevel(logging.CRITICAL)
+        raise
     print(f"Dask dashboard: {client.dashboard_link}", flush=True)
     return client, cluster
 
