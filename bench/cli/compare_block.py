@@ -12,6 +12,7 @@ from bench.hard import check_expected
 from bench.matrix.cost import read_timings
 from bench.matrix.store import read_results
 from bench.perf.scaling import replace_in_readme
+from bench.report.console import sequences_text
 from bench.report.ranking import spread_text
 from bench.report.render import read_json
 from bench.report.summary import scene_answers
@@ -26,10 +27,9 @@ def compare_block(table: pd.DataFrame, hard: pd.DataFrame | None, seconds: float
     recommendation per scene and the measured timing spread when ``results`` is given."""
     statuses = table["status"].value_counts()
     by_status = ", ".join(f"{statuses[s]} {s}" for s in sorted(statuses.index))
-    sequences = table["sequence_key"].nunique()
     text = (f"Last `python -m bench compare` on this machine ({platform.machine()}, Python "
             f"{platform.python_version()}): **{len(table)} result rows** ({by_status}) in "
-            f"{sequences} sequences")
+            f"{sequences_text(table)}")
     if hard is not None:
         checks = check_expected(hard, load_expected().get("hard", []))
         passed = sum(c["passed"] for c in checks)

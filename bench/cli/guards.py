@@ -64,7 +64,7 @@ def check_compare_out(out: str | Path, overwrite: bool) -> None:
     folder = Path(out)
     if overwrite or not folder.is_dir() or written_by(folder, "compare"):
         return
-    if any(p.name != ".lock" for p in folder.iterdir()):
+    if any(p.name not in (".lock", "report") for p in folder.iterdir()):  # report: its own
         raise InputError(f"--out={str(out)!r} holds files that compare did not write (it "
                          "replaces the results of its folder); give a new or empty folder, "
                          "or --overwrite to replace them")

@@ -22,6 +22,16 @@ def duration(seconds: float) -> str:
     return f"{int(minutes)} min {rest:.0f} s" if minutes else f"{rest:.1f} s"
 
 
+def sequences_text(table: pd.DataFrame) -> str:
+    """'192 sequences (140 run, 52 combinations skipped)': every sequence of the table, and
+    how many were whole-sequence rows that say why a combination cannot run."""
+    every = table["sequence_key"].nunique()
+    skipped = table.loc[(table["level"] < 0) & (table["status"] == "skipped"),
+                        "sequence_key"].nunique()
+    return (f"{every} sequences ({every - skipped} run, {skipped} combinations skipped)"
+            if skipped else f"{every} sequences")
+
+
 def hard_lines(hard: pd.DataFrame, room: int) -> list[str]:
     """The verdicts as counts, then the unexpected rows (as many as ``room`` allows)."""
     counts = ", ".join(f"{n} {v}" for v, n in hard["verdict"].value_counts().items())
@@ -47,8 +57,8 @@ def console_summary(readme: Path, table: pd.DataFrame, hard: pd.DataFrame | None
     rows = with_labels(table)
     rows = rows[rows["level"] >= 0]
     if seconds is not None:
-        lines.append(f"{len(table)} rows, {rows['sequence_key'].nunique()} sequences; "
-                     f"wall time {duration(seconds)}")
+        lines.append(f"{len(table)} rows in {sequences_text(table)}; wall time "
+                     f"{duration(seconds)}")
     lines += [answer.sentence for answer in scene_answers(rows, truth or {}, results)]
     if hard is not None and len(hard):
         lines += hard_lines(hard, MAX_LINES - len(lines))
