@@ -84,7 +84,8 @@ COMPARE_HELPS = {
                        f"{COMPARE_REFERENCE_DOFS_3D} for the P2 references in 3D"),
     "cells": "cell shape(s), comma-separated: tri, quad; the whole comparison runs on each"}
 COMPARE_OPTIONS = ("max_dofs", "cells", "reference_dofs", "max_memory_gib", "backend", "workers",
-                   "scheduler", "cache", "scene_files", "crosscheck_dofs", "out", "overwrite")
+                   "scheduler", "cache", "scene_files", "crosscheck_dofs", "timing_repeats", "out",
+                   "overwrite")
 
 
 def _cell_option(parser, each: str) -> None:
