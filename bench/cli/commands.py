@@ -24,8 +24,9 @@ from bench.cli.guards import (
 )
 from bench.cli.listing import list_command
 from bench.cli.parser import build_parser, with_negative_values
-from bench.cli.progress import Progress, progress, summary
+from bench.cli.progress import progress
 from bench.cli.run_files import overwrite_of, run_file_defaults
+from bench.cli.running import command_line, configured, run_config, save_config
 from bench.cli.scaling_commands import scaling_command
 from bench.cli.signals import ended_line, ending_signals, exit_status
 from bench.cli.study import study_command
@@ -37,12 +38,10 @@ from bench.hard import (
     run_hard,
     write_hard,
 )
-from bench.matrix import RunConfig, run
+from bench.matrix import RunConfig
 from bench.matrix.config_files import (
     COMPARE_KEYS,
-    RunFileError,
     compare_settings,
-    save_run_file,
 )
 from bench.matrix.files import FULL
 from bench.matrix.plugins import load_plugins
@@ -58,62 +57,6 @@ from estimators import estimator_names
 from formulations import formulation_names
 from scenes import get_scene, scene_names
 from scenes.registry import SCENES, scene_dim
-
-
-def configured(**fields) -> RunConfig | None:
-    """The run's configuration, or None after printing why it is refused."""
-    try:
-        return RunConfig(**fields)
-    except ValueError as error:
-        print(f"error: {error}", file=sys.stderr)
-        return None
-
-
-def run_config(config: RunConfig | None, compare: bool = False, quiet: bool = False) -> int:
-    """Run ``config``: a progress bar on a terminal; ``run`` prints a line per level and a
-    table per sequence, ``compare`` (``compare``) only its progress (and nothing with
-    ``quiet``), then prints its own summary."""
-    if config is None:
-        return 2
-    live = Progress(len(config.specs()), quiet=quiet, what="matrix")
-    timing: list[Progress] = []
-
-    def timed(spec, total: int) -> None:  # the candidates to be the cheapest, timed again
-        if not timing:
-            live.close()
-            timing.append(Progress(total, quiet=quiet, what="timing the cheapest again",
-                                   lines=3))
-        timing[0].sequence(spec)
-
-    try:
-        result = run(config, on_level=live.level(lambda r: None if compare else progress(r)),
-                     on_sequence=live.sequence, on_timed=timed)
-    finally:
-        for bar in [live, *timing]:
-            bar.close()
-    say = (lambda *a: None) if quiet else print
-    if result.reused:
-        say(f"reused {len(result.reused)} sequences finished by an earlier run in "
-            f"{result.store.out}")
-    if not compare:
-        print(f"wrote {result.store.out / 'rates.md'}")
-        print("\n" + summary(result.table) + "\n")
-    say(f"wrote {len(result.rows)} rows to {result.store.parquet} and {result.store.csv}")
-    return 1 if result.failed else 0
-
-
-def command_line(args) -> str:
-    return " ".join(["python -m bench", *args.argv])
-
-
-def save_config(config: RunConfig | None, args) -> None:
-    """``--save-config FILE``: the run's full configuration as a run file."""
-    if config is not None and getattr(args, "save_config", None):
-        try:
-            written = save_run_file(config, args.save_config, command_line(args))
-        except RunFileError as error:
-            raise InputError(str(error)) from None
-        print(f"wrote {written}")
 
 
 def run_command(args) -> int:

@@ -76,7 +76,9 @@ def test_an_empty_output_folder_is_refused(tmp_path, monkeypatch, capsys, comman
         RunConfig(out="")
 
 
-def test_a_run_without_truth_says_why_errors_are_not_measured(tmp_path, capsys):
+def test_a_run_without_truth_says_why_errors_are_not_measured(tmp_path, capsys, monkeypatch):
+    # an empty cache: one that holds compare's references would be taken (and say so)
+    monkeypatch.setenv("SIGNORINI_BENCH_CACHE", str(tmp_path / "cache"))
     assert main(["run", "--solver", "active-set", "--max-dofs", "200",
                  "--out", str(tmp_path)]) == 0
     err = capsys.readouterr().err
