@@ -15,7 +15,8 @@ from bench.matrix.files import FULL, atomic_text
 from bench.sequence.options import SECTIONS, option_fields
 
 COMPARE_SETTINGS = Path(__file__).with_name("compare.toml")
-COMPARE_SETTINGS_3D = Path(__file__).with_name("compare-3d.toml")
+# the default comparison of each dimension (``compare --dim``)
+COMPARE_SETTINGS_BY_DIM = {2: COMPARE_SETTINGS, 3: COMPARE_SETTINGS.with_name("compare-3d.toml")}
 COMPARE_KEYS = ("dim", "reports", "readme")  # compare's own keys beside run's
 PART_KEYS = ("part", "parts")  # a run file's [[part]] tables; run.json's "parts"
 SECTION_TITLES = {"what": "what runs", "how": "how each sequence runs",
@@ -112,9 +113,8 @@ def read_toml(path: str | Path, what: str) -> dict:
 def compare_settings(path: str | Path | None = None, dim: int = 2) -> dict:
     """The settings of ``compare`` (fields, plus ``dim``, ``reports`` and ``readme``): the
     package's for ``dim`` unless ``path``."""
-    if path is None:
-        path = COMPARE_SETTINGS_3D if dim == 3 else COMPARE_SETTINGS
-    return read_run_file(path, extra=COMPARE_KEYS)
+    return read_run_file(COMPARE_SETTINGS_BY_DIM[dim] if path is None else path,
+                         extra=COMPARE_KEYS)
 
 
 def run_file_text(config: RunConfig, command: str = "") -> str:

@@ -35,7 +35,6 @@ class Ranked:
     and the second best (``high``; the best again for a single sample)."""
 
     combination: str
-    estimator: str
     ndofs: int
     seconds: float
     low: float
@@ -81,7 +80,7 @@ def rank(group: pd.DataFrame, norm: float, target: float,
     for reach in reaches(group, norm, target):
         seconds = samples_of(timings, reach.sequence_key, reach.level, reach.seconds)
         first = rows[reach.sequence_key].iloc[0]
-        ranked.append(Ranked(combination(first), str(first["estimator"]), reach.ndofs,
+        ranked.append(Ranked(combination(first), reach.ndofs,
                              float(seconds[0]), float(seconds[0]),
                              float(seconds[min(1, seconds.size - 1)]), int(seconds.size)))
     timed = timings is not None and not timings.empty

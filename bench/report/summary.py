@@ -38,9 +38,11 @@ def flags(everything: pd.DataFrame) -> str:
     return ", ".join(p for p in parts if p) or "none"
 
 
-def scene_answers(rows: pd.DataFrame, truth: dict, results: Path | None) -> list[SceneAnswer]:
-    """Every scene's answer, its cost from the results folder's timings when there are any."""
-    timings = read_timings(results)
+def scene_answers(rows: pd.DataFrame, truth: dict, results: Path | None,
+                  timings: pd.DataFrame | None = None) -> list[SceneAnswer]:
+    """Every scene's answer, its cost from the results folder's timings when there are any
+    (``timings``: already read)."""
+    timings = read_timings(results) if timings is None else timings
     return [scene_answer(str(scene), group, scene_norm(str(scene), truth), timings)
             for scene, group in rows.groupby("scene", sort=True)]
 
@@ -49,7 +51,8 @@ def first_screen(everything: pd.DataFrame, rows: pd.DataFrame, rates: pd.DataFra
                  truth: dict, results: Path | None = None) -> dict:
     """The recommendations, the evidence table (one row per scene), how cost was measured,
     and per scene the five cheapest combinations to each relative error (the detail)."""
-    answers = scene_answers(rows, truth, results)
+    timings = read_timings(results)
+    answers = scene_answers(rows, truth, results, timings)
     table, detail = [], []
     for answer in answers:
         table.append({**evidence_row(answer),
@@ -61,4 +64,4 @@ def first_screen(everything: pd.DataFrame, rows: pd.DataFrame, rates: pd.DataFra
                 detail.append({"scene": answer.scene, "target": sig3(ranking.target),
                                "norm": sig3(answer.norm), "ranking": ranking.frame()})
     return {"sentences": [a.sentence for a in answers], "table": pd.DataFrame(table),
-            "detail": detail, "noise": spread_text(read_timings(results))}
+            "detail": detail, "noise": spread_text(timings)}
