@@ -1,12 +1,13 @@
 """The seed's residual estimator on a quadrilateral hierarchy with hanging nodes: the terms of
 ``estimators.residual`` (the paper's (8) with eta_0 of its section 5) for Q1 and Q2 solutions
-of ``formulations.quad_vi`` and ``formulations.quad_mixed`` (docs/theory.md, section 15).
+on the quadrilateral family's meshes (docs/theory.md, section 15).
 
 eta_0^2 = (1/E) sum_T ( (h_T/p)^2 ||f + div sigma(u_h)||_T^2 + sum_{e in E_T} (h_e/p) R_e^2 ).
 An edge with a hanging node is measured on each of its halves, the fine cell against the
 coarse one across it: R_e = 1/2 ||[sigma_n(u_h)]||_e on interior edges and halves,
 ||sigma_n(u_h) - q||_e on Gamma_N, ||sigma_nn(u_h) + lambda_h||_e + ||sigma_nt(u_h)||_e on
-Gamma_C. The contact terms: E ||w||_0 ||w||_1 and |(lambda_h, w)| with w = (g - u_hn)_-.
+Gamma_C. The contact terms, E ||w||_0 ||w||_1 and |(lambda_h, w)| with w = (g - u_hn)_-, are
+``estimators.contact_terms``'s, as on every cell.
 The stress is evaluated from the exact gradient polynomials of ``formulations.quad_evaluation``.
 """
 
@@ -15,19 +16,16 @@ from __future__ import annotations
 import numpy as np
 
 from estimators.base import Estimate, register_cell_variant
-from estimators.contact_terms import contact_terms as shared_contact_terms
+from estimators.contact_terms import contact_terms
 from estimators.nitsche_residual import nitsche_estimate
-from formulations.base import DiscreteSolution
 from formulations.contact import gauss_legendre
 from formulations.elasticity import element_diameters, stress_tensor_from_gradient
 from formulations.quad_evaluation import QuadGradient
 from formulations.quad_load import affine_maps
-from formulations.quad_vi import ContactEdges
 from formulations.tensor_stiffness import tensor_rule
 from scenes.quad_hierarchy import edge_keys
 
 EDGE_POINTS = 4  # Gauss points on Neumann and contact edges: q and lambda_h are not polynomials
-CONTACT_POINTS = 10  # w has kinks where u_hn crosses g (as estimators.contact_terms)
 
 
 class QuadStress:
@@ -54,16 +52,6 @@ class QuadStress:
         d_trace = dgrad[0, 0] + dgrad[1, 1]  # d_k tr(eps)
         return np.array([2 * mu * (strain[i, 0, 0] + strain[i, 1, 1]) + lam * d_trace[i]
                          for i in range(2)])
-
-
-def contact_edges_of(solution) -> ContactEdges:
-    """The contact edges of a solution: a ``DiscreteSolution``'s trace, or the edges of a
-    solution of ``formulations.quad_vi`` and ``formulations.quad_mixed``."""
-    if not isinstance(solution, DiscreteSolution):
-        return solution.edges
-    trace, mesh = solution.trace, solution.elasticity.mesh
-    return ContactEdges(trace.facets, mesh.p[:, trace.vertices[0]], mesh.p[:, trace.vertices[1]],
-                        trace.normal, trace.length, trace.element)
 
 
 def element_residuals(scene, solution, stress: QuadStress) -> np.ndarray:
@@ -130,7 +118,7 @@ def boundary_residuals(scene, solution, stress: QuadStress) -> np.ndarray:
     mesh, order, n_cells = elasticity.basis.mesh, elasticity.order, elasticity.basis.mesh.t.shape[1]
     out = np.zeros(n_cells)
     t, w = gauss_legendre(EDGE_POINTS)
-    edges = contact_edges_of(solution)
+    trace = solution.trace
     neumann = scene.neumann_facets(mesh)
     if neumann.size:
         cells = mesh.f2t[0, neumann]
@@ -146,50 +134,16 @@ def boundary_residuals(scene, solution, stress: QuadStress) -> np.ndarray:
             sn = sn - scene.traction(x)
         out += np.bincount(cells, h / order * ((sn**2).sum(axis=0) * w).sum(axis=1) * h,
                            n_cells)
-    if edges.facets.size:
-        x = edges.points(t).reshape(2, -1)
-        normal = np.repeat(edges.normal, t.size, axis=1)
-        sn = np.einsum("ijn,jn->in", stress.sigma(x, np.repeat(edges.cells, t.size)), normal)
+    if trace.size:
+        x = trace.points(t).reshape(2, -1)
+        normal = np.repeat(trace.normal, t.size, axis=1)
+        sn = np.einsum("ijn,jn->in", stress.sigma(x, np.repeat(trace.element, t.size)), normal)
         snn = np.einsum("in,in->n", sn, normal).reshape(-1, t.size)
         snt2 = ((sn - snn.ravel() * normal) ** 2).sum(axis=0).reshape(-1, t.size)
-        r_e = (np.sqrt((((snn + solution.pressure(t)) ** 2) * w).sum(axis=1) * edges.length)
-               + np.sqrt((snt2 * w).sum(axis=1) * edges.length))
-        out += np.bincount(edges.cells, edges.length / order * r_e**2, n_cells)
+        r_e = (np.sqrt((((snn + solution.pressure(t)) ** 2) * w).sum(axis=1) * trace.length)
+               + np.sqrt((snt2 * w).sum(axis=1) * trace.length))
+        out += np.bincount(trace.element, trace.length / order * r_e**2, n_cells)
     return out
-
-
-def contact_terms(scene, solution, stress: QuadStress) -> tuple[float, float, np.ndarray]:
-    """E ||w||_0 ||w||_1, |(lambda_h, w)| and their shares per cell, w = (g - u_hn)_-."""
-    edges, basis = contact_edges_of(solution), solution.elasticity.basis
-    n_cells = basis.mesh.t.shape[1]
-    if edges.facets.size == 0:
-        return 0.0, 0.0, np.zeros(n_cells)
-    t, w = gauss_legendre(CONTACT_POINTS)
-    x = edges.points(t)  # (2, n, nq)
-    values = (basis.probes(x.reshape(2, -1)) @ solution.u).reshape(2, -1)
-    normal = np.repeat(edges.normal, t.size, axis=1)
-    u_n = (values * normal).sum(axis=0).reshape(-1, t.size)
-    d = np.asarray(scene.gap(x)) - u_n
-    penetrating = d < 0
-    grad = stress.gradient(x.reshape(2, -1), np.repeat(edges.cells, t.size))
-    tangent = np.repeat((edges.b - edges.a) / edges.length, t.size, axis=1)
-    step = 1e-6 * edges.length[None, :, None] * (edges.b - edges.a)[:, :, None] \
-        / edges.length[None, :, None]
-    dg = (np.asarray(scene.gap(x + step)) - np.asarray(scene.gap(x - step))) \
-        / (2e-6 * edges.length[:, None])
-    du = np.einsum("in,ijn,jn->n", normal, grad, tangent).reshape(-1, t.size)
-    wval = np.where(penetrating, d, 0.0)
-    dw = np.where(penetrating, dg - du, 0.0)
-    l2 = (wval**2 * w).sum(axis=1) * edges.length
-    h1 = l2 + (dw**2 * w).sum(axis=1) * edges.length
-    young = float(scene.material.young_modulus)
-    geometric = young * float(np.sqrt(l2.sum() * h1.sum()))
-    local = np.sqrt(l2 * h1)
-    if local.sum() > 0:
-        local *= geometric / local.sum()
-    complementarity = np.abs((solution.pressure(t) * wval * w).sum(axis=1) * edges.length)
-    shares = np.bincount(edges.cells, local + complementarity, n_cells)
-    return geometric, float(complementarity.sum()), shares
 
 
 def quad_volume_terms(scene, solution, stress: QuadStress | None = None) -> np.ndarray:
@@ -208,17 +162,12 @@ def nitsche_residual_estimate(scene, solution) -> Estimate:
 @register_cell_variant("residual", "quad")
 def quad_residual_estimate(scene, solution) -> Estimate:
     """eta of the paper's (8) for a quadrilateral contact solution, per-cell indicators."""
-    stress = QuadStress(solution)
-    volume = quad_volume_terms(scene, solution, stress)
-    if isinstance(solution, DiscreteSolution):  # the contact terms every estimator shares
-        shared = shared_contact_terms(scene, solution)
-        geometric, complementarity = shared.geometric, shared.complementarity
-        shares = shared.per_element
-    else:
-        geometric, complementarity, shares = contact_terms(scene, solution, stress)
+    volume = quad_volume_terms(scene, solution)
+    shared = contact_terms(scene, solution)  # the contact terms every estimator shares
+    geometric, complementarity = shared.geometric, shared.complementarity
     eta_0 = float(np.sqrt(volume.sum()))
     return Estimate(estimator="residual", eta=float(np.sqrt(eta_0**2 + geometric
                                                             + complementarity)),
                     eta_0=eta_0, eta_geometric=float(np.sqrt(geometric)),
                     eta_complementarity=float(np.sqrt(complementarity)),
-                    indicators=volume + shares)
+                    indicators=volume + shared.per_element)

@@ -13,7 +13,7 @@ from bench.matrix.config import RunConfig
 from bench.matrix.config_files import COMPARE_KEYS, RunFileError, read_run_file
 from bench.matrix.scene_files import load_scene_files
 from bench.sequence.options import option_fields
-from bench.study.run import StudyConfig, read_study_file
+from bench.study.run import read_study_file
 
 
 def _as_text(value) -> str:
@@ -74,7 +74,7 @@ def run_file_defaults(argv: list[str]) -> dict:
     if path is None or command not in ("run", "compare", "study"):
         return {}
     if command == "study":
-        return {"study": StudyConfig(**read_study_file(path)[0])}
+        return {"study": read_study_file(path)}
     fields = read_run_file(path, COMPARE_KEYS if command == "compare" else ())
     load_scene_files(fields.get("scene_files", ()))  # before the names are checked
     fields = checked_run_file(fields, path, RunConfig)

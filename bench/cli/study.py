@@ -3,32 +3,28 @@
 from __future__ import annotations
 
 import dataclasses
-from pathlib import Path
-
-import pandas as pd
 
 from bench.cli import option_types as options
 from bench.cli.guards import InputError
 from bench.study import QUICK, StudyConfig, run_study
-from bench.study.quads import (
-    QuadStudy,
-    as_frame,
-    hex_sequence,
-    run_quad_study,
-    write_hex_report,
-    write_quad_report,
-)
-from bench.study.run import report_study
-from scenes import scene_names
+from bench.study.quads import as_frame, hex_sequence, write_hex_report
+from bench.study.run import STUDY_FILE, StudyFile, report_study
+from formulations.cells import family_for
+from scenes import get_scene, scene_names
 
-DEFAULTS = StudyConfig()
+DEFAULTS = STUDY_FILE.settings
+# the options a study file also sets: field -> flag (given ones override the file)
+STUDY_FLAGS = {"scenes": "scene", "orders": "order", "uniform_max_dofs": "uniform-max-dofs",
+               "adaptive_max_dofs": "adaptive-max-dofs", "reference_dofs": "reference-dofs",
+               "workers": "workers", "out": "out", "report": "report"}
 HEX_SCENE = "free-boundary-3d"  # the 3D scene with an exact solution
 
 
-def add_study_parser(sub, settings: StudyConfig | None = None) -> None:
-    """The study's options, their defaults from ``settings`` (a study file's, ``--config``) or
-    the package's study.toml."""
-    d = settings or DEFAULTS
+def add_study_parser(sub, study_file: StudyFile | None = None) -> None:
+    """The study's options, their defaults from ``study_file`` (``--config``) or the
+    package's study.toml."""
+    study_file = study_file or STUDY_FILE
+    d = study_file.settings
     study = sub.add_parser(
         "study", help="the rate study: uniform sequences to 2e6 DOFs, adaptive to 1e6, every "
         "formulation x estimator, against sharp references; writes its own report",
@@ -58,13 +54,14 @@ def add_study_parser(sub, settings: StudyConfig | None = None) -> None:
                        help=f"adaptive sequences run in parallel on a local Dask cluster of "
                             f"this many processes; uniform ones one at a time "
                             f"(default: {d.workers})")
-    study.add_argument("--cell", choices=("tri", "quad", "hex"), default="tri",
-                       help="tri (default): the matrix's formulations on triangles; quad: the "
-                            "seed's own discretisation, Q1 (Q2 with --order 2) on hierarchical "
-                            "quadrilateral meshes with hanging nodes, vi and the mixed method "
-                            "with lambda_H one and two levels coarser, the seed's residual "
-                            "estimator (REPORT/quads.md); hex: Q1 on the 3D scenes' cubes, "
-                            "vi, uniform (REPORT/hexes.md)")
+    study.add_argument("--cell", choices=("tri", "quad", "hex"), default=d.cell,
+                       help="tri (default): every formulation x estimator on triangles; quad: "
+                            "the study file's [cells.quad] table, the seed's own discretisation "
+                            "(Q1, Q2 with --order 2, on hierarchical quadrilateral meshes with "
+                            "hanging nodes, vi and the mixed method with lambda_H one and two "
+                            "levels coarser, the residual estimator), run by the matrix, with "
+                            "the seed's Fig. 1 and Fig. 2 in the report; hex: Q1 on the 3D "
+                            "scenes' cubes, vi, uniform (REPORT/hexes.md)")
     study.add_argument("--quick", action="store_true",
                        help=f"the reduced study of the default tests ([quick] of study.toml): "
                             f"{','.join(QUICK.scenes)}, uniform to {QUICK.uniform_max_dofs} and "
@@ -81,43 +78,7 @@ def add_study_parser(sub, settings: StudyConfig | None = None) -> None:
                        help="read the study's settings from FILE, a copy of the package's "
                             "bench/study/study.toml (its keys: scenes, orders, "
                             "uniform-max-dofs, ...); options given override them")
-    study.set_defaults(study_scenes=d.scenes, study_crosscheck=d.crosscheck)
-
-
-def quad_study_command(args) -> int:
-    """``study --cell quad``: the quadrilateral sequences and their report."""
-    orders = tuple(o for o in args.order if o in (1, 2))
-    if len(orders) < len(args.order):
-        raise InputError(f"--order={','.join(map(str, args.order))}: quadrilaterals run "
-                         "orders 1 and 2")
-    study = QuadStudy(scenes=tuple(args.scene or DEFAULTS.scenes), orders=orders,
-                      uniform_max_dofs=9000 if args.quick else args.uniform_max_dofs,
-                      adaptive_max_dofs=5000 if args.quick else args.adaptive_max_dofs,
-                      reference_dofs=args.reference_dofs)
-
-    if args.report_only:  # the report again from the levels of the last run
-        csv = Path(args.report) / "quads.csv"
-        if not csv.is_file():
-            raise InputError(f"--report={args.report!r} holds no quads.csv; run "
-                             "study --cell quad first")
-        table = pd.read_csv(csv)
-        print(f"wrote {write_quad_report(table, args.report, read_command(args.report), 20000)}")
-        return 0
-
-    def show(rows):
-        last = rows[-1]
-        print(f"{last.scene}/{last.method}/Q{last.order}/{last.strategy}: {len(rows)} "
-              f"levels to {last.ndofs} DOFs, error {last.energy_error:.4g}, eta "
-              f"{last.eta:.4g}", flush=True)
-
-    try:
-        table = run_quad_study(study, show)
-    except ValueError as error:
-        raise InputError(str(error)) from None
-    report = write_quad_report(table, args.report, " ".join(["python -m bench", *args.argv]),
-                               min(study.adaptive_max_dofs, 20000))
-    print(f"{len(table)} levels; wrote {report}")
-    return 0
+    study.set_defaults(study_file=study_file)
 
 
 def hex_study_command(args) -> int:
@@ -138,25 +99,31 @@ def hex_study_command(args) -> int:
     return 0
 
 
-def read_command(folder) -> str:
-    """The command line recorded in an earlier FOLDER/quads.md ('' if none)."""
-    path = Path(folder) / "quads.md"
-    lines = path.read_text().splitlines() if path.is_file() else []
-    return next((line.strip("`") for line in lines if line.startswith("`python -m bench")), "")
+def study_config(args) -> StudyConfig:
+    """The study the command line asks for: the study file's settings on ``--cell`` (reduced
+    by ``--quick``), then the options given on the command line."""
+    config = args.study_file.config(args.cell, quick=args.quick)
+    given = {name for name, flag in STUDY_FLAGS.items()
+             if any(a == f"--{flag}" or a.startswith(f"--{flag}=") for a in args.argv)}
+    values = dict(scenes=tuple(args.scene or ()), orders=tuple(args.order),
+                  uniform_max_dofs=args.uniform_max_dofs,
+                  adaptive_max_dofs=args.adaptive_max_dofs,
+                  reference_dofs=args.reference_dofs, workers=args.workers, out=args.out,
+                  report=args.report)
+    config = dataclasses.replace(config, **{name: values[name] for name in given},
+                                 command=" ".join(["python -m bench", *args.argv]))
+    for scene in config.scenes:  # a cell without the element is refused, not a skipped study
+        family = family_for(config.cell, get_scene(scene).dim)
+        why = next(filter(None, map(family.why_no_element, config.orders)), None)
+        if why is not None:
+            raise InputError(f"--order={','.join(map(str, config.orders))}: {why}")
+    return config
 
 
 def study_command(args) -> int:
-    if args.cell == "quad":
-        return quad_study_command(args)
     if args.cell == "hex":
         return hex_study_command(args)
-    base = QUICK if args.quick else StudyConfig(
-        scenes=tuple(args.scene or args.study_scenes), orders=tuple(args.order),
-        uniform_max_dofs=args.uniform_max_dofs, adaptive_max_dofs=args.adaptive_max_dofs,
-        reference_dofs=args.reference_dofs, workers=args.workers,
-        crosscheck=args.study_crosscheck)
-    config = dataclasses.replace(base, out=args.out, report=args.report,
-                                 command=" ".join(["python -m bench", *args.argv]))
+    config = study_config(args)
     if args.report_only:
         try:
             table, report, verdicts = report_study(config)

@@ -20,7 +20,8 @@ FIT_LEVELS = 4  # the asymptotic slope: least squares over the last levels
 QUANTITIES = {"error": "energy_error", "eta": "eta", "pressure": "pressure_error"}
 NEARLY = 0.05  # "nearly O(h^1/2)": a local error slope within this of -1/4
 EFFECTIVITY_FROM = 1000  # effectivity statistics from this many DOFs (coarser: no contact yet)
-SHOWN = ["scene", "formulation", "estimator", "strategy", "order"]  # the columns of a sequence
+# the columns that tell the sequences apart in the tables
+SHOWN = ["scene", "formulation", "formulation_options", "estimator", "strategy", "order", "cell"]
 
 
 def _ok(table: pd.DataFrame) -> pd.DataFrame:

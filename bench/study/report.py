@@ -10,7 +10,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from bench.report.figures import colour, line_style
-from bench.sequence.rows import KEYS, phase_time
+from bench.sequence.rows import KEYS, phase_time, with_labels
 from bench.study.analysis import (
     EFFECTIVITY_FROM,
     NEARLY,
@@ -20,24 +20,30 @@ from bench.study.analysis import (
     nearly_half_range,
     predictions,
 )
+from bench.study.seed_figures import write_seed_figures
 from bench.verify.gates import check_gates, verdict_table
 from formulations import STATUS_OK
 
 MARKERS = {"uniform": "s", "adaptive": "o"}
 
 
+# a sequence of one scene in the figures
+SEQUENCE = ["formulation", "formulation_options", "estimator", "strategy", "order"]
+
+
 def _sequences(table: pd.DataFrame, scene: str):
-    ok = table[(table["scene"] == scene) & (table["status"] == STATUS_OK)]
-    for key, group in ok.groupby(["formulation", "estimator", "strategy", "order"], sort=True):
+    ok = with_labels(table[(table["scene"] == scene) & (table["status"] == STATUS_OK)])
+    for key, group in ok.groupby(SEQUENCE, sort=True):
         yield key, group.sort_values("ndofs")
 
 
 def _draw(axes, key, x, y) -> None:
     """One sequence's line: colour by formulation, style by estimator, marker by strategy."""
-    formulation, estimator, strategy, order = key
+    formulation, options, estimator, strategy, order = key
+    name = f"{formulation}:{options}" if options else formulation
     axes.plot(x, y, color=colour(formulation), linestyle=line_style(estimator),
               marker=MARKERS.get(strategy, "x"), markersize=3,
-              label=f"{formulation}/{estimator}/{strategy}/P{order}")
+              label=f"{name}/{estimator}/{strategy}/p{order}")
 
 
 def _finish(axes, xlabel: str, ylabel: str, title: str) -> None:
@@ -79,7 +85,7 @@ def local_slope_figure(slopes: pd.DataFrame, scene: str, predicted: pd.DataFrame
     axes = figure.add_subplot()
     axes.set_xscale("log")
     mine = slopes[slopes["scene"] == scene]
-    for key, group in mine.groupby(["formulation", "estimator", "strategy", "order"]):
+    for key, group in with_labels(mine).groupby(SEQUENCE):
         _draw(axes, key, np.sqrt(group["ndofs_from"] * group["ndofs_to"]), group["error_slope"])
     for strategy, style in (("uniform", "-"), ("adaptive", "--")):
         axes.axhline(float(predicted[f"predicted_{strategy}"].iloc[0]), color="k",
@@ -126,9 +132,10 @@ def _markdown(frame: pd.DataFrame) -> str:
 
 def write_study_report(table: pd.DataFrame, out: str | Path, wall_seconds: float | None = None,
                        planned: int | None = None, gates: list[dict] | None = None,
-                       ) -> tuple[Path, list]:
+                       results: str | Path | None = None) -> tuple[Path, list]:
     """README.md, tables as CSV and figures for the study's rows ``table``; with ``gates``
-    (the ``[[study_gate]]`` entries of expected.toml) also their verdicts, returned too."""
+    (the ``[[study_gate]]`` entries of expected.toml) also their verdicts, returned too; with
+    ``results`` (the study's results folder, for the artifacts) the seed's Figures 1 and 2."""
     out = Path(out)
     (out / "figures").mkdir(parents=True, exist_ok=True)
     slopes, asymptotic = local_slopes(table), asymptotic_table(table)
@@ -150,7 +157,9 @@ def write_study_report(table: pd.DataFrame, out: str | Path, wall_seconds: float
             path = out / "figures" / f"{scene}-{kind}.png"
             figure.savefig(path, dpi=110, bbox_inches="tight")
             figures.append(path.name)
-    text = _report_text(table, asymptotic, predicted, nearly, figures, wall_seconds, planned)
+    seed = write_seed_figures(table, results, out / "figures") if results is not None else []
+    text = _report_text(table, asymptotic, predicted, nearly, figures, wall_seconds, planned,
+                        seed)
     if verdicts:
         text += ("\n## Gates\n\nThe `[[study_gate]]` entries of bench/verify/expected.toml.\n\n"
                  + verdict_table(verdicts) + "\n")
@@ -158,7 +167,8 @@ def write_study_report(table: pd.DataFrame, out: str | Path, wall_seconds: float
     return out / "README.md", verdicts
 
 
-def _report_text(table, asymptotic, predicted, nearly, figures, wall_seconds, planned) -> str:
+def _report_text(table, asymptotic, predicted, nearly, figures, wall_seconds, planned,
+                 seed=()) -> str:
     columns = SHOWN + ["levels", "ndofs_last", "error_slope", "error_slope_se", "eta_slope",
                       "eta_slope_se", "pressure_slope", "pressure_slope_se", "predicted",
                       "singular_share", "crossover_ndofs", "effectivity_min", "effectivity_max",
@@ -185,6 +195,14 @@ def _report_text(table, asymptotic, predicted, nearly, figures, wall_seconds, pl
              "## The seed paper's \"nearly O(h^1/2)\" under uniform refinement", "",
              f"Range of DOFs over which local error slopes are within {NEARLY} of -1/4, the "
              "range of all local slopes and the last one.",
-             "", _markdown(nearly), "", "## Figures", ""]
+             "", _markdown(nearly), ""]
+    if seed:
+        lines += ["## The seed's figures", "",
+                  "Fig. 1: the adaptive mesh of the seed's setup (the mixed method, residual "
+                  "estimator, lowest order) with its hanging nodes, and the von Mises stress "
+                  "on the deformed body. Fig. 2: its estimated and true error under uniform "
+                  "and adaptive refinement.", ""]
+        lines += [f"![{name}](figures/{name})" for name in seed] + [""]
+    lines += ["## Figures", ""]
     lines += [f"![{name}](figures/{name})" for name in figures]
     return "\n".join(lines) + "\n"

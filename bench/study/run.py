@@ -6,7 +6,7 @@ ordinary result store, and a rerun reuses every finished sequence."""
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import pandas as pd
@@ -19,23 +19,27 @@ from bench.study.report import write_study_report
 from bench.verify import load_expected
 from estimators import estimator_names
 from formulations import formulation_names
+from formulations.cells import DEFAULT_CELL, check_cell
 from formulations.solvers.registry import FAST_SOLVER
 
 STUDY_SETTINGS = Path(__file__).with_name("study.toml")  # the defaults, and [quick]
 STUDY_KEYS = ["scenes", "orders", "uniform_max_dofs", "adaptive_max_dofs", "reference_dofs",
-              "workers", "crosscheck", "out", "report"]
+              "workers", "crosscheck", "out", "report", "cell", "formulations", "estimators"]
 
 
-def read_study_file(path: str | Path = STUDY_SETTINGS) -> tuple[dict, dict]:
-    """A study file's settings and its ``[quick]`` table's, as ``StudyConfig`` fields."""
+def _study_tables(path: str | Path) -> tuple[dict, dict, dict]:
+    """A study file's settings, its ``[quick]`` table's and its ``[cells.NAME]`` tables', as
+    ``StudyConfig`` fields."""
     data = read_toml(path, "a study file")
-    quick = data.pop("quick", {})
+    quick, cells = data.pop("quick", {}), data.pop("cells", {})
     where = f"config={str(path)!r}"
     return (dataclass_fields(data, STUDY_KEYS, where),
-            dataclass_fields(quick, STUDY_KEYS, f"{where} [quick]"))
+            dataclass_fields(quick, STUDY_KEYS, f"{where} [quick]"),
+            {check_cell(cell): dataclass_fields(table, STUDY_KEYS, f"{where} [cells.{cell}]")
+             for cell, table in cells.items()})
 
 
-_SETTINGS, _QUICK = read_study_file()
+_SETTINGS = _study_tables(STUDY_SETTINGS)[0]
 
 
 @dataclass(frozen=True)
@@ -51,24 +55,51 @@ class StudyConfig:
     crosscheck: bool = _SETTINGS["crosscheck"]  # the P2 references too, compared in truth.json
     out: str = _SETTINGS["out"]
     report: str = _SETTINGS["report"]
+    cell: str = _SETTINGS.get("cell", DEFAULT_CELL)  # the matrix's cell axis (one shape)
+    # () runs every registered formulation, or estimator
+    formulations: tuple[str, ...] = _SETTINGS.get("formulations", ())
+    estimators: tuple[str, ...] = _SETTINGS.get("estimators", ())
     command: str = "python -m bench study"
 
     def run_configs(self) -> list[RunConfig]:
         """Adaptive first (in parallel, about 5 GiB each at 1e6 DOFs), then uniform in this
         process (a 2.1e6-DOF level needs about 11 GiB, half of a 24 GiB machine)."""
-        common = dict(scenes=self.scenes, solvers=(FAST_SOLVER,),
-                      estimators=tuple(estimator_names()), orders=self.orders,
+        common = dict(scenes=self.scenes, solvers=(FAST_SOLVER,), cells=(self.cell,),
+                      estimators=self.estimators or tuple(estimator_names()), orders=self.orders,
                       reference_dofs=self.reference_dofs, reference_crosscheck=self.crosscheck,
                       out=self.out, command=self.command)
-        formulations = tuple(formulation_names())
+        formulations = self.formulations or tuple(formulation_names())
         return [RunConfig(strategies=("adaptive",), max_dofs=self.adaptive_max_dofs,
                           workers=self.workers, formulations=formulations, **common),
                 RunConfig(strategies=("uniform",), max_dofs=self.uniform_max_dofs,
                           formulations=formulations, **common)]
 
 
+@dataclass(frozen=True)
+class StudyFile:
+    """A study file: its settings, and what ``[quick]`` and each ``[cells.NAME]`` replace."""
+
+    settings: StudyConfig
+    quick: tuple[tuple[str, object], ...] = ()
+    cells: tuple[tuple[str, tuple[tuple[str, object], ...]], ...] = ()
+
+    def config(self, cell: str | None = None, quick: bool = False) -> StudyConfig:
+        """The study on ``cell`` (default: the file's), reduced to ``[quick]`` if asked."""
+        cell = check_cell(cell or self.settings.cell)
+        config = replace(self.settings, cell=cell, **dict(dict(self.cells).get(cell, ())))
+        return replace(config, **dict(self.quick)) if quick else config
+
+
+def read_study_file(path: str | Path = STUDY_SETTINGS) -> StudyFile:
+    """A study file (the package's study.toml, or a copy given with ``--config``)."""
+    settings, quick, cells = _study_tables(path)
+    return StudyFile(StudyConfig(**settings), tuple(quick.items()),
+                     tuple((cell, tuple(table.items())) for cell, table in cells.items()))
+
+
 # the default tests' version: the paper scene to a few thousand DOFs
-QUICK = StudyConfig(**_QUICK)
+STUDY_FILE = read_study_file()
+QUICK = STUDY_FILE.config(quick=True)
 
 
 def study_gates(config: StudyConfig) -> list[dict] | None:
@@ -79,7 +110,8 @@ def study_gates(config: StudyConfig) -> list[dict] | None:
             or config.adaptive_max_dofs < full.adaptive_max_dofs):
         return None
     return [gate for gate in load_expected().get("study_gate", [])
-            if gate.get("scene", config.scenes[0]) in config.scenes
+            if gate.get("cell", DEFAULT_CELL) == config.cell
+            and gate.get("scene", config.scenes[0]) in config.scenes
             and gate.get("order", config.orders[0]) in config.orders]
 
 
@@ -93,7 +125,8 @@ def run_study(config: StudyConfig, on_level=None) -> tuple[pd.DataFrame, object,
     table = pd.concat(tables, ignore_index=True)
     report, verdicts = write_study_report(
         table, config.report, time.perf_counter() - start,
-        planned=table.groupby("sequence_key").ngroups, gates=study_gates(config))
+        planned=table.groupby("sequence_key").ngroups, gates=study_gates(config),
+        results=config.out)
     return table, report, verdicts
 
 
@@ -113,5 +146,5 @@ def report_study(config: StudyConfig) -> tuple[pd.DataFrame, object, list]:
     if table.empty:
         raise ValueError(f"out={config.out!r} holds no finished sequence of this study")
     report, verdicts = write_study_report(table, config.report, planned=planned,
-                                          gates=study_gates(config))
+                                          gates=study_gates(config), results=config.out)
     return table, report, verdicts

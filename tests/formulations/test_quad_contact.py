@@ -1,5 +1,6 @@
-"""Contact on quadrilaterals (Q1, Q2, hanging nodes included), the VI and the seed's mixed
-method with lambda_H one and two levels coarser: a rigid flat pressing the body up is
+"""Contact on quadrilaterals (Q1, Q2, hanging nodes included) through the registered
+formulations, the VI and the seed's mixed method with lambda_H one and two levels coarser
+(the multipliers piecewise constant, as in the seed): a rigid flat pressing the body up is
 reproduced exactly, and the fast active-set solve agrees with Clarabel."""
 
 import numpy as np
@@ -8,8 +9,6 @@ import pytest
 from conftest import square_scene
 from formulations import get_formulation, solve
 from formulations.cells import family_for
-from formulations.quad_mixed import solve_quad_mixed
-from formulations.quad_vi import solve_quad_vi
 from scenes import get_scene
 from scenes.quad_hierarchy import QuadHierarchy, coarse_edges
 
@@ -19,49 +18,55 @@ def hierarchy_with_hanging_nodes() -> QuadHierarchy:
         .refined([0, 5]).refined([1])
 
 
-SOLVES = {"vi": solve_quad_vi,
-          "mixed": solve_quad_mixed,
-          "mixed-two-up": lambda *a, **k: solve_quad_mixed(*a, levels_up=2, **k)}
+# the seed's methods: formulation and options
+METHODS = {"vi": ("vi", {}), "mixed": ("mixed", {"multiplier_degree": 0}),
+           "mixed-two-up": ("mixed", {"multiplier_degree": 0, "h_over_H": 0.25})}
 
 
-@pytest.mark.parametrize("method", SOLVES)
+def solve_on(method: str, scene, hierarchy: QuadHierarchy, order: int,
+             solver: str = "active-set"):
+    name, options = METHODS[method]
+    return solve(get_formulation(name)(scene, hierarchy.mesh(), order=order, **options), solver)
+
+
+@pytest.mark.parametrize("method", METHODS)
 @pytest.mark.parametrize("order", [1, 2])
 def test_a_flat_push_is_reproduced(compression_scene, order, method):
     """u = (0, delta (1 - y) / 2), pressure E delta / 2 on all of Gamma_C (conftest): linear,
     so in Q1 and Q2; energy 1/2 (E delta^2 / 4) |Omega| = 0.05, force 10."""
-    solution = SOLVES[method](compression_scene, hierarchy_with_hanging_nodes(), order)
+    solution = solve_on(method, compression_scene, hierarchy_with_hanging_nodes(), order)
     assert solution.status == "ok"
     assert solution.energy == pytest.approx(0.05, rel=1e-12)  # round-off of a direct solve
-    assert solution.contact_force == pytest.approx(10.0, rel=1e-12)
+    assert solution.contact_force() == pytest.approx(10.0, rel=1e-12)
     basis = solution.elasticity.basis
     uy = solution.u[basis.nodal_dofs[1]]
     assert np.allclose(uy, 0.005 * (1 - basis.mesh.p[1]), atol=1e-14)
 
 
-@pytest.mark.parametrize("method", SOLVES)
+@pytest.mark.parametrize("method", METHODS)
 @pytest.mark.parametrize("order", [1, 2])
 def test_the_fast_solve_agrees_with_the_reference_solver(order, method):
     scene = get_scene("paper")
     hierarchy = QuadHierarchy.from_tensor(np.linspace(-1, 1, 9), np.linspace(-1, 1, 9))
     hierarchy = hierarchy.refined(np.arange(8))  # the bottom row: hanging nodes above it
     assert hierarchy.hanging()[0].size > 0
-    fast = SOLVES[method](scene, hierarchy, order, solver="active-set")
-    judge = SOLVES[method](scene, hierarchy, order, solver="reference")
+    fast = solve_on(method, scene, hierarchy, order)
+    judge = solve_on(method, scene, hierarchy, order, solver="reference")
     # Clarabel's interior point stops at a relative gap of about 1e-8
     assert fast.energy == pytest.approx(judge.energy, rel=1e-7)
-    assert fast.contact_force == pytest.approx(judge.contact_force, rel=1e-6)
+    assert fast.contact_force() == pytest.approx(judge.contact_force(), rel=1e-6)
 
 
 def test_an_empty_contact_zone_is_a_free_solve(free_scene):
     hierarchy = QuadHierarchy.from_tensor(np.linspace(-1, 1, 5), np.linspace(-1, 1, 5))
-    solution = solve_quad_vi(free_scene, hierarchy, 1)
-    assert solution.status == "ok" and solution.contact_force == 0.0
+    solution = solve_on("vi", free_scene, hierarchy, 1)
+    assert solution.status == "ok" and solution.contact_force() == 0.0
     assert solution.energy < 0  # a body force with nothing in the way: E(u) = -F'u / 2
 
 
 def test_a_scene_without_contact_rows_is_not_confused_with_one(compression_scene):
     lifted = square_scene(lambda x: np.full(x.shape[1:], 1.0))
-    assert solve_quad_vi(lifted, hierarchy_with_hanging_nodes(), 1).contact_force == 0.0
+    assert solve_on("vi", lifted, hierarchy_with_hanging_nodes(), 1).contact_force() == 0.0
 
 
 def test_the_multiplier_mesh_is_a_coarser_level_of_the_hierarchy():
@@ -85,14 +90,15 @@ def test_the_inf_sup_constant_levels_off_for_h_over_H_at_most_one_half():
     leaves' own edges (h/H = 1) it halves with h (measured 0.46 .. 0.027); one or two levels
     coarser (h/H = 1/2, 1/4) it levels off (measured 0.60 and 0.70 at 4096 cells)."""
     from formulations.diagnostics import inf_sup_constant
-    from formulations.quad_mixed import mixed_problem
 
     scene = get_scene("paper")
     hierarchy = QuadHierarchy.from_tensor(np.linspace(-1, 1, 5), np.linspace(-1, 1, 5))
     beta = {up: [] for up in (0, 1, 2)}
     for _ in range(5):
         for up in beta:
-            beta[up].append(inf_sup_constant(mixed_problem(scene, hierarchy, 1, up)))
+            mixed = get_formulation("mixed")(scene, hierarchy.mesh(), h_over_H=0.5**up,
+                                             multiplier_degree=0)
+            beta[up].append(inf_sup_constant(mixed))
         hierarchy = hierarchy.refined()
     same = np.array(beta[0])
     assert np.allclose(same[2:] / same[1:-1], 0.5, atol=0.03)  # beta_h ~ h
@@ -100,25 +106,3 @@ def test_the_inf_sup_constant_levels_off_for_h_over_H_at_most_one_half():
         levels = np.array(beta[up])
         assert levels[-1] > 0.5  # bounded below ...
         assert abs(levels[-1] / levels[-2] - 1) < 0.03  # ... and levelled off (within 1 %)
-
-
-@pytest.mark.parametrize("order", [1, 2])
-def test_the_matrix_mixed_method_on_quadrilaterals_is_the_seeds(order):
-    """``mixed`` on a quadrilateral leaf mesh takes its multiplier mesh from the hierarchy
-    (one level up for h/H = 1/2): the same discrete problem as ``solve_quad_mixed``, whose
-    rows are built independently (Newton-Cotes on each leaf edge, not Gauss points through
-    the element's basis)."""
-    scene = get_scene("paper")
-    family = family_for("quad", 2)
-    mesh = family.refinement(family.starting_mesh(scene)).refined
-    rng = np.random.default_rng(2)
-    for _ in range(3):
-        marked = np.flatnonzero(rng.random(mesh.t.shape[1]) < 0.3)
-        mesh = family.refinement(mesh, marked).refined
-    assert mesh.hierarchy.hanging()[0].size > 0
-    matrix = solve(get_formulation("mixed")(scene, mesh, order=order, multiplier_degree=0),
-                   "active-set")
-    seed = solve_quad_mixed(scene, mesh.hierarchy, order=order, levels_up=1)
-    # measured 1.3e-12: the two assemblies' round-off through a condensed active-set solve
-    assert matrix.energy == pytest.approx(seed.energy, rel=1e-10)
-    assert matrix.contact_force() == pytest.approx(seed.contact_force, rel=1e-10)

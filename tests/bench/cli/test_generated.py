@@ -43,7 +43,7 @@ def test_study_defaults_are_its_settings_file():
     raw = tomllib.loads(STUDY_SETTINGS.read_text())
     assert args.uniform_max_dofs == raw["uniform-max-dofs"] == StudyConfig().uniform_max_dofs
     assert args.adaptive_max_dofs == raw["adaptive-max-dofs"]
-    assert tuple(args.study_scenes) == tuple(raw["scenes"])
+    assert tuple(args.study_file.settings.scenes) == tuple(raw["scenes"])
     assert (args.out, args.report, args.workers) == (raw["out"], raw["report"], raw["workers"])
 
 
