@@ -23,13 +23,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from formulations import DiscreteSolution
-from formulations.contact import gauss_legendre
 from formulations.evaluation import evaluate_on_trace
 
-# w has kinks where u_hn crosses g inside a facet; 10 Gauss points keep that quadrature error far
-# below the discretisation error the term measures.
-QUADRATURE_POINTS = 10
-QUADRATURE_DEGREE_3D = 10  # the same idea on triangles: 25 points
+# w has kinks where u_hn crosses g inside a facet: the contact boundary's ``kink_degree`` (10
+# Gauss points on an edge, 25 points on a triangle) keeps that quadrature error far below the
+# discretisation error the term measures
 # central difference step (relative to the facet) for the tangential derivative of g
 _DT = 1e-6
 
@@ -42,26 +40,15 @@ class ContactTerms:
 
 
 def tangential_derivatives(scene, trace, t: np.ndarray, gradient: np.ndarray) -> list:
-    """d/dtau (g - u_hn) (n, nq) along each unit tangent tau of the facets (one in 2D, two
-    orthogonal ones in 3D): g by central differences, u_hn from grad u_h (d, d, n nq) exactly."""
+    """d/dtau (g - u_hn) (n, nq) along each unit direction tau of the facets (the contact
+    boundary's ``surface_tangents``): g by central differences, u_hn from grad u_h (d, d, n nq)
+    exactly."""
     nq = t.shape[-1]
-    normal = np.repeat(trace.normal, nq, axis=1)
-    x = trace.points(t)
-    if trace.dim == 2:  # along the facet in its local coordinate
-        tangents = [trace.tangent]
-        dg = [(scene.gap(trace.points(t + _DT)) - scene.gap(trace.points(t - _DT)))
-              / (2 * _DT * trace.length[:, None])]
-    else:
-        first = trace.points(np.array([[1.0], [0.0]]))[:, :, 0] - trace.points(
-            np.array([[0.0], [0.0]]))[:, :, 0]
-        first /= np.linalg.norm(first, axis=0)
-        tangents = [first, np.cross(trace.normal, first, axis=0)]
-        step = _DT * trace.diameter[None, :, None]
-        dg = [(scene.gap(x + step * tau[:, :, None]) - scene.gap(x - step * tau[:, :, None]))
-              / (2 * step[0]) for tau in tangents]
-    return [dg_k - np.einsum("in,ijn,jn->n", normal, gradient,
-                             np.repeat(tau, nq, axis=1)).reshape(trace.size, nq)
-            for dg_k, tau in zip(dg, tangents, strict=True)]
+    normal = trace.at_points(trace.normal, nq)
+    return [dg - np.einsum("in,ijn,jn->n", normal, gradient,
+                           trace.at_points(tau, nq)).reshape(trace.size, nq)
+            for dg, tau in zip(trace.gap_derivatives(scene, t, _DT), trace.surface_tangents(),
+                               strict=True)]
 
 
 def friction_complementarity(scene, solution: DiscreteSolution, at_points, t: np.ndarray,
@@ -72,18 +59,13 @@ def friction_complementarity(scene, solution: DiscreteSolution, at_points, t: np
     sigma_t,h are vectors."""
     trace, law = solution.trace, scene.friction
     nq = t.shape[-1]
-    u = at_points.value(solution.u)
-    if trace.dim == 2:
-        tangent = np.repeat(np.array([-trace.normal[1], trace.normal[0]]), nq, axis=1)
-        u_t = np.einsum("in,in->n", u, tangent).reshape(trace.size, -1) - law.slide
-        size, work = np.abs(u_t), solution.friction.traction(t) * u_t
-    else:
-        normal = np.repeat(trace.normal, nq, axis=1)
-        u = u - law.slide_vector(3)[:, None]  # relative to the obstacle (w = slide e_x)
-        u_t = u - np.einsum("in,in->n", u, normal) * normal
-        size = np.linalg.norm(u_t, axis=0).reshape(trace.size, nq)
-        work = np.einsum("in,in->n", solution.friction.traction(t).reshape(3, -1),
-                         u_t).reshape(trace.size, nq)
+    normal = trace.at_points(trace.normal, nq)
+    # relative to the obstacle, whose slide w is the contact boundary's
+    u = at_points.value(solution.u) - trace.at_points(trace.slide_vector(law.slide), nq)
+    u_t = u - np.einsum("in,in->n", u, normal) * normal
+    size = np.linalg.norm(u_t, axis=0).reshape(trace.size, nq)
+    shear = trace.shear_vector(solution.friction.traction(t))  # (d, n, nq)
+    work = np.einsum("in,in->n", shear.reshape(shear.shape[0], -1), u_t).reshape(trace.size, nq)
     bound = (law.slip_bound_at(trace.points(t)) if law.kind == "tresca"
              else law.coefficient * solution.pressure(t))
     return np.abs(trace.integrate(bound * size + work, w))
@@ -91,11 +73,10 @@ def friction_complementarity(scene, solution: DiscreteSolution, at_points, t: np
 
 def contact_terms(scene, solution: DiscreteSolution) -> ContactTerms:
     trace = solution.trace
-    t, w = (gauss_legendre(QUADRATURE_POINTS) if trace.dim == 2
-            else trace.rule(QUADRATURE_DEGREE_3D))
+    t, w = trace.rule(trace.kink_degree)
     at_points = evaluate_on_trace(solution.elasticity.basis, trace, t)
     nq = t.shape[-1]
-    normal = np.repeat(trace.normal, nq, axis=1)
+    normal = trace.at_points(trace.normal, nq)
     u_n = np.einsum("in,in->n", at_points.value(solution.u), normal).reshape(trace.size, nq)
     g = scene.gap(trace.points(t))
     d = g - u_n

@@ -53,7 +53,7 @@ from estimators.proved_constants import proved_constants
 from estimators.rigid_duals import RigidChain
 from estimators.weak_symmetry import weakly_symmetrised
 from formulations import DiscreteSolution
-from formulations.contact import gauss_legendre
+from formulations.contact_boundary import gauss_legendre
 
 NAME = "equilibrated-local"
 

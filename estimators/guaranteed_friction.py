@@ -29,7 +29,7 @@ from estimators.guaranteed_contact import (
     traction_at,
 )
 from estimators.strip_extension import StripExtension
-from formulations.contact import gauss_legendre
+from formulations.contact_boundary import gauss_legendre
 from formulations.evaluation import evaluate_on_trace
 from formulations.slack_friction import contact_tangent
 

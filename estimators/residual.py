@@ -25,7 +25,8 @@ from estimators.base import Estimate, combine, register_estimator
 from estimators.contact_terms import contact_terms
 from estimators.residual_3d import face_residuals_3d, stress_divergence_3d
 from formulations import DiscreteSolution
-from formulations.contact import gauss_legendre, outer_normals
+from formulations.contact_boundary import gauss_legendre
+from formulations.contact_edges import outer_normals
 from formulations.elasticity import ELEMENTS, element_diameters, stress_from_gradient
 from formulations.evaluation import gradients_at, gradients_at_reference
 

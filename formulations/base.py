@@ -15,8 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import sparse
 
-from formulations.contact import ContactTrace
-from formulations.contact_surface import triangle_lagrange
+from formulations.contact_edges import ContactTrace
 from formulations.elasticity import Elasticity
 from formulations.evaluation import normal_trace_matrix
 
@@ -260,30 +259,9 @@ class DiscreteSolution:
         return values.reshape(self.trace.size, t.shape[-1])
 
     def pressure_at(self, s: np.ndarray, samples: int = 17) -> np.ndarray:
-        """lambda_h at contact coordinates ``s``: located in its facet, interpolated linearly
-        between ``samples`` equispaced values per facet (exact for the piecewise constant and
-        piecewise linear pressures; for the penalty's kinked one, error O(h / samples)^2). In
-        3D, s is (2, m): lambda_h at the point of its facet (``ContactSurface.locate``)."""
-        if self.trace.dim == 3:
-            return self._pressure_at_3d(s)
-        s = np.asarray(s, dtype=float)
-        t = np.linspace(0.0, 1.0, samples)
-        values = self.pressure(t)
-        s0, s1 = self.trace.coordinate
-        facet = np.clip(np.searchsorted(s0, s, "right") - 1, 0, s0.size - 1)
-        local = np.clip((s - s0[facet]) / (s1[facet] - s0[facet]), 0.0, 1.0) * (samples - 1)
-        k = np.minimum(np.floor(local).astype(int), samples - 2)
-        frac = local - k
-        return (1 - frac) * values[facet, k] + frac * values[facet, k + 1]
-
-    def _pressure_at_3d(self, s: np.ndarray) -> np.ndarray:
-        """lambda_h at contact coordinates s (2, m), each in its facet: the quadratic
-        interpolant of lambda_h's values at the facet's six P2 nodes (exact for P1 and P2
-        pressures; for the penalty's kinked one, error O(h^2) where the kink crosses)."""
-        facet, t = self.trace.locate(s)
-        nodes, basis = triangle_lagrange(2)
-        values = self.pressure(nodes)  # (n_facets, 6)
-        return np.einsum("km,km->m", values[facet].T, basis(t))
+        """lambda_h at contact coordinates ``s`` (a number along a 2D Gamma_C, (2, m) on a 3D
+        one), located in its facet (the contact boundary's ``pressure_at``)."""
+        return self.trace.pressure_at(self.pressure, s, samples)
 
     def contact_force(self, quadrature_points: int = 4) -> float:
         """The integral of lambda_h over Gamma_C (``quadrature_points`` Gauss points per

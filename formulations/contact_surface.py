@@ -1,10 +1,11 @@
-"""The contact boundary Gamma_C of a tetrahedral mesh: triangular facets, their outer normals,
-quadrature on them and the location of contact coordinates (docs/theory.md, section 14).
+"""Triangles: the contact boundary of a tetrahedral mesh (``formulations.contact_boundary``):
+triangular facets, their outer normals, quadrature on them, the location of contact
+coordinates, and nodal contact on their P1 and P2 nodes (``formulations.surface_nodes``)
+(docs/theory.md, section 14).
 
-It answers the same questions as the 2D ``ContactTrace`` (``formulations.contact``), with local
-coordinates t of shape (2, nq) in the reference triangle (x = a + t_0 (b - a) + t_1 (c - a))
-instead of (nq,) along a segment, so that a formulation written against ``points``, ``rule``,
-``integrate``, ``measure`` and ``diameter`` runs in both dimensions.
+It answers the same questions as the 2D ``ContactTrace`` (``formulations.contact_edges``), with
+local coordinates t of shape (2, nq) in the reference triangle (x = a + t_0 (b - a) + t_1 (c - a))
+instead of (nq,) along a segment.
 """
 
 from __future__ import annotations
@@ -16,10 +17,16 @@ from scipy.spatial import cKDTree
 from skfem import ElementTriP1, ElementTriP2, ElementTriP3, Mesh
 from skfem.quadrature import get_quadrature_tri
 
+from formulations.contact_boundary import ContactBoundary, register_boundary
 from scenes.base import simplex_measures, simplex_points
 
 # the reference triangle's vertices as local coordinates (2, 3)
 TRIANGLE_VERTICES = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
+# where a traction is sampled on each triangle: its corners, edge midpoints and centroid
+TRIANGLE_SAMPLES = np.array([[0, 1, 0, 0.5, 0.5, 0, 1 / 3], [0, 0, 1, 0, 0.5, 0.5, 1 / 3]])
+# the sub-triangles of a P2 triangle between its nodes (ElementTriP2's order)
+P2_CHILDREN = np.array([[0, 3, 5], [3, 1, 4], [5, 4, 2], [3, 4, 5]])
+DISC_DEGREE = 10  # 25 points per contact triangle for the area of the contact zone
 # candidate facets per located point: the nearest centroids (in contact coordinates) tried
 CANDIDATES = 8
 
@@ -61,7 +68,7 @@ def barycentric(corners: np.ndarray, s: np.ndarray) -> np.ndarray:
 
 
 @dataclass(frozen=True, eq=False)
-class ContactSurface:
+class ContactSurface(ContactBoundary):
     """Contact facets of a tetrahedral ``mesh``. ``vertices`` (3, n) are each facet's corners,
     ``normal`` (3, n) the outer unit normals, ``measure`` (n,) the areas, ``diameter`` (n,) the
     longest edges, ``coordinate`` (2, 3, n) the scene's contact coordinates of the corners and
@@ -75,11 +82,24 @@ class ContactSurface:
     diameter: np.ndarray
     coordinate: np.ndarray
     element: np.ndarray
-    dim: int = 3
+    name = "triangles"
+    dim = 3
+    kink_degree = 10  # 25 points per triangle
 
-    @property
-    def size(self) -> int:
-        return int(self.facets.size)
+    @classmethod
+    def of(cls, scene, mesh) -> ContactSurface:
+        """The contact facets of a tetrahedral mesh (in the mesh's facet order)."""
+        facets = scene.contact_facets(mesh)
+        vertices = mesh.facets[:, facets]
+        corners = mesh.p[:, vertices]  # (3, 3, n)
+        element = mesh.f2t[0, facets]
+        edges = [np.linalg.norm(corners[:, i] - corners[:, (i + 1) % 3], axis=0)
+                 for i in range(3)]
+        coordinate = np.asarray(scene.contact_coordinate(corners), dtype=float)
+        return cls(mesh=mesh, facets=facets, vertices=vertices,
+                   normal=outer_triangle_normals(mesh, corners, element),
+                   measure=simplex_measures(corners), diameter=np.max(edges, axis=0),
+                   coordinate=coordinate, element=element)
 
     def points(self, t: np.ndarray) -> np.ndarray:
         """Points at local coordinates t (2, nq) on each facet; shape (3, n, nq)."""
@@ -112,9 +132,116 @@ class ContactSurface:
 
         return np.linalg.solve(monomials(points), monomials(np.asarray(t, dtype=float)))
 
-    def integrate(self, values: np.ndarray, w: np.ndarray) -> np.ndarray:
-        """Per-facet integrals of ``values`` (n, nq) given at points with weights w."""
-        return (values * w[None, :]).sum(axis=1) * self.measure
+    @staticmethod
+    def samples(n: int) -> np.ndarray:
+        """Where a traction is sampled on each triangle: ``TRIANGLE_SAMPLES`` (``n``, the
+        count along an edge, is for edges)."""
+        return TRIANGLE_SAMPLES
+
+    @staticmethod
+    def lagrange_points(order: int) -> np.ndarray:
+        return triangle_lagrange(order)[0]
+
+    @staticmethod
+    def lagrange_basis(order: int):
+        return triangle_lagrange(order)[1]
+
+    @staticmethod
+    def lattice(order: int) -> tuple[np.ndarray, np.ndarray]:
+        """The Lagrange nodes of P1 or P2 (P3 drawn as P2) and the sub-triangles between them."""
+        nodes = triangle_lagrange(min(order, 2))[0]
+        return nodes, (np.array([[0, 1, 2]]) if order == 1 else P2_CHILDREN)
+
+    def surface_tangents(self) -> list[np.ndarray]:
+        """Two orthogonal unit directions in each facet: along its first edge, and n x that."""
+        first = self.points(np.array([[1.0], [0.0]]))[:, :, 0] - self.points(
+            np.array([[0.0], [0.0]]))[:, :, 0]
+        first /= np.linalg.norm(first, axis=0)
+        return [first, np.cross(self.normal, first, axis=0)]
+
+    # --- nodal contact (formulations.surface_nodes) ------------------------------------------
+    def nodes(self, order: int):
+        from formulations.surface_nodes import surface_nodes
+
+        return surface_nodes(self.mesh, self, order)
+
+    def node_rows(self, elasticity, nodes, directions: np.ndarray | None = None):
+        from formulations.surface_nodes import surface_rows
+
+        return surface_rows(elasticity, nodes, directions)
+
+    def node_pressures(self, nodes, reaction: np.ndarray) -> np.ndarray:
+        from formulations.surface_nodes import nodal_pressures
+
+        return nodal_pressures(self, nodes, reaction)
+
+    @staticmethod
+    def nodal_pressure(values: np.ndarray):
+        from formulations.surface_nodes import surface_pressure
+
+        return lambda t: surface_pressure(values, t)
+
+    # --- tractions and zones ----------------------------------------------------------------
+    @staticmethod
+    def shear(components: np.ndarray, tangents: list[np.ndarray]) -> np.ndarray:
+        """The shear vector sum_k sigma_k t_k (3, n, nq) from its components (n, nq, 2)."""
+        from formulations.slack_friction import shear_vectors
+
+        return shear_vectors(components, tangents)
+
+    @staticmethod
+    def slide_component(traction: np.ndarray) -> np.ndarray:
+        """The shear traction along the obstacle's slide (x): the vector's first component."""
+        return traction[0]
+
+    @staticmethod
+    def shear_vector(traction: np.ndarray) -> np.ndarray:
+        """The shear traction, a vector already (3, n, nq)."""
+        return traction
+
+    def slide_vector(self, slide: float) -> np.ndarray:
+        """The obstacle's slide w = slide e_x at every facet (3, n)."""
+        return np.outer(np.eye(3)[0] * float(slide), np.ones(self.size))
+
+    @staticmethod
+    def ordered_breaks(coordinates: np.ndarray) -> np.ndarray:
+        """A surface has no order along it: no breaks."""
+        return np.zeros(0)
+
+    def zone(self, pressure) -> tuple[float, float]:
+        """A 3D contact zone as (c - r, c + r): r the radius of the disc of the same area as
+        the part of Gamma_C where ``pressure`` > ACTIVE_FRACTION x its maximum (by
+        quadrature), c the first contact coordinate of its centroid (docs/theory.md, 14.2)."""
+        from formulations.kkt import ACTIVE_FRACTION
+
+        t, w = self.rule(DISC_DEGREE)
+        values = pressure(t)
+        pressed = values > ACTIVE_FRACTION * values.max(initial=0.0)
+        area = self.integrate(pressed.astype(float), w).sum()
+        if area <= 0:
+            return float("nan"), float("nan")
+        centre = self.integrate(pressed * self.coordinates_at(t)[0], w).sum() / area
+        radius = float(np.sqrt(area / np.pi))
+        return float(centre - radius), float(centre + radius)
+
+    def pressure_at(self, pressure, s: np.ndarray, samples: int = 17) -> np.ndarray:
+        """lambda_h at contact coordinates s (2, m), each in its facet: the quadratic
+        interpolant of its values at the facet's six P2 nodes (exact for P1 and P2 pressures;
+        for the penalty's kinked one, error O(h^2) where the kink crosses)."""
+        facet, t = self.locate(s)
+        nodes, basis = triangle_lagrange(2)
+        values = pressure(nodes)  # (n_facets, 6)
+        return np.einsum("km,km->m", values[facet].T, basis(t))
+
+    @staticmethod
+    def variation(pressure, samples: int) -> float:
+        """A surface has no order along it: NaN."""
+        return float("nan")
+
+    @staticmethod
+    def graded(marked: np.ndarray, n_elements: int) -> np.ndarray:
+        """No grading closure on a surface: ``marked`` as it is."""
+        return marked
 
     def locate(self, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The facet holding each contact coordinate s (2, m) and the local coordinates there
@@ -144,15 +271,5 @@ def outer_triangle_normals(mesh: Mesh, corners: np.ndarray, element: np.ndarray)
     return normal
 
 
-def contact_surface(scene, mesh: Mesh) -> ContactSurface:
-    """The contact facets of a tetrahedral mesh (in the mesh's facet order)."""
-    facets = scene.contact_facets(mesh)
-    vertices = mesh.facets[:, facets]
-    corners = mesh.p[:, vertices]  # (3, 3, n)
-    element = mesh.f2t[0, facets]
-    edges = [np.linalg.norm(corners[:, i] - corners[:, (i + 1) % 3], axis=0) for i in range(3)]
-    coordinate = np.asarray(scene.contact_coordinate(corners), dtype=float)
-    return ContactSurface(mesh=mesh, facets=facets, vertices=vertices,
-                          normal=outer_triangle_normals(mesh, corners, element),
-                          measure=simplex_measures(corners), diameter=np.max(edges, axis=0),
-                          coordinate=coordinate, element=element)
+register_boundary(ContactSurface, "triangles: the faces of tetrahedra on Gamma_C, P1 and P2 "
+                                  "nodes")

@@ -56,12 +56,4 @@ def inf_sup_constant(discretisation, backend: str | None = None,
 def pressure_oscillation(solution: DiscreteSolution, samples: int = 5) -> float:
     """TV(lambda_h) / (2 max lambda_h) along Gamma_C (see the module docstring); NaN on a 3D
     contact surface, which has no order along it."""
-    if solution.trace.dim != 2:
-        return float("nan")
-    values = solution.pressure(np.linspace(0.0, 1.0, samples)).ravel()  # facets in order
-    if not np.isfinite(values).all():
-        return float("nan")
-    peak = values.max(initial=0.0)
-    if peak <= 0.0:
-        return 0.0
-    return float(np.abs(np.diff(np.concatenate([[0.0], values, [0.0]]))).sum() / (2.0 * peak))
+    return solution.trace.variation(solution.pressure, samples)

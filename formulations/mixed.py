@@ -36,7 +36,8 @@ from skfem import MeshTri
 
 from formulations.base import ContactQP, DiscreteSolution, QPSolution, Residuals
 from formulations.cells import family_of
-from formulations.contact import contact_trace, gauss_legendre
+from formulations.contact import contact_trace
+from formulations.contact_boundary import gauss_legendre
 from formulations.contact_patches import (
     free_normal_vertices,
     patch_sizes,

@@ -20,10 +20,10 @@ import numpy as np
 from scipy import sparse
 
 from formulations.base import FrictionRows, FrictionState
-from formulations.contact import gauss_legendre
+from formulations.contact_boundary import gauss_legendre, tangent_frame
 from formulations.evaluation import drop_roundoff, evaluate_on_trace
 from formulations.friction_state import friction_state
-from formulations.nodal_friction import interleaved, slide_components, tangent_frame
+from formulations.nodal_friction import interleaved, slide_components
 
 
 def tangential_rows(elasticity, trace, weights: sparse.csr_matrix,

@@ -182,8 +182,7 @@ def discretise(scene: Scene, mesh: MeshTri, theta: float = 1.0,
         return discrete_solution(
             "nitsche", elasticity, trace, replace(answer, multipliers=pressure_at_points),
             residuals, status, reason, u_free=u_free, pressure=pressure,
-            multiplier_breaks=(np.append(trace.coordinate[0], trace.coordinate[1, -1])
-                               if trace.dim == 2 else np.zeros(0)),
+            multiplier_breaks=trace.facet_breaks(),
             active_constraints=int((pressure_at_points > 0).sum()), details=details,
             consistency=consistency_term(system, trace, u_free, t, residual),
             friction=None if friction is None else nitsche_friction_state(

@@ -107,7 +107,7 @@ def shear_function(scene, elasticity, trace, gamma_facet: np.ndarray, u_free: np
 
     def shear(tt):
         projected = parts(tt)[1]
-        return projected[..., 0] if trace.dim == 2 else shear_vectors(projected, tangents)
+        return trace.shear(projected, tangents)
 
     return shear
 

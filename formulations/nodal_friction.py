@@ -14,20 +14,9 @@ import numpy as np
 from scipy import sparse
 
 from formulations.base import FrictionRows, FrictionState
+from formulations.contact_edges import nodal_interpolant
 from formulations.contact_surface import triangle_lagrange
 from formulations.friction_state import friction_state
-
-
-def tangent_frame(normal: np.ndarray) -> list[np.ndarray]:
-    """Unit tangents at every node, orthogonal to the normals (d, m): in 2D t = (-n_2, n_1)
-    (n turned by +90 degrees); in 3D t_1 = n x e_k / |n x e_k| with e_k the axis least aligned
-    with n, and t_2 = n x t_1."""
-    if normal.shape[0] == 2:
-        return [np.array([-normal[1], normal[0]])]
-    axis = np.eye(3)[:, np.argmin(np.abs(normal), axis=0)]
-    first = np.cross(normal, axis, axis=0)
-    first /= np.linalg.norm(first, axis=0)
-    return [first, np.cross(normal, first, axis=0)]
 
 
 def interleaved(rows: list[sparse.csr_matrix]) -> sparse.csr_matrix:
@@ -60,15 +49,6 @@ def friction_rows(scene, nodes, T, frame: list[np.ndarray]) -> FrictionRows | No
                         shift=slide_components(law.slide, frame), block=len(frame))
 
 
-def facet_interpolant(values: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """The piecewise linear interpolant along each 2D facet of its p + 1 nodal ``values``
-    (n_facets, p + 1) at local coordinates t: (n_facets, len(t))."""
-    pieces = values.shape[1] - 1
-    x = np.clip(np.asarray(t, dtype=float), 0.0, 1.0) * pieces
-    k = np.minimum(np.floor(x).astype(int), pieces - 1)
-    return values[:, k] + (values[:, k + 1] - values[:, k]) * (x - k)[None, :]
-
-
 def nodal_friction(friction: FrictionRows, u_free: np.ndarray, reactions: np.ndarray,
                    tangential: np.ndarray, nodes, coordinate: np.ndarray,
                    frame: list[np.ndarray]) -> FrictionState:
@@ -78,7 +58,7 @@ def nodal_friction(friction: FrictionRows, u_free: np.ndarray, reactions: np.nda
     shear = -tangential / np.repeat(nodes.weight, friction.block)
     if friction.block == 1:
         def traction(t):
-            return facet_interpolant(shear[nodes.facet_rows], t)
+            return nodal_interpolant(shear[nodes.facet_rows], t)
     else:
         vectors = sum(shear.reshape(-1, 2)[:, k] * frame[k] for k in range(2))  # (3, m)
         basis = triangle_lagrange(nodes.facet_rows.shape[1] // 3)[1]

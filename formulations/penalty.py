@@ -166,8 +166,8 @@ def discretise(scene: Scene, mesh: MeshTri, epsilon_0: float = DEFAULT_EPSILON_0
     gap_h = gap_interpolant(scene, trace, order)
     gap = gap_h(t)
     P = elasticity.restrict(normal_trace_matrix(elasticity.basis, trace, t))
-    if trace.dim == 3:  # round-off of the functions that vanish on the facet, and normal
-        P = drop_roundoff(P)  # components it lacks: not columns of the Schur set
+    # round-off of the functions that vanish on the facet, and normal components it lacks: not
+    P = drop_roundoff(P)  # columns of the Schur set
     epsilon = epsilon_0 * trace.diameter / (order**2 * young)
     # per Gauss point: eps, and Gauss weight x facet measure (its share of Gamma_C)
     row_epsilon, row_length = np.repeat(epsilon, nq), np.tile(w, nf) * np.repeat(trace.measure,
@@ -199,9 +199,7 @@ def discretise(scene: Scene, mesh: MeshTri, epsilon_0: float = DEFAULT_EPSILON_0
         penetrating = int((penetration_at_points > 0).sum())
         return discrete_solution(
             "penalty", elasticity, trace, answer, residuals, status, reason, u_free=u_free,
-            pressure=pressure, multiplier_breaks=(
-                np.append(trace.coordinate[0], trace.coordinate[1, -1]) if trace.dim == 2
-                else np.zeros(0)),
+            pressure=pressure, multiplier_breaks=trace.facet_breaks(),
             active_constraints=penetrating,
             pressure_mismatch=mismatch,
             details=PenaltyDetails(epsilon_0=epsilon_0, epsilon=epsilon, slacks=slacks),

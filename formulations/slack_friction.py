@@ -24,7 +24,7 @@ from scipy import sparse
 
 from formulations.base import ContactQP, FrictionRows
 from formulations.evaluation import evaluate_on_trace
-from formulations.nodal_friction import interleaved, slide_components, tangent_frame
+from formulations.nodal_friction import interleaved, slide_components
 
 
 def contact_tangent(trace) -> np.ndarray:
@@ -34,8 +34,8 @@ def contact_tangent(trace) -> np.ndarray:
 
 def contact_tangents(trace) -> list[np.ndarray]:
     """The tangents of every contact facet: t (2D), or the frame t_1, t_2 of
-    ``nodal_friction.tangent_frame`` (3D)."""
-    return [contact_tangent(trace)] if trace.dim == 2 else tangent_frame(trace.normal)
+    ``contact_boundary.tangent_frame`` (3D)."""
+    return trace.tangents()
 
 
 def tangential_rows(elasticity, trace, t: np.ndarray) -> sparse.csr_matrix:

@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 from scipy import sparse
 
-from formulations.contact import TraceNodes
+from formulations.contact_boundary import TraceNodes
 from formulations.contact_surface import triangle_lagrange, triangle_rule
 from formulations.kkt import ACTIVE_FRACTION
 from formulations.nonnegative_fit import bounded_least_squares

@@ -16,8 +16,7 @@ def solution_difference(discretisation, solution, other) -> tuple[float, float]:
     or pressure (nothing touches) is not divided by zero."""
     K = discretisation.elasticity.K
     du = solution.u - other.u
-    t = (np.linspace(0.0, 1.0, PRESSURE_SAMPLES) if discretisation.trace.dim == 2
-         else discretisation.trace.rule(2)[0])  # 3D: three points inside each facet
+    t = discretisation.trace.samples(PRESSURE_SAMPLES)
     lam, lam_other = solution.pressure(t), other.pressure(t)
     young, gap = discretisation.objective_scale, discretisation.gap_scale
     scale = max(np.sqrt(other.u @ K @ other.u), np.sqrt(young) * gap, 1e-300)

@@ -19,7 +19,7 @@ from skfem import Basis
 
 from bench.measure.contact import contact_zone, zone_error
 from formulations import DiscreteSolution
-from formulations.contact import gauss_legendre
+from formulations.contact_boundary import gauss_legendre
 from formulations.elasticity import stress_from_gradient, stress_tensor_from_gradient
 from formulations.friction_state import traction_size
 

@@ -17,7 +17,7 @@ from bench.sequence.columns import (
     friction_columns,
     solver_columns,
 )
-from bench.sequence.marking import MARKINGS, check_marking, grade_contact_trace, mark
+from bench.sequence.marking import MARKINGS, check_marking, mark
 from bench.sequence.memory import MemoryRoute, available_gib, dense_block_route, memory_route
 from bench.sequence.options import option
 from bench.sequence.rows import ResultRow, identity_columns
@@ -147,10 +147,8 @@ def refinement(mesh: MeshTri, sol, est, config: LoopConfig) -> Plan:
     if config.strategy == "uniform":
         return family.refinement(mesh)
     marked = mark(est.indicators, config.marking, config.theta)
-    if config.grade_contact and sol.trace.dim == 2:  # a 2:1 grading along a 1D Gamma_C
-        trace = sol.trace
-        marked = grade_contact_trace(marked, trace.length, trace.element, trace.coordinate,
-                                     mesh.t.shape[1])
+    if config.grade_contact:  # a 2:1 grading along Gamma_C, where it has an order
+        marked = sol.trace.graded(marked, mesh.t.shape[1])
     return family.refinement(mesh, marked)
 
 

@@ -38,25 +38,3 @@ def mark(indicators: np.ndarray, marking: str, theta: float) -> np.ndarray:
     return doerfler(indicators, theta) if marking == "doerfler" else maximum(indicators, theta)
 
 
-def grade_contact_trace(marked: np.ndarray, length: np.ndarray, element: np.ndarray,
-                        coordinate: np.ndarray, n_elements: int, ratio: float = 2.0) -> np.ndarray:
-    """Add to ``marked`` the elements of contact facets that would otherwise be more than
-    ``ratio`` times longer than a neighbouring contact facet after refinement (a 2:1 grading
-    closure along Gamma_C; facets in trace order, ``coordinate`` (2, n) their end points).
-
-    Why: a multiplier segment must be at least twice its longest facet (h/H <= 1/2), so an
-    unrefined long facet next to a refined contact zone forces a long segment over it, and the
-    estimator never marks that facet (nothing is wrong there): the mixed method's multiplier
-    mesh would lag the refinement (seen on the Hertz scene). Refining such facets is cheap and
-    harmless for every formulation."""
-    flagged = np.zeros(n_elements, dtype=bool)
-    flagged[marked] = True
-    joined = np.isclose(coordinate[1, :-1], coordinate[0, 1:])  # neighbours really touch
-    while True:
-        after = np.where(flagged[element], 0.5 * length, length)
-        left = np.where(np.r_[False, joined], np.r_[np.inf, after[:-1]], np.inf)
-        right = np.where(np.r_[joined, False], np.r_[after[1:], np.inf], np.inf)
-        too_long = (after > ratio * np.minimum(left, right) * (1 + 1e-9)) & ~flagged[element]
-        if not too_long.any():
-            return np.flatnonzero(flagged)
-        flagged[element[too_long]] = True

@@ -63,6 +63,7 @@ class CellFamily:
     centroid_rule: tuple[np.ndarray, np.ndarray] = (np.zeros((2, 1)), np.ones(1))
     adaptive: bool = True  # meshes refine where marked (else uniform only)
     tensor_product: bool = False  # Q_p on mapped squares or cubes (else P_p on simplices)
+    contact_boundary: str = "edges"  # the kind of facet Gamma_C is made of (a registered one)
     # the registered formulations run on these cells and answer for friction themselves (else
     # a scene with friction is refused here: the family's own formulations do not model it)
     friction: bool = False
@@ -88,8 +89,14 @@ class CellFamily:
         return None
 
     def why_no_contact(self) -> str | None:
-        """Why the formulations cannot pose contact on this family's meshes, or None."""
-        return None
+        """Why the formulations cannot pose contact on this family's meshes (its contact
+        boundary is not a registered one), or None."""
+        from formulations.contact_boundary import CONTACT_BOUNDARIES
+
+        if self.contact_boundary in CONTACT_BOUNDARIES.names():
+            return None
+        return (f"the contact boundary of {self.shape} ({self.contact_boundary}) is not "
+                f"built; contact boundaries: {', '.join(CONTACT_BOUNDARIES.names())}")
 
     # --- meshes -----------------------------------------------------------------------------
     def starting_mesh(self, scene):

@@ -20,13 +20,10 @@ class Hexahedra(CellFamily):
     elements = {1: ElementHex1}
     centroid_rule = (np.full((3, 1), 0.5), np.array([1.0]))  # the unit cube
     adaptive = False
+    contact_boundary = "quadrilaterals"
 
     def why_no_mesh(self, scene) -> str | None:
         return not_a_grid(scene, self.dim, "hexahedral")
-
-    def why_no_contact(self) -> str | None:
-        return ("the contact surface of hexahedra (quadrilateral faces) is not built; "
-                "`python -m bench study --cell hex` runs the VI on them")
 
     def starting_mesh(self, scene) -> MeshHex:
         why = self.why_no_mesh(scene)

@@ -18,6 +18,7 @@ class Tetrahedra(Triangles):
     # and estimators say for themselves whether they model it (register_formulation(...,
     # friction=(2, 3)))
     friction = True
+    contact_boundary = "triangles"
     mesh_type = MeshTet1
     elements = {1: ElementTetP1, 2: ElementTetP2}
     centroid_rule = (np.full((3, 1), 1.0 / 4.0), np.array([1.0 / 6.0]))  # weight = the volume

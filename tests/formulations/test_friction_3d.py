@@ -12,7 +12,7 @@ from bench.measure.difference import solution_difference
 from bench.sequence.loop import LoopConfig, run_sequence
 from estimators.base import ESTIMATORS
 from formulations import get_formulation, solve
-from formulations.nodal_friction import tangent_frame
+from formulations.contact_boundary import tangent_frame
 from formulations.registry import FORMULATIONS
 from formulations.solvers.disc import disc_ssn
 from scenes import get_scene

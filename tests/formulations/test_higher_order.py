@@ -9,7 +9,8 @@ from skfem.helpers import dot
 from bench.measure.difference import solution_difference
 from conftest import square_scene
 from formulations import get_formulation, solve
-from formulations.contact import contact_trace, gauss_legendre
+from formulations.contact import contact_trace
+from formulations.contact_boundary import gauss_legendre
 from formulations.diagnostics import inf_sup_constant
 from formulations.elasticity import assemble_elasticity, count_free_dofs, vector_element
 from formulations.evaluation import normal_trace_matrix

@@ -8,7 +8,6 @@ import pytest
 
 from conftest import square_scene
 from formulations import get_formulation, solve
-from formulations.cells import family_for
 from scenes import get_scene
 from scenes.quad_hierarchy import QuadHierarchy, coarse_edges
 

@@ -4,7 +4,7 @@
 import numpy as np
 import pytest
 
-from formulations.contact_surface import contact_surface, triangle_rule
+from formulations.contact_surface import ContactSurface, triangle_rule
 from formulations.surface_nodes import (
     BERNSTEIN_MOMENTS,
     lagrange_values,
@@ -18,7 +18,7 @@ from scenes import get_scene
 def _surface():
     scene = get_scene("free-boundary-3d")
     mesh = scene.mesh.refined(1)
-    trace = contact_surface(scene, mesh)
+    trace = ContactSurface.of(scene, mesh)
     return trace, surface_nodes(mesh, trace, 2)
 
 

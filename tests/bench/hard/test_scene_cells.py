@@ -22,7 +22,7 @@ def test_a_hard_scene_runs_on_quadrilaterals_with_every_solver_agreeing():
 def test_hexahedra_are_one_row_that_says_why_and_judge_nothing():
     records = scene_case("grazing-3d", "quad")
     assert len(records) == 1 and records[0]["status"] == "skipped"
-    assert "contact surface of hexahedra" in records[0]["reason"]
+    assert "contact boundary of hexahedra" in records[0]["reason"]
     assert check_expected(pd.DataFrame(records), load_expected().get("hard", [])) == []
 
 

@@ -66,4 +66,4 @@ def test_a_scene_whose_mesh_is_not_a_tensor_grid_has_no_quadrilaterals():
 def test_hexahedra_refine_uniformly_only_and_say_why_they_pose_no_contact():
     family = family_for("quad", 3)
     assert "uniform only" in family.why_not(get_scene("paper-3d"), "adaptive")
-    assert "contact surface of hexahedra" in family.why_not(get_scene("paper-3d"), "uniform")
+    assert "contact boundary of hexahedra" in family.why_not(get_scene("paper-3d"), "uniform")

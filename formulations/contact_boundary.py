@@ -1,0 +1,153 @@
+"""The contact boundary Gamma_C as a registered unit (docs/theory.md, sections 1 and 14).
+
+A contact boundary is the kind of facet Gamma_C is made of: edges of a 2D body, triangles of a
+tetrahedral one. Each kind is one class registered here (``register_boundary``) and declared by
+the cell families whose meshes have it (``CellFamily.contact_boundary``). Its instances hold one
+mesh's contact facets in order and answer every question a formulation, an estimator or a
+measurement asks of them: the reference facet and its quadrature, the Lagrange nodes and their
+lumped surface mass, the normals and tangents, the constraint rows of nodal contact, the
+pressure from nodal reactions, where a contact coordinate lies, the traction's samples and the
+contact zone's measure. Code outside the classes never asks which kind it holds.
+
+Local coordinates t have shape (nq,) on an edge (a point of [0, 1]) and (2, nq) on a triangle
+(x = a + t_0 (b - a) + t_1 (c - a)); a contact coordinate is a number along a 2D Gamma_C and a
+pair (2,) on a 3D one.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from scenes.registry import Registry
+
+CONTACT_BOUNDARIES = Registry("contact boundary")
+
+
+def gauss_legendre(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """n-point Gauss-Legendre rule on [0, 1]: points t and weights w (sum w = 1)."""
+    x, w = np.polynomial.legendre.leggauss(n)
+    return 0.5 * (x + 1.0), 0.5 * w
+
+
+def lagrange_nodes(order: int) -> np.ndarray:
+    """The equispaced nodes k / p (k = 0..p) on [0, 1] of the trace of a P_p Lagrange element
+    on one facet."""
+    return np.linspace(0.0, 1.0, order + 1)
+
+
+def lagrange_basis(nodes: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """The 1D Lagrange polynomials on ``nodes`` at t; shape (len(nodes), len(t))."""
+    t = np.asarray(t, dtype=float)
+    out = np.ones((nodes.size, t.size))
+    for k in range(nodes.size):
+        for j in range(nodes.size):
+            if j != k:
+                out[k] *= (t - nodes[j]) / (nodes[k] - nodes[j])
+    return out
+
+
+def lagrange_basis_1d(order: int, t: np.ndarray) -> np.ndarray:
+    """The 1D Lagrange polynomials of degree p on the nodes ``lagrange_nodes(p)`` at t;
+    shape (p + 1, len(t))."""
+    return lagrange_basis(lagrange_nodes(order), t)
+
+
+def facet_coordinates(coordinate: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """Contact coordinates at local coordinates t in [0, 1] of facets whose end points are
+    ``coordinate`` (2, n); shape (n, len(t)) (affine along a facet of a straight Gamma_C)."""
+    s0, s1 = coordinate
+    return s0[:, None] + (s1 - s0)[:, None] * np.asarray(t)[None, :]
+
+
+@dataclass(frozen=True, eq=False)
+class TraceNodes:
+    """The Lagrange nodes of the displacement on Gamma_C: the facets' vertices, then the nodes
+    inside them (2D: p - 1 per edge; 3D P2: the edges' midpoints). ``facet_rows`` (n_facets,
+    k) gives, per facet, the row of each of its nodes (2D: in order of t = k / p; 3D: in
+    ElementTriP2's order)."""
+
+    points: np.ndarray        # (d, m)
+    normal: np.ndarray        # (d, m) unit, measure-weighted mean at a vertex
+    weight: np.ndarray        # (m,) int_{Gamma_C} phi_i ds (lumped boundary mass)
+    facet_rows: np.ndarray    # (n_facets, k)
+    vertices: np.ndarray      # mesh vertex of each of the first rows
+    edges: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))  # 3D P2: then
+    # the mesh edge of each midpoint row
+
+
+def tangent_frame(normal: np.ndarray) -> list[np.ndarray]:
+    """Unit tangents at every point, orthogonal to the normals (d, m): in 2D t = (-n_2, n_1)
+    (n turned by +90 degrees); in 3D t_1 = n x e_k / |n x e_k| with e_k the axis least aligned
+    with n, and t_2 = n x t_1."""
+    if normal.shape[0] == 2:
+        return [np.array([-normal[1], normal[0]])]
+    axis = np.eye(3)[:, np.argmin(np.abs(normal), axis=0)]
+    first = np.cross(normal, axis, axis=0)
+    first /= np.linalg.norm(first, axis=0)
+    return [first, np.cross(normal, first, axis=0)]
+
+
+class ContactBoundary:
+    """What every contact boundary answers from its fields (``mesh``, ``facets``,
+    ``vertices``, ``normal``, ``measure``, ``diameter``, ``coordinate``, ``element``); the
+    kinds fill in the rest."""
+
+    name: str = ""
+    dim: int = 2  # of the body
+    # quadrature degree for integrands with kinks inside a facet (w = (g - u_hn)_- where u_hn
+    # crosses g): many points on an edge; on a triangle what a 3D estimate can afford
+    kink_degree: int = 19
+
+    @property
+    def size(self) -> int:
+        return int(self.facets.size)
+
+    def integrate(self, values: np.ndarray, w: np.ndarray) -> np.ndarray:
+        """Per-facet integrals of ``values`` (n, nq) given at points with weights w."""
+        return (values * w[None, :]).sum(axis=1) * self.measure
+
+    def facet_breaks(self) -> np.ndarray:
+        """Where a pressure piecewise on the facets may break (``ordered_breaks`` of the facets'
+        ends)."""
+        return self.ordered_breaks(np.append(self.coordinate[0], self.coordinate[1, -1]))
+
+    def tangents(self) -> list[np.ndarray]:
+        """The friction tangents of every facet (``tangent_frame`` of the normals)."""
+        return tangent_frame(self.normal)
+
+    def at_points(self, values: np.ndarray, nq: int) -> np.ndarray:
+        """Per-facet ``values`` (k, n) repeated for each of nq points: (k, n nq)."""
+        return np.repeat(values, nq, axis=1)
+
+    def gap_derivatives(self, scene, t: np.ndarray, step: float) -> list[np.ndarray]:
+        """d/dtau g (n, nq) at local coordinates t along each of ``surface_tangents()``, by
+        central differences of ``step`` times the facet's diameter."""
+        x = self.points(t)
+        h = step * self.diameter[None, :, None]
+        return [(scene.gap(x + h * tau[:, :, None]) - scene.gap(x - h * tau[:, :, None]))
+                / (2 * h[0]) for tau in self.surface_tangents()]
+
+    def lagrange_values(self, values: np.ndarray, order: int):
+        """The P_order interpolant on every facet of its nodal ``values`` (n, k) at the nodes
+        ``lagrange_points(order)``, as a function of local coordinates t: (n, nq)."""
+        basis = self.lagrange_basis(order)
+        return lambda t: values @ basis(np.asarray(t, dtype=float))
+
+    def interpolant_of(self, function, order: int):
+        """The P_order Lagrange interpolant of ``function(x)`` (x (d, ...)) on every facet."""
+        nodes = self.lagrange_points(order)
+        points = self.points(nodes)
+        values = np.asarray(function(points.reshape(points.shape[0], -1)), dtype=float)
+        return self.lagrange_values(values.reshape(self.size, -1), order)
+
+
+def register_boundary(cls, description: str):
+    """Register the contact boundary class ``cls`` under its ``name`` (one line per kind)."""
+    return CONTACT_BOUNDARIES.register(cls.name, description, dim=cls.dim)(cls)
+
+
+def boundary_kind(name: str):
+    """The registered class of contact boundary ``name``; ValueError naming the built ones."""
+    return CONTACT_BOUNDARIES.get(name)
