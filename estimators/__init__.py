@@ -13,6 +13,7 @@ from estimators import (  # noqa: F401  (register themselves)
     nitsche_residual,
     quad_residual,
     residual,
+    residual_3d,
 )
 from estimators.base import (
     Estimate,

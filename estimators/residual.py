@@ -23,7 +23,6 @@ from skfem import Basis, ElementTetP0, ElementTriP0
 
 from estimators.base import Estimate, combine, register_estimator
 from estimators.contact_terms import contact_terms
-from estimators.residual_3d import face_residuals_3d, stress_divergence_3d
 from formulations import DiscreteSolution
 from formulations.contact_boundary import gauss_legendre
 from formulations.contact_edges import outer_normals
@@ -64,9 +63,10 @@ def stress_divergence(solution: DiscreteSolution, basis: Basis) -> np.ndarray:
     return div
 
 
-def element_residual(scene, solution: DiscreteSolution) -> np.ndarray:
+def element_residual(scene, solution: DiscreteSolution, divergence=None) -> np.ndarray:
     """(h_T / p)^2 ||f + div sigma(u_h)||_T^2 per triangle or tetrahedron (div sigma(u_h) = 0
-    for P1)."""
+    for P1); ``divergence(solution, basis)`` gives div sigma(u_h) at the basis's points
+    (default: ``stress_divergence``, on triangles)."""
     elasticity = solution.elasticity
     mesh, order = elasticity.mesh, elasticity.order
     if scene.body_force is None and order == 1:
@@ -79,8 +79,7 @@ def element_residual(scene, solution: DiscreteSolution) -> np.ndarray:
     if scene.body_force is not None:
         residual += scene.body_force(np.asarray(basis.global_coordinates()))
     if order > 1:
-        residual += (stress_divergence(solution, basis) if d == 2
-                     else stress_divergence_3d(solution, basis.dx.shape[1]))
+        residual += (divergence or stress_divergence)(solution, basis)
     norm2 = ((residual**2).sum(axis=0) * basis.dx).sum(axis=1)
     return (element_diameters(mesh) / order) ** 2 * norm2
 
@@ -151,9 +150,7 @@ def estimate(scene, solution: DiscreteSolution) -> Estimate:
 
 
 def volume_terms(scene, solution: DiscreteSolution) -> np.ndarray:
-    """eta_0^2 per element: element residuals and edge (2D) or face (3D) residuals, over E."""
+    """eta_0^2 per triangle: element and edge residuals, over E (tetrahedra:
+    ``estimators.residual_3d``)."""
     young = float(scene.material.young_modulus)
-    if solution.trace.dim == 3:
-        return (element_residual(scene, solution)
-                + face_residuals_3d(scene, solution)) / young
     return (element_residual(scene, solution) + edge_residuals(scene, solution)) / young

@@ -8,7 +8,8 @@ R_F = 1/2 ||[sigma_n(u_h)]||_F inside, ||sigma_n(u_h) - q||_F on Gamma_N and
 without friction); h_F is the face's diameter.
 For P1 and P2 on affine tetrahedra sigma(u_h) is of degree p - 1, so div sigma(u_h) is 0 (P1)
 or constant per element (P2, ``stress_divergence_3d``); the element residual itself is
-``estimators.residual.element_residual``, the same in both dimensions.
+``estimators.residual.element_residual``, the same in both dimensions. Registered as the
+tetrahedral variants of ``residual`` and ``nitsche-residual``.
 """
 
 from __future__ import annotations
@@ -16,6 +17,10 @@ from __future__ import annotations
 import numpy as np
 from skfem import ElementTetP1
 
+from estimators.base import Estimate, combine, register_cell_variant
+from estimators.contact_terms import contact_terms
+from estimators.nitsche_residual import nitsche_estimate
+from estimators.residual import element_residual
 from formulations import DiscreteSolution
 from formulations.contact_surface import outer_triangle_normals, triangle_rule
 from formulations.elasticity import stress_tensor_from_gradient
@@ -118,3 +123,22 @@ def face_residuals_3d(scene, solution: DiscreteSolution) -> np.ndarray:
     r_f = normal_part + np.sqrt(trace.integrate(snt2, w))
     out += np.bincount(trace.element, trace.diameter / order * r_f**2, n_elements)
     return out
+
+
+def volume_terms_3d(scene, solution: DiscreteSolution) -> np.ndarray:
+    """eta_0^2 per tetrahedron: element and face residuals, over E."""
+    def divergence(solution, basis):
+        return stress_divergence_3d(solution, basis.dx.shape[1])
+
+    return (element_residual(scene, solution, divergence)
+            + face_residuals_3d(scene, solution)) / float(scene.material.young_modulus)
+
+
+@register_cell_variant("residual", "tet")
+def residual_estimate_3d(scene, solution: DiscreteSolution) -> Estimate:
+    return combine("residual", volume_terms_3d(scene, solution), contact_terms(scene, solution))
+
+
+@register_cell_variant("nitsche-residual", "tet")
+def nitsche_residual_estimate_3d(scene, solution: DiscreteSolution) -> Estimate:
+    return nitsche_estimate(volume_terms_3d(scene, solution))

@@ -19,7 +19,6 @@ from skfem import Basis
 
 from bench.measure.contact import contact_zone, zone_error
 from formulations import DiscreteSolution
-from formulations.contact_boundary import gauss_legendre
 from formulations.elasticity import stress_from_gradient, stress_tensor_from_gradient
 from formulations.friction_state import traction_size
 
@@ -48,13 +47,9 @@ def pressure_error(solution: DiscreteSolution, true_pressure, trace=None) -> flo
     """||lambda - lambda_h||_{0,Gamma_C} on the facets of ``trace`` (the finer one; default
     u_h's), with ``true_pressure(s)`` a function of the contact coordinate."""
     trace = solution.trace if trace is None else trace
-    if trace.dim == 3:  # on u_h's own facets: lambda_h at the rule's points directly
-        t, w = trace.rule(2 * PRESSURE_POINTS - 1)
-        diff = true_pressure(trace.coordinates_at(t)) - solution.pressure(t)
-        return float(np.sqrt(trace.integrate(diff**2, w).sum()))
-    t, w = gauss_legendre(PRESSURE_POINTS)
-    s = trace.coordinates_at(t)
-    diff = true_pressure(s) - solution.pressure_at(s.ravel()).reshape(s.shape)
+    t, w = trace.rule(2 * PRESSURE_POINTS - 1)
+    values = solution.pressure_at(trace.row_coordinates(t)).reshape(trace.size, -1)
+    diff = true_pressure(trace.coordinates_at(t)) - values
     return float(np.sqrt(trace.integrate(diff**2, w).sum()))
 
 

@@ -25,7 +25,6 @@ import numpy as np
 
 from bench.measure.contact import contact_zone
 from formulations import DiscreteSolution
-from formulations.contact_surface import triangle_lagrange
 from formulations.kkt import ACTIVE_FRACTION
 
 # P2 triangles cut at their edge midpoints (scikit-fem's order: vertices, then 01, 12, 02)
@@ -62,16 +61,9 @@ def _nodal_squares(solution):
     facets that hold a node: lambda_h may jump between facets, and a node on the edge of a
     piecewise constant lambda_h is not pressed) and which nodes are pressed."""
     trace, order = solution.trace, max(solution.elasticity.order, 1)
-    if trace.dim == 2:
-        t = np.linspace(0.0, 1.0, order + 1)
-        coords = trace.coordinates_at(t)[None]                       # (1, n, nq)
-        local = np.array([[k, k + 1] for k in range(order)])
-    else:
-        t = triangle_lagrange(min(order, 2))[0]
-        coords = trace.coordinates_at(t)                             # (2, n, nq)
-        local = np.array([[0, 1, 2]]) if order == 1 else P2_CHILDREN
+    t, local = trace.lattice(order)
     values = solution.pressure(t)                                    # (n, nq)
-    flat = coords.reshape(coords.shape[0], -1)
+    flat = trace.row_coordinates(t).reshape(-1, values.size)         # (1 or 2, n nq)
     scale = np.abs(flat).max() + 1.0
     _, first, index = np.unique(np.round(flat / scale, 11), axis=1, return_index=True,
                                 return_inverse=True)

@@ -15,9 +15,7 @@ from bench.sequence.loop import run_sequence
 from formulations.friction_state import traction_size
 
 PEAK_SAMPLES = 20001  # points over +-b where the predicted peak shear is sought
-FACET_SAMPLES = np.linspace(0.0, 1.0, 9)  # where sigma_t,h is sampled on each facet
-# on each contact triangle (3D): its corners, edge midpoints and centroid
-TRIANGLE_SAMPLES = np.array([[0, 1, 0, 0.5, 0.5, 0, 1 / 3], [0, 0, 1, 0, 0.5, 0.5, 1 / 3]])
+FACET_SAMPLES = 9  # where sigma_t,h is sampled on each facet (the contact boundary's samples)
 FORCE_POINTS = 4  # Gauss points per facet for P and Q (exact for cubic tractions)
 
 
@@ -55,9 +53,8 @@ def compare(scene, solution) -> dict:
     t, w = trace.rule(2 * FORCE_POINTS - 1)
     normal_force = solution.contact_force(FORCE_POINTS)
     traction = state.traction(t)  # in 3D a vector: Q is its x component (the slide's)
-    tangential_force = float(trace.integrate(traction if trace.dim == 2 else traction[0],
-                                             w).sum())
-    peak = traction_size(state.traction(FACET_SAMPLES if trace.dim == 2 else TRIANGLE_SAMPLES))
+    tangential_force = float(trace.integrate(trace.slide_component(traction), w).sum())
+    peak = traction_size(state.traction(trace.samples(FACET_SAMPLES)))
     predicted = scene.predict_stick(normal_force, tangential_force)
     start, end = state.zone("stick")
     b = predicted.half_width
