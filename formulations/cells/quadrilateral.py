@@ -89,13 +89,22 @@ class Quadrilaterals(CellFamily):
 
     def multiplier_groups(self, mesh, trace, h_over_H: float) -> np.ndarray:
         """The seed's T_CH: each contact edge's ancestor log2(H/h) levels up in the hierarchy
-        (one level for h/H = 1/2), numbered along Gamma_C (docs/theory.md, section 15.3)."""
+        (one level for h/H = 1/2), numbered along Gamma_C (docs/theory.md, section 15.3). An
+        ancestor that holds a finer group (a leaf too coarse to go the whole way up, next to
+        refined ones) takes that group in: segments are runs along Gamma_C, never nested."""
         levels_up = max(0, int(round(-np.log2(h_over_H))))
         groups = coarse_edges(mesh.hierarchy, trace.element, trace.normal, levels_up)
-        _, first, inverse = np.unique(groups, return_index=True, return_inverse=True)
-        rank = np.empty(first.size, dtype=np.int64)
-        rank[np.argsort(first, kind="stable")] = np.arange(first.size)
-        return rank[inverse]
+        _, inverse = np.unique(groups, return_inverse=True)
+        s0, s1 = trace.coordinate
+        low = np.full(inverse.max(initial=-1) + 1, np.inf)
+        high = np.full(low.size, -np.inf)
+        np.minimum.at(low, inverse, s0)
+        np.maximum.at(high, inverse, s1)
+        # a new segment where a facet's group starts past everything before it reaches
+        reach = np.maximum.accumulate(high[inverse])
+        tol = 1e-12 * (np.abs(trace.coordinate).max(initial=0.0) + 1.0)
+        new = np.r_[True, low[inverse][1:] >= reach[:-1] - tol]
+        return np.cumsum(new) - 1
 
     def conforming(self, values: np.ndarray, basis) -> np.ndarray:
         P, kept = prolongation(basis.mesh.hierarchy, basis)

@@ -8,6 +8,7 @@ import pytest
 
 from conftest import square_scene
 from formulations import get_formulation, solve
+from formulations.cells import family_for
 from scenes import get_scene
 from scenes.quad_hierarchy import QuadHierarchy, coarse_edges
 
@@ -105,3 +106,26 @@ def test_the_inf_sup_constant_levels_off_for_h_over_H_at_most_one_half():
         levels = np.array(beta[up])
         assert levels[-1] > 0.5  # bounded below ...
         assert abs(levels[-1] / levels[-2] - 1) < 0.03  # ... and levelled off (within 1 %)
+
+
+def test_multiplier_segments_are_runs_where_a_coarse_leaf_meets_refined_ones():
+    """Two levels up from the leaves of a graded bottom edge: a leaf that cannot go the whole
+    way up keeps its root edge, which holds the refined leaves' groups too; the segments
+    must still be runs along Gamma_C, one per multiplier (a nested group once gave the
+    mixed method more segment breaks than rows)."""
+    scene = get_scene("paper")
+    hierarchy = QuadHierarchy.from_tensor(np.linspace(-1, 1, 3), np.linspace(-1, 1, 3))
+    mesh = hierarchy.mesh()
+    # the bottom-left root cell to level 1, its corner to level 2, then the level-2 cell on
+    # [-0.75, -0.5] to level 3: along y = -1, levels 2, 3, 3, 1 under one root edge
+    for centre in ((-0.5, -0.5), (-0.75, -0.75), (-0.625, -0.875)):
+        centroids = mesh.p[:, mesh.t].mean(axis=1)
+        cell = np.argmin(np.linalg.norm(centroids - np.array(centre)[:, None], axis=0))
+        mesh = mesh.hierarchy.refined([cell]).mesh()
+    family = family_for("quad", 2)
+    trace = get_formulation("mixed")(scene, mesh, h_over_H=0.25).trace
+    segment = family.multiplier_groups(mesh, trace, 0.25)
+    runs = np.flatnonzero(np.diff(np.r_[-1, segment]))
+    assert np.all(np.diff(segment) >= 0) and runs.size == np.unique(segment).size
+    mixed = get_formulation("mixed")(scene, mesh, h_over_H=0.25)
+    assert mixed.row_coordinate.size == mixed.qp.m
