@@ -22,7 +22,7 @@ from estimators.guaranteed_contact import (
 )
 from estimators.nonnegative_traction import nonnegative_pressure
 from estimators.strip_extension import relaxed
-from formulations.contact_boundary import gauss_legendre
+from formulations.reference_facets import gauss_legendre
 
 
 def contact_traction(scene, solution, interior, reaction: np.ndarray, clamped: np.ndarray,

@@ -65,16 +65,6 @@ def combine(estimator: str, volume: np.ndarray, contact) -> Estimate:
                     indicators=volume + contact.per_element)
 
 
-def planar_only(name: str, why: str):
-    """An ``applies`` check refusing 3D scenes for an estimator built on triangles."""
-    def applies(scene=None, **_) -> str | None:
-        if scene is not None and scene.dim != 2:
-            return f"{name} is implemented on triangles only: {why}"
-        return None
-
-    return applies
-
-
 ESTIMATORS = Registry("estimator")
 # "estimator@family" -> the estimate function of an estimator on other cells
 ESTIMATOR_VARIANTS = Registry("estimator variant")

@@ -39,7 +39,7 @@ from estimators.guaranteed_friction import (
 )
 from estimators.nonnegative_traction import EPSILON, bernstein_polynomial, hat_moments
 from formulations.base import STATUS_OK
-from formulations.contact_boundary import gauss_legendre
+from formulations.reference_facets import gauss_legendre
 from formulations.slack_friction import contact_tangent
 from formulations.solvers.box import box_bvls
 

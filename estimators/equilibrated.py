@@ -27,7 +27,7 @@ import numpy as np
 
 from estimators.auxiliary_traction import contact_traction
 from estimators.averaging import compliance_energy
-from estimators.base import BoundTerms, Estimate, planar_only, register_estimator
+from estimators.base import BoundTerms, Estimate, register_estimator
 from estimators.bounded_shear import auxiliary_shear, l2_excess_term
 from estimators.consistency_stress import consistency_stress, with_consistency
 from estimators.constants import domain_constants
@@ -61,22 +61,19 @@ class NotEquilibrated(RuntimeError):
     """The discrete solution does not balance the auxiliary problem's hat functions."""
 
 
-def tresca_only_for(name: str, solid: bool = False):
+def tresca_only_for(name: str):
     """The ``applies`` check of estimator ``name``: Coulomb is refused (not a minimisation: no
-    bound, docs/theory.md 17.5); 3D too unless ``solid`` (a tetrahedral variant exists)."""
+    bound, docs/theory.md 17.5)."""
     def check(scene=None, **context) -> str | None:
         if scene is not None and scene.friction.kind == "coulomb":
             return (f"estimator '{name}' bounds the error under Tresca friction only "
                     f"(the scene's law is {scene.friction.label}: Coulomb's is not a "
                     "minimisation)")
-        if solid:
-            return None
-        return planar_only(name, "the Raviart-Thomas patch equilibration is built on "
-                                 "triangles")(scene=scene, **context)
+        return None
     return check
 
 
-tresca_only = tresca_only_for("equilibrated", solid=True)
+tresca_only = tresca_only_for("equilibrated")
 
 
 @dataclass(frozen=True)

@@ -53,7 +53,7 @@ from estimators.proved_constants import proved_constants
 from estimators.rigid_duals import RigidChain
 from estimators.weak_symmetry import weakly_symmetrised
 from formulations import DiscreteSolution
-from formulations.contact_boundary import gauss_legendre
+from formulations.reference_facets import gauss_legendre
 
 NAME = "equilibrated-local"
 
@@ -72,7 +72,8 @@ def skew_squares(rec, korn: np.ndarray, mu: float) -> np.ndarray:
 @register_estimator(NAME, "equilibrated with every constant proved: local Korn constants "
                           "from the patches' angles (weakly symmetric stress) and trace and "
                           "Friedrichs constants from the domain's geometry",
-                    guaranteed=True, applies=tresca_only_for(NAME), friction=True)
+                    guaranteed=True, applies=tresca_only_for(NAME), friction=True,
+                    families=("tri",))  # the patch equilibration with proved constants: 2D
 def estimate(scene, solution: DiscreteSolution):
     mesh = solution.elasticity.mesh
     lam, mu = solution.elasticity.lame

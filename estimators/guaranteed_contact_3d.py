@@ -23,7 +23,7 @@ from estimators.contact_extension import discrete_gap, vertex_normals
 from estimators.contact_extension_3d import EXTENSIONS_3D, SurfaceExtension, corner_weights
 from estimators.equilibration import BoundaryData, boundary_balance, boundary_fluxes
 from estimators.guaranteed_contact import ContactBound, bound_of, contact_mass
-from formulations.contact_surface import triangle_rule
+from formulations.reference_facets import triangle_rule
 
 QUADRATURE_DEGREE = 8  # the rule on each contact triangle for lambda*_+ and the slack (kinked)
 PROJECTION_DEGREE = 8  # the rule for projecting lambda_h onto P1 per triangle

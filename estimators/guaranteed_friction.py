@@ -29,8 +29,8 @@ from estimators.guaranteed_contact import (
     traction_at,
 )
 from estimators.strip_extension import StripExtension
-from formulations.contact_boundary import gauss_legendre
 from formulations.evaluation import evaluate_on_trace
+from formulations.reference_facets import gauss_legendre
 from formulations.slack_friction import contact_tangent
 
 QUADRATURE = 10  # Gauss points per contact facet for the kinked integrands

@@ -37,8 +37,8 @@ from estimators.guaranteed_contact_3d import (
     traction_balance,
 )
 from estimators.guaranteed_friction import FrictionBound
-from formulations.contact_surface import triangle_rule
 from formulations.evaluation import evaluate_on_trace
+from formulations.reference_facets import triangle_rule
 
 
 @dataclass(frozen=True, eq=False)

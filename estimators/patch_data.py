@@ -34,7 +34,7 @@ SCALARS = {**ELEMENTS, 4: ElementTriP4}
 def scalar_lagrange(degree: int, dim: int):
     """The scalar Lagrange element of ``degree`` on triangles (to P4) or tetrahedra (to P3;
     P3 discontinuous, ``estimators.lagrange_tet``)."""
-    elements = SCALARS if dim == 2 else {**scalar_elements(dim), 3: ElementTetDGP3}
+    elements = {2: SCALARS, 3: {**scalar_elements(3), 3: ElementTetDGP3}}[dim]
     if degree not in elements:
         raise ValueError(f"degree={degree} has no Lagrange element on {dim}D simplices here "
                          f"(allowed: {sorted(elements)})")

@@ -18,10 +18,10 @@ import numpy as np
 from estimators.base import Estimate, register_cell_variant
 from estimators.contact_terms import contact_terms
 from estimators.nitsche_residual import nitsche_estimate
-from formulations.contact_boundary import gauss_legendre
 from formulations.elasticity import element_diameters, stress_tensor_from_gradient
 from formulations.quad_evaluation import QuadGradient
 from formulations.quad_load import affine_maps
+from formulations.reference_facets import gauss_legendre
 from formulations.tensor_stiffness import tensor_rule
 from scenes.quad_hierarchy import edge_keys
 

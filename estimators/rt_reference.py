@@ -17,6 +17,7 @@ product over all elements. No basis function is evaluated on the physical elemen
 from __future__ import annotations
 
 import functools
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -41,12 +42,12 @@ OPPOSITE_FACET = {2: np.array([1, 2, 0]), 3: np.array([3, 2, 1, 0])}
 def rt_element(k: int, dim: int) -> ElementHdiv:
     """RT_k on triangles (dim 2) or tetrahedra (dim 3); built once (its nodal basis is an
     inverse)."""
-    return ElementTriRTk(k) if dim == 2 else ElementTetRTk(k)
+    return {2: ElementTriRTk, 3: ElementTetRTk}[dim](k)
 
 
 def facet_dof_count(k: int, dim: int) -> int:
-    """RT_k DOFs per facet: dim P_k on a segment or a triangle."""
-    return k + 1 if dim == 2 else (k + 1) * (k + 2) // 2
+    """RT_k DOFs per facet: dim P_k on a facet (a segment in 2D, a triangle in 3D)."""
+    return math.comb(k + dim - 1, dim - 1)
 
 
 @dataclass(frozen=True, eq=False)

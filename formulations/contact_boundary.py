@@ -25,42 +25,6 @@ from scenes.registry import Registry
 CONTACT_BOUNDARIES = Registry("contact boundary")
 
 
-def gauss_legendre(n: int) -> tuple[np.ndarray, np.ndarray]:
-    """n-point Gauss-Legendre rule on [0, 1]: points t and weights w (sum w = 1)."""
-    x, w = np.polynomial.legendre.leggauss(n)
-    return 0.5 * (x + 1.0), 0.5 * w
-
-
-def lagrange_nodes(order: int) -> np.ndarray:
-    """The equispaced nodes k / p (k = 0..p) on [0, 1] of the trace of a P_p Lagrange element
-    on one facet."""
-    return np.linspace(0.0, 1.0, order + 1)
-
-
-def lagrange_basis(nodes: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """The 1D Lagrange polynomials on ``nodes`` at t; shape (len(nodes), len(t))."""
-    t = np.asarray(t, dtype=float)
-    out = np.ones((nodes.size, t.size))
-    for k in range(nodes.size):
-        for j in range(nodes.size):
-            if j != k:
-                out[k] *= (t - nodes[j]) / (nodes[k] - nodes[j])
-    return out
-
-
-def lagrange_basis_1d(order: int, t: np.ndarray) -> np.ndarray:
-    """The 1D Lagrange polynomials of degree p on the nodes ``lagrange_nodes(p)`` at t;
-    shape (p + 1, len(t))."""
-    return lagrange_basis(lagrange_nodes(order), t)
-
-
-def facet_coordinates(coordinate: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """Contact coordinates at local coordinates t in [0, 1] of facets whose end points are
-    ``coordinate`` (2, n); shape (n, len(t)) (affine along a facet of a straight Gamma_C)."""
-    s0, s1 = coordinate
-    return s0[:, None] + (s1 - s0)[:, None] * np.asarray(t)[None, :]
-
-
 @dataclass(frozen=True, eq=False)
 class TraceNodes:
     """The Lagrange nodes of the displacement on Gamma_C: the facets' vertices, then the nodes

@@ -13,17 +13,17 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import sparse
 
-from formulations.contact_boundary import (
-    ContactBoundary,
-    TraceNodes,
+from formulations.contact_boundary import ContactBoundary, TraceNodes, register_boundary
+from formulations.evaluation import evaluate_on_trace
+from formulations.reference_facets import (
     facet_coordinates,
     gauss_legendre,
     lagrange_basis,
     lagrange_basis_1d,
     lagrange_nodes,
-    register_boundary,
+    newton_cotes,
+    nodal_interpolant,
 )
-from formulations.evaluation import evaluate_on_trace
 
 ZONE_SAMPLES = np.array([0.25, 0.5, 0.75])  # inside each facet: where lambda_h > 0 is contact
 
@@ -37,14 +37,6 @@ def outer_normals(mesh, v0: np.ndarray, v1: np.ndarray, element: np.ndarray):
     inward = np.einsum("in,in->n", normal, centroid - 0.5 * (a + b)) > 0
     normal[:, inward] *= -1.0
     return length, normal
-
-
-def newton_cotes(order: int) -> np.ndarray:
-    """int_0^1 L_k dt for the 1D Lagrange polynomials L_k on the equispaced nodes k / p (the
-    lumped boundary mass per unit facet length: 1/2, 1/2 for P1; 1/6, 2/3, 1/6 for P2 --
-    Simpson; 1/8, 3/8, 3/8, 1/8 for P3); all positive for p <= 3."""
-    t, w = gauss_legendre(order + 1)
-    return lagrange_basis_1d(order, t) @ w
 
 
 @dataclass(frozen=True, eq=False)
@@ -217,6 +209,11 @@ class ContactTrace(ContactBoundary):
         """Where a piecewise pressure may break along Gamma_C: the coordinates, sorted."""
         return np.sort(coordinates)
 
+    @staticmethod
+    def around(centre: float, half_width: float) -> np.ndarray:
+        """Contact coordinates over a zone's surroundings: 8001 points over +-4 half-widths."""
+        return np.linspace(centre - 4 * half_width, centre + 4 * half_width, 8001)
+
     def zone(self, pressure) -> tuple[float, float]:
         """End points of the union of facets where ``pressure(t)`` > ACTIVE_FRACTION x its
         maximum (an interior-point solution leaves ~1e-9 relative everywhere: not contact)."""
@@ -227,6 +224,14 @@ class ContactTrace(ContactBoundary):
         if not pressed.any():
             return float("nan"), float("nan")
         return float(self.coordinate[0][pressed].min()), float(self.coordinate[1][pressed].max())
+
+    def pressure_samples(self, solution) -> tuple[np.ndarray, np.ndarray]:
+        """A reference's lambda_h sampled along Gamma_C: contact coordinates (sorted) and
+        values, 9 per facet."""
+        t = self.samples(9)
+        s, values = self.coordinates_at(t).ravel(), solution.pressure(t).ravel()
+        order = np.argsort(s, kind="stable")
+        return s[order], values[order]
 
     def pressure_at(self, pressure, s: np.ndarray, samples: int = 17) -> np.ndarray:
         """lambda_h at contact coordinates s: located in its facet, linear between ``samples``
@@ -274,15 +279,6 @@ class ContactTrace(ContactBoundary):
             if not too_long.any():
                 return np.flatnonzero(flagged)
             flagged[self.element[too_long]] = True
-
-
-def nodal_interpolant(values: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """The piecewise linear interpolant along each facet of its p + 1 nodal ``values``
-    (n_facets, p + 1) at local coordinates t: (n_facets, len(t))."""
-    pieces = values.shape[1] - 1
-    x = np.clip(np.asarray(t, dtype=float), 0.0, 1.0) * pieces
-    k = np.minimum(np.floor(x).astype(int), pieces - 1)
-    return values[:, k] + (values[:, k + 1] - values[:, k]) * (x - k)[None, :]
 
 
 register_boundary(ContactTrace, "edges: the boundary edges of triangles and quadrilaterals on "

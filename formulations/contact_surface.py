@@ -14,57 +14,21 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.spatial import cKDTree
-from skfem import ElementTriP1, ElementTriP2, ElementTriP3, Mesh
-from skfem.quadrature import get_quadrature_tri
+from skfem import Mesh
 
 from formulations.contact_boundary import ContactBoundary, register_boundary
+from formulations.reference_facets import (
+    P2_CHILDREN,
+    TRIANGLE_SAMPLES,
+    barycentric,
+    triangle_lagrange,
+    triangle_rule,
+)
 from scenes.base import simplex_measures, simplex_points
 
-# the reference triangle's vertices as local coordinates (2, 3)
-TRIANGLE_VERTICES = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
-# where a traction is sampled on each triangle: its corners, edge midpoints and centroid
-TRIANGLE_SAMPLES = np.array([[0, 1, 0, 0.5, 0.5, 0, 1 / 3], [0, 0, 1, 0, 0.5, 0.5, 1 / 3]])
-# the sub-triangles of a P2 triangle between its nodes (ElementTriP2's order)
-P2_CHILDREN = np.array([[0, 3, 5], [3, 1, 4], [5, 4, 2], [3, 4, 5]])
 DISC_DEGREE = 10  # 25 points per contact triangle for the area of the contact zone
 # candidate facets per located point: the nearest centroids (in contact coordinates) tried
 CANDIDATES = 8
-
-
-# scikit-fem's triangle rules of these degrees have a negative weight: the next one is taken (a
-# penalty weight D_q must be positive)
-NEGATIVE_WEIGHT_DEGREES = (3, 7)
-
-
-def triangle_rule(degree: int) -> tuple[np.ndarray, np.ndarray]:
-    """A rule exact to ``degree`` with positive weights on the reference triangle: points t
-    (2, nq) and weights w (nq,) with sum w = 1 (scikit-fem's rules, whose weights sum to the
-    area 1/2)."""
-    degree = max(int(degree), 1)
-    t, w = get_quadrature_tri(degree + (degree in NEGATIVE_WEIGHT_DEGREES))
-    return t, 2.0 * w
-
-
-def triangle_lagrange(order: int):
-    """The Lagrange nodes (2, k) of P_order on the reference triangle (scikit-fem's
-    ``ElementTriP*`` DOF order: vertices, edges, interior) and ``basis(t)`` (k, nq), the
-    Lagrange polynomials at local coordinates t (2, nq)."""
-    element = {1: ElementTriP1, 2: ElementTriP2, 3: ElementTriP3}[int(order)]()
-    nodes = np.asarray(element.doflocs, dtype=float).T
-
-    def basis(t: np.ndarray) -> np.ndarray:
-        return np.array([element.lbasis(np.asarray(t, dtype=float), k)[0]
-                         for k in range(nodes.shape[1])])
-
-    return nodes, basis
-
-
-def barycentric(corners: np.ndarray, s: np.ndarray) -> np.ndarray:
-    """Local coordinates (2, m) of points s (2, m) in 2D triangles with corners (2, 3, m)."""
-    a, b, c = corners[:, 0], corners[:, 1], corners[:, 2]
-    e1, e2, r = b - a, c - a, s - a
-    det = e1[0] * e2[1] - e1[1] * e2[0]
-    return np.array([(r[0] * e2[1] - r[1] * e2[0]) / det, (e1[0] * r[1] - e1[1] * r[0]) / det])
 
 
 @dataclass(frozen=True, eq=False)
@@ -208,6 +172,13 @@ class ContactSurface(ContactBoundary):
         """A surface has no order along it: no breaks."""
         return np.zeros(0)
 
+    @staticmethod
+    def around(centre: float, radius: float) -> np.ndarray:
+        """Contact coordinates (2, m) over a disc's surroundings: a grid of 201 x 201 points
+        over +-2 radii about (centre, 0)."""
+        line = np.linspace(-2 * radius, 2 * radius, 201)
+        return np.array(np.meshgrid(centre + line, line)).reshape(2, -1)
+
     def zone(self, pressure) -> tuple[float, float]:
         """A 3D contact zone as (c - r, c + r): r the radius of the disc of the same area as
         the part of Gamma_C where ``pressure`` > ACTIVE_FRACTION x its maximum (by
@@ -223,6 +194,27 @@ class ContactSurface(ContactBoundary):
         centre = self.integrate(pressed * self.coordinates_at(t)[0], w).sum() / area
         radius = float(np.sqrt(area / np.pi))
         return float(centre - radius), float(centre + radius)
+
+    def pressure_samples(self, solution) -> tuple[np.ndarray, np.ndarray]:
+        """A reference's pressure on tetrahedra: -sigma_nn(u_h) at the P2 nodes and the
+        centroid of every contact triangle, clipped at 0, and 0 on the triangles where
+        lambda_h is 0 throughout: the pressure of the displacement itself, not one recovered
+        from the VI's nodal reactions (docs/theory.md, section 14.6). Contact coordinates
+        (2, m) and values, each point once."""
+        from formulations.elasticity import stress_tensor_from_gradient
+        from formulations.evaluation import gradients_at
+
+        t, nq = TRIANGLE_SAMPLES, TRIANGLE_SAMPLES.shape[1]
+        x, normal = self.points(t).reshape(3, -1), self.at_points(self.normal, nq)
+        grad = gradients_at(solution.elasticity.basis, solution.u, x,
+                            np.repeat(self.element, nq))
+        sigma = stress_tensor_from_gradient(grad, *solution.elasticity.lame)
+        values = np.maximum(-np.einsum("in,ijn,jn->n", normal, sigma, normal), 0.0)
+        pressed = (solution.pressure(t) > 0).any(axis=1)  # per facet: the nodal one dips to 0
+        values[~np.repeat(pressed, nq)] = 0.0
+        s, index = np.unique(self.coordinates_at(t).reshape(2, -1).round(14), axis=1,
+                             return_index=True)
+        return s, values[index]
 
     def pressure_at(self, pressure, s: np.ndarray, samples: int = 17) -> np.ndarray:
         """lambda_h at contact coordinates s (2, m), each in its facet: the quadratic

@@ -152,10 +152,10 @@ def gradients_at_reference(basis: Basis, u: np.ndarray, X: np.ndarray) -> np.nda
 
 
 def p1_gradients(basis: Basis, u: np.ndarray) -> np.ndarray:
-    """The constant grad u_h (2, 2, n_elements) of a vector P1 field: sum_i u_i g_i' with
-    the barycentric gradients g_i (scikit-fem's local DOF 2 i + c: node i, component c)."""
-    g, _ = barycentric_gradients(basis.mesh)  # (3, 2, nE)
-    nodal = u[basis.element_dofs].reshape(3, 2, -1)
+    """The constant grad u_h (d, d, n_elements) of a vector P1 field: sum_i u_i g_i' with
+    the barycentric gradients g_i (scikit-fem's local DOF d i + c: node i, component c)."""
+    g, _ = barycentric_gradients(basis.mesh)  # (d + 1, d, nE)
+    nodal = u[basis.element_dofs].reshape(*g.shape[:2], -1)
     return np.einsum("ice,ide->cde", nodal, g)
 
 

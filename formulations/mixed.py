@@ -37,7 +37,6 @@ from skfem import MeshTri
 from formulations.base import ContactQP, DiscreteSolution, QPSolution, Residuals
 from formulations.cells import family_of
 from formulations.contact import contact_trace
-from formulations.contact_boundary import gauss_legendre
 from formulations.contact_patches import (
     free_normal_vertices,
     patch_sizes,
@@ -54,6 +53,7 @@ from formulations.mixed_friction import (
     surface_friction_rows,
     surface_friction_state,
 )
+from formulations.reference_facets import gauss_legendre
 from formulations.registry import register_formulation
 from scenes import Scene
 from scenes.base import is_integer, is_number
@@ -164,8 +164,16 @@ def discretise(scene: Scene, mesh: MeshTri, h_over_H: float = 0.5, order: int = 
     p - 1, docs/theory.md, section 9). On a quadrilateral hierarchy h_over_H = 2^-k takes the
     edges k levels up (module docstring). On tetrahedra (``discretise_surface``) h_over_H = 1/2
     means star patches, 1 the contact triangles, and q is 0."""
-    if scene.dim == 3:
-        return discretise_surface(scene, mesh, h_over_H, order, multiplier_degree)
+    boundary = family_of(mesh).contact_boundary
+    if boundary not in MULTIPLIER_SPACES:
+        raise ValueError(f"the mixed method has no multiplier space on {boundary} (it has one "
+                         f"on {', '.join(MULTIPLIER_SPACES)})")
+    return MULTIPLIER_SPACES[boundary](scene, mesh, h_over_H, order, multiplier_degree)
+
+
+def discretise_segments(scene: Scene, mesh, h_over_H: float, order: int,
+                        multiplier_degree: int | None) -> Discretisation:
+    """The mixed method on a 2D Gamma_C: lambda_H of degree q on segments of edges."""
     order, degree = checked_options(h_over_H, order, multiplier_degree)
     elasticity = assemble_elasticity(scene, mesh, order)
     trace = contact_trace(scene, mesh)
@@ -262,3 +270,7 @@ def discretise_surface(scene: Scene, mesh, h_over_H: float, order: int,
     # sum_P H_P ||mu||_{0,P}^2 = H_P |P| mu_P^2 (in 2D H_S^2, as |S| = H_S)
     return Discretisation(formulation="mixed", elasticity=elasticity, trace=surface, qp=qp,
                           recover=recover, row_coordinate=centroid, multiplier_gram=H * area)
+
+
+# the multiplier space of the mixed method on each contact boundary (formulations.contact)
+MULTIPLIER_SPACES = {"edges": discretise_segments, "triangles": discretise_surface}

@@ -20,10 +20,11 @@ import numpy as np
 from scipy import sparse
 
 from formulations.base import FrictionRows, FrictionState
-from formulations.contact_boundary import gauss_legendre, tangent_frame
+from formulations.contact_boundary import tangent_frame
 from formulations.evaluation import drop_roundoff, evaluate_on_trace
 from formulations.friction_state import friction_state
 from formulations.nodal_friction import interleaved, slide_components
+from formulations.reference_facets import gauss_legendre
 
 
 def tangential_rows(elasticity, trace, weights: sparse.csr_matrix,

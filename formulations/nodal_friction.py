@@ -14,9 +14,8 @@ import numpy as np
 from scipy import sparse
 
 from formulations.base import FrictionRows, FrictionState
-from formulations.contact_edges import nodal_interpolant
-from formulations.contact_surface import triangle_lagrange
 from formulations.friction_state import friction_state
+from formulations.reference_facets import nodal_interpolant, triangle_lagrange
 
 
 def interleaved(rows: list[sparse.csr_matrix]) -> sparse.csr_matrix:

@@ -27,9 +27,9 @@ import numpy as np
 from scipy import sparse
 
 from formulations.contact_boundary import TraceNodes
-from formulations.contact_surface import triangle_lagrange, triangle_rule
 from formulations.kkt import ACTIVE_FRACTION
 from formulations.nonnegative_fit import bounded_least_squares
+from formulations.reference_facets import triangle_lagrange, triangle_rule
 
 # lumped mass per unit facet area, local nodes in scikit-fem's ElementTriP2 order
 # (vertices 0, 1, 2; midpoints of edges 01, 12, 02)

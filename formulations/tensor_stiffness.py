@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 from scipy import sparse
 
-from formulations.contact_boundary import gauss_legendre
+from formulations.reference_facets import gauss_legendre
 
 
 def tensor_rule(points: int) -> tuple[np.ndarray, np.ndarray]:

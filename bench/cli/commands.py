@@ -165,7 +165,8 @@ def compare_command(args) -> int:
     if config is None:
         return status
     args.case = None
-    hard_status = hard_command(args, compare=True) if args.dim == 2 else 0  # the hard cases: 2D
+    runs_hard = {**compare_settings(dim=args.dim), **args.file_fields}.get("hard-cases", False)
+    hard_status = hard_command(args, compare=True) if runs_hard else 0
     table = read_results(args.out)
     readme = write_report(table, args.reports, args.out)
     if args.readme is not None:

@@ -14,45 +14,56 @@ SCALING_3D_MARKERS = (scaling_3d.README_START_3D, scaling_3d.README_END_3D)
 SEQUENCE_MARKERS = (sequence.README_START, sequence.README_END)
 
 
-def scaling_command(args) -> int:
-    def show(row):
-        print(f"{row['size']} P{row['order']}: ndofs {row['ndofs']}  "
-              f"fast {row['t_fast_solve']:.2f} s  "
-              f"linear {row['t_linear_solve']:.2f} s  reference "
-              f"{row['t_reference_solve']:.2f} s  peak {row['peak_gib']:.2f} GiB", flush=True)
-    try:
-        check_backend(args.backend)
-    except ValueError as error:
-        raise InputError(f"--backend: {error}") from None
-    if args.readme is not None:  # before anything is measured
-        start, end = (SEQUENCE_MARKERS if args.sequence else
-                      SCALING_3D_MARKERS if args.dim == 3 else SCALING_MARKERS)
-        try:
-            check_markers(args.readme, start, end)
-        except ValueError as error:
-            raise InputError(f"--{error}") from None
-    if args.sequence:
-        return sequence_command(args)
-    sizes = args.sizes or list(SIZES_3D if args.dim == 3 else SIZES)
-    allowed = SIZES_3D if args.dim == 3 else SIZES
-    wrong = [size for size in sizes if size not in allowed]
-    if wrong:
-        raise InputError(f"--sizes={','.join(wrong)} is not one of {', '.join(allowed)} "
-                         f"in {args.dim}D")
-    if args.dim == 3:
-        frame = run_scaling_3d(sizes, args.backend, args.order, on_row=show_3d)
-        print(f"wrote {write_scaling_3d(frame, args.out, args.readme)}")
-        return 0
-    frame = run_scaling(sizes, args.backend, args.reference_max_dofs, on_row=show,
-                        orders=args.order)
-    print(f"wrote {write_scaling(frame, args.out, args.readme)}")
-    return 0
+def show(row) -> None:
+    print(f"{row['size']} P{row['order']}: ndofs {row['ndofs']}  "
+          f"fast {row['t_fast_solve']:.2f} s  "
+          f"linear {row['t_linear_solve']:.2f} s  reference "
+          f"{row['t_reference_solve']:.2f} s  peak {row['peak_gib']:.2f} GiB", flush=True)
 
 
 def show_3d(row) -> None:
     print(f"{row['size']} P{row['order']} 3D: ndofs {row['ndofs']}  assembly "
           f"{row['t_assemble']:.2f} s  linear {row['t_linear_solve']:.2f} s  fast "
           f"{row['t_fast_solve']:.2f} s  peak {row['peak_gib']:.2f} GiB", flush=True)
+
+
+def scaling_2d(args, sizes: list[str]) -> str:
+    frame = run_scaling(sizes, args.backend, args.reference_max_dofs, on_row=show,
+                        orders=args.order)
+    return write_scaling(frame, args.out, args.readme)
+
+
+def scaling_3d_table(args, sizes: list[str]) -> str:
+    frame = run_scaling_3d(sizes, args.backend, args.order, on_row=show_3d)
+    return write_scaling_3d(frame, args.out, args.readme)
+
+
+# per dimension: the README block the scaling table goes into, its sizes and its run
+SCALING_BY_DIM = {2: (SCALING_MARKERS, SIZES, scaling_2d),
+                  3: (SCALING_3D_MARKERS, SIZES_3D, scaling_3d_table)}
+
+
+def scaling_command(args) -> int:
+    try:
+        check_backend(args.backend)
+    except ValueError as error:
+        raise InputError(f"--backend: {error}") from None
+    if args.readme is not None:  # before anything is measured
+        start, end = SEQUENCE_MARKERS if args.sequence else SCALING_BY_DIM[args.dim][0]
+        try:
+            check_markers(args.readme, start, end)
+        except ValueError as error:
+            raise InputError(f"--{error}") from None
+    if args.sequence:
+        return sequence_command(args)
+    allowed = SCALING_BY_DIM[args.dim][1]
+    sizes = args.sizes or list(allowed)
+    wrong = [size for size in sizes if size not in allowed]
+    if wrong:
+        raise InputError(f"--sizes={','.join(wrong)} is not one of {', '.join(allowed)} "
+                         f"in {args.dim}D")
+    print(f"wrote {SCALING_BY_DIM[args.dim][2](args, sizes)}")
+    return 0
 
 
 def sequence_command(args) -> int:

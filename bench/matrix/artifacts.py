@@ -18,10 +18,9 @@ from bench.measure.contact import contact_zone
 from bench.measure.discretisation_error import element_energy_errors
 from bench.sequence.rows import name_parts
 from formulations.base import FRICTION_STATES
-from formulations.contact_surface import TRIANGLE_VERTICES
 from formulations.elasticity import von_mises
 
-PRESSURE_SAMPLES = np.linspace(0.0, 1.0, 9)
+PRESSURE_SAMPLES = 9  # lambda_h's samples per facet (the contact boundary's)
 
 
 def file_stem(*parts) -> str:
@@ -58,8 +57,7 @@ def save_artifact(path: Path, result, scene=None) -> Path | None:
     indicators = (estimate.indicators if estimate is not None
                   else np.full(n_elements, np.nan))
     trace, dim = sol.trace, mesh.dim()
-    corners = np.array([0.0, 1.0]) if dim == 2 else TRIANGLE_VERTICES
-    ends = sol.pressure(corners)  # (n_facets, 2 or 3): at each facet's vertices
+    ends = sol.pressure(trace.lagrange_points(1))  # (n_facets, 2 or 3): at the facets' vertices
     k = trace.vertices.shape[0]
     gap = (np.asarray(scene.gap(mesh.p[:, trace.vertices].reshape(dim, -1)), dtype=float)
            .reshape(k, -1) if scene is not None else np.full(trace.vertices.shape, np.nan))
@@ -71,7 +69,7 @@ def save_artifact(path: Path, result, scene=None) -> Path | None:
         error_density=element_error_density(scene, sol, n_elements),
         trace_vertices=sol.trace.vertices, trace_pressure=ends.T, trace_gap=gap,
         trace_coordinate=sol.trace.coordinate,
-        pressure=sol.pressure(PRESSURE_SAMPLES) if dim == 2 else ends,
+        pressure=sol.pressure(trace.samples(PRESSURE_SAMPLES)),
         zone=np.array(contact_zone(sol)), contact_force=sol.contact_force(),
         ndofs=sol.elasticity.ndofs, level=result.row.level, **friction_fields(sol))
     atomic_bytes(buffer.getvalue(), path)

@@ -17,7 +17,7 @@ from bench.sequence.options import SECTIONS, option_fields
 COMPARE_SETTINGS = Path(__file__).with_name("compare.toml")
 # the default comparison of each dimension (``compare --dim``)
 COMPARE_SETTINGS_BY_DIM = {2: COMPARE_SETTINGS, 3: COMPARE_SETTINGS.with_name("compare-3d.toml")}
-COMPARE_KEYS = ("dim", "reports", "readme")  # compare's own keys beside run's
+COMPARE_KEYS = ("dim", "reports", "readme", "hard-cases")  # compare's own keys beside run's
 PART_KEYS = ("part", "parts")  # a run file's [[part]] tables; run.json's "parts"
 SECTION_TITLES = {"what": "what runs", "how": "how each sequence runs",
                   "where": "where it runs"}

@@ -74,7 +74,7 @@ def compare_reference_dofs(given: int | None, dim: int) -> int:
     scenes' dimension."""
     if given is not None:
         return given
-    return COMPARE_REFERENCE_DOFS_3D if dim == 3 else COMPARE_REFERENCE_DOFS
+    return {2: COMPARE_REFERENCE_DOFS, 3: COMPARE_REFERENCE_DOFS_3D}[dim]
 
 
 @dataclass(frozen=True, eq=False)

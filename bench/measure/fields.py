@@ -80,12 +80,16 @@ class Locator:
         return cells
 
 
+def _exponents(total: int, dim: int) -> list[tuple[int, ...]]:
+    """The exponents of ``dim`` variables summing to ``total``, the first ones descending."""
+    if dim == 1:
+        return [(total,)]
+    return [(i, *rest) for i in range(total, -1, -1) for rest in _exponents(total - i, dim - 1)]
+
+
 def monomials(degree: int, dim: int = 2) -> list[tuple[int, ...]]:
-    """Exponents (i, j) of xi^i eta^j with i + j <= degree; (i, j, k) in 3D."""
-    if dim == 3:
-        return [(i, j, total - i - j) for total in range(degree + 1)
-                for i in range(total, -1, -1) for j in range(total - i, -1, -1)]
-    return [(i, total - i) for total in range(degree + 1) for i in range(total, -1, -1)]
+    """Exponents (i, j) of xi^i eta^j with i + j <= degree ((i, j, k) in 3D), by degree."""
+    return [e for total in range(degree + 1) for e in _exponents(total, dim)]
 
 
 def _lattice(degree: int, dim: int = 2) -> np.ndarray:
@@ -98,10 +102,8 @@ def _lattice(degree: int, dim: int = 2) -> np.ndarray:
 
 
 def _powers(xi: np.ndarray, degree: int) -> np.ndarray:
-    if xi.shape[0] == 3:
-        return np.array([xi[0] ** i * xi[1] ** j * xi[2] ** k
-                         for i, j, k in monomials(degree, 3)])
-    return np.array([xi[0] ** i * xi[1] ** j for i, j in monomials(degree)])
+    return np.array([np.prod([x**k for x, k in zip(xi, exponents, strict=True)], axis=0)
+                     for exponents in monomials(degree, xi.shape[0])])
 
 
 def locator_for(mesh):
@@ -122,8 +124,8 @@ class GradientField:
     def from_solution(cls, basis: Basis, u: np.ndarray) -> GradientField:
         """The field of the DOF vector ``u`` of a vector P_p ``basis``."""
         degree, dim = basis.elem.maxdeg - 1, basis.mesh.dim()
-        if degree == 0 and dim == 2:  # P1: the constant gradient of each element
-            return cls(Locator.from_mesh(basis.mesh), 0, p1_gradients(basis, u)[:, :, None, :])
+        if degree == 0:  # P1: the constant gradient of each element
+            return cls(locator_for(basis.mesh), 0, p1_gradients(basis, u)[:, :, None, :])
         nodes = _lattice(degree, dim)
         values = gradients_at_reference(basis, u, nodes)  # (d, d, nE, n_nodes)
         solve = np.linalg.inv(_powers(nodes, degree).T)  # Vandermonde: coefficients <- values

@@ -61,7 +61,7 @@ def _scene(name: str):
 def _pressure_curve(scene, artifacts: dict):
     """The true pressure to draw beside lambda_h: the exact one, or the scene's closed-form
     prediction at the computed contact force of the first adaptive artifact."""
-    if scene is None or scene.dim != 2:  # 3D: no curve along Gamma_C
+    if scene is None:
         return None
     if scene.exact is not None:
         s = np.linspace(*np.sort(scene.contact_coordinate(scene.mesh.p))[[0, -1]], 801)
@@ -78,7 +78,7 @@ def _pressure_curve(scene, artifacts: dict):
 def _shear_curve(scene, artifacts: dict):
     """The true shear traction: the exact one, or the scene's partial-slip prediction at the
     forces of the first adaptive artifact with friction."""
-    if scene is None or scene.dim != 2:
+    if scene is None:
         return None
     if scene.exact is not None and scene.exact.shear is not None:
         s = np.linspace(*np.sort(scene.contact_coordinate(scene.mesh.p))[[0, -1]], 801)
@@ -128,7 +128,7 @@ def _stick_circles(scene):
     return exact.stick_zone[1], exact.contact_zone[1]
 
 
-def field_figures_3d(artifacts: dict, scene=None) -> tuple:
+def field_figures_3d(scene, name: str, artifacts: dict, preferred) -> tuple:
     """The 3D figures drawn from the artifacts: pressure maps, mesh slices and, with friction,
     the friction states over Gamma_C."""
     return (
@@ -144,15 +144,21 @@ def field_figures_3d(artifacts: dict, scene=None) -> tuple:
          "exact stick and contact zones."))
 
 
+FIELD_FIGURES = {2: field_figures, 3: field_figures_3d}  # by the scene's dimension
+SCENE_PICTURES = {2: figures.scene_picture}  # a 3D scene has none
+
+
 def scene_section(name: str, group: pd.DataFrame, results: Path | None, figs: Figures,
                   truth: dict) -> dict:
     scene = _scene(name)
     artifacts = _artifacts(results, group)
     section = {"name": name, "truth": truth.get(name, {"kind": "unknown"}), "figures": []}
     preferred = _first_adaptive(artifacts)
+    # the figures of the scene's dimension (an unregistered scene's: 2D, without a picture)
+    dim = scene.dim if scene is not None else 2
+    fields, picture = FIELD_FIGURES[dim], SCENE_PICTURES.get(dim)
     for figure, suffix, caption in (
-            (figures.scene_picture(scene) if scene is not None and scene.dim == 2 else None,
-             "scene",
+            (picture(scene) if picture and scene is not None else None, "scene",
              "Geometry (initial mesh), boundary parts and the obstacle."),
             (panels.convergence(group), "convergence",
              "One panel per formulation: the error (solid) and eta (dashed) against ndofs, "
@@ -165,8 +171,7 @@ def scene_section(name: str, group: pd.DataFrame, results: Path | None, figs: Fi
              "Work-precision: the error (eta without a truth) against the cumulative wall time "
              "of each sequence (as the matrix timed it), one panel per polynomial order, "
              "colour = formulation, marker = strategy, one line per estimator."),
-            *(field_figures(scene, name, artifacts, preferred) if scene is None
-              or scene.dim == 2 else field_figures_3d(artifacts, scene))):
+            *fields(scene, name, artifacts, preferred)):
         item = figs.add(figure, file_stem(name, suffix), caption)
         if item is not None:
             section["figures"].append(item)

@@ -67,6 +67,9 @@ REFERENCE_BOUND = "cholmod"  # the back-end whose measured line bounds the refer
 ORDER_FACTOR = {1: 1.0, 2: 1.4, 3: 1.7}  # per-DOF memory of P_p relative to P1 (docstring)
 # 3D: per-DOF memory relative to 2D at DIM3_AT DOFs (docstring), then growing like N^(1/3)
 DIM3_FACTOR, DIM3_AT = 7.4, 1.05e5
+# per dimension: the per-DOF factor against the measured 2D lines, from how many DOFs it grows,
+# and the power of N it grows with
+FILL = {2: (1.0, 1.0, 0.0), 3: (DIM3_FACTOR, DIM3_AT, 1 / 3)}
 
 
 def memory_line(route_name: str) -> MemoryLine:
@@ -90,13 +93,13 @@ def predict_peak_gib(ndofs: int, solver: str, backend: str, order: int = 1,
     a back-end with a measured 3D line (``Backend.memory_gib_3d``: no factor, no fill) uses
     that line instead."""
     name = route(solver, backend)
-    if dim == 3 and name in BACKENDS.names() and BACKENDS.get(name).memory_gib_3d:
-        base, per_dof = BACKENDS.get(name).memory_gib_3d
+    measured = ({3: BACKENDS.get(name).memory_gib_3d} if name in BACKENDS.names() else {})
+    if measured.get(dim):
+        base, per_dof = measured[dim]
         return base + ORDER_FACTOR[order] * per_dof * ndofs
     line = memory_line(name)
-    per_dof = ORDER_FACTOR[order] * line.per_dof_gib
-    if dim == 3:
-        per_dof *= DIM3_FACTOR * max(ndofs / DIM3_AT, 1.0) ** (1 / 3)
+    factor, at, exponent = FILL[dim]
+    per_dof = ORDER_FACTOR[order] * line.per_dof_gib * factor * max(ndofs / at, 1.0) ** exponent
     return line.base_gib + per_dof * ndofs
 
 

@@ -40,8 +40,6 @@ from bench.measure.quad_fields import gradient_field_of
 from bench.sequence.loop import LoopConfig, run_sequence
 from bench.truth.error_bar import error_bar
 from formulations import STATUS_OK, DiscreteSolution
-from formulations.elasticity import stress_tensor_from_gradient
-from formulations.evaluation import gradients_at
 from formulations.solvers.backends import FactorisationError
 from formulations.solvers.registry import FAST_SOLVER
 
@@ -137,34 +135,9 @@ def reference_key(scene, max_dofs: int, recipe: str | None = None) -> str:
     return f"{scene.name}-{recipe}-{max_dofs}-{hashlib.sha256(text.encode()).hexdigest()[:16]}"
 
 
-SURFACE_SAMPLES = np.array([[0, 1, 0, .5, .5, 0, 1 / 3], [0, 0, 1, 0, .5, .5, 1 / 3]])
-
-
-def _surface_pressure(solution: DiscreteSolution):
-    """On tetrahedra: -sigma_nn(u_h) at the P2 nodes and the centroid of every contact
-    triangle, clipped at 0, and 0 on the triangles where lambda_h is 0 throughout: the pressure
-    of the displacement itself, not one recovered from the VI's nodal reactions
-    (docs/theory.md, section 14.6)."""
-    trace, t = solution.trace, SURFACE_SAMPLES
-    nq = t.shape[1]
-    x, normal = trace.points(t).reshape(3, -1), np.repeat(trace.normal, nq, axis=1)
-    grad = gradients_at(solution.elasticity.basis, solution.u, x, np.repeat(trace.element, nq))
-    sigma = stress_tensor_from_gradient(grad, *solution.elasticity.lame)
-    values = np.maximum(-np.einsum("in,ijn,jn->n", normal, sigma, normal), 0.0)
-    pressed = (solution.pressure(t) > 0).any(axis=1)  # per facet: the nodal one dips to 0
-    values[~np.repeat(pressed, nq)] = 0.0
-    s, index = np.unique(trace.coordinates_at(t).reshape(2, -1).round(14), axis=1,
-                         return_index=True)
-    return s, values[index]
-
-
 def _sampled_pressure(solution: DiscreteSolution):
-    if solution.trace.dim == 3:
-        return _surface_pressure(solution)
-    t = np.linspace(0.0, 1.0, 9)
-    s, values = solution.trace.coordinates_at(t).ravel(), solution.pressure(t).ravel()
-    order = np.argsort(s, kind="stable")
-    return s[order], values[order]
+    """A reference's pressure: contact coordinates and values, from the contact boundary."""
+    return solution.trace.pressure_samples(solution)
 
 
 class TruthError(ValueError):

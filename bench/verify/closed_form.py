@@ -3,7 +3,6 @@ Hertz's half-width and peak pressure) at the computed contact force."""
 
 from __future__ import annotations
 
-import numpy as np
 import pandas as pd
 
 from bench.matrix.config import RunConfig
@@ -12,9 +11,6 @@ from bench.matrix.spec import build_scene
 from bench.measure.contact import contact_zone
 from bench.measure.zone_edge import square_root_zone
 from bench.sequence.loop import run_sequence
-
-PEAK_SAMPLES = 8001  # points over +-4 half-widths where the computed peak pressure is sought
-PEAK_GRID_3D = 201  # 3D: a grid of 201 x 201 points over +-2 contact radii
 
 
 def closed_form_table(runs: list[dict]) -> pd.DataFrame:
@@ -48,10 +44,7 @@ def _compare(scene, spec, result) -> dict:
     start, end = contact_zone(sol)
     edge_start, edge_end = square_root_zone(sol)
     b = predicted.half_width
-    s = np.linspace(predicted.centre - 4 * b, predicted.centre + 4 * b, PEAK_SAMPLES)
-    if scene.dim == 3:  # a square grid over the disc's surroundings
-        line = np.linspace(predicted.centre - 2 * b, predicted.centre + 2 * b, PEAK_GRID_3D)
-        s = np.array(np.meshgrid(line, line - predicted.centre)).reshape(2, -1)
+    s = sol.trace.around(predicted.centre, b)  # where the computed peak pressure is sought
     return {"scene": scene.name, "formulation": spec.formulation, "order": spec.order,
             "dim": scene.dim, "ndofs": result.row.ndofs, "contact_force": force,
             "half_width": 0.5 * (end - start), "predicted_half_width": b,

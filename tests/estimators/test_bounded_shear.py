@@ -15,7 +15,7 @@ from estimators.guaranteed_friction import (
 )
 from estimators.nonnegative_traction import bernstein_polynomial
 from formulations import get_formulation, solve
-from formulations.contact_boundary import gauss_legendre
+from formulations.reference_facets import gauss_legendre
 from formulations.slack_friction import contact_tangent
 from scenes import get_scene
 

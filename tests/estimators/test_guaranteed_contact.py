@@ -11,7 +11,7 @@ from estimators.contact_extension import vertex_normals
 from estimators.equilibrated import equilibrate
 from estimators.guaranteed_contact import FacetPolynomial, balanced_traction
 from formulations import get_formulation, solve
-from formulations.contact_boundary import gauss_legendre
+from formulations.reference_facets import gauss_legendre
 from scenes import get_scene
 
 

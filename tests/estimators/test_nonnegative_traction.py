@@ -10,7 +10,7 @@ from estimators.equilibrated import equilibrate
 from estimators.guaranteed_contact import traction_balance
 from estimators.nonnegative_traction import hat_moments, nonnegative_pressure
 from formulations import get_formulation, solve
-from formulations.contact_boundary import gauss_legendre
+from formulations.reference_facets import gauss_legendre
 from scenes import get_scene
 
 

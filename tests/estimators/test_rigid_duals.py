@@ -10,9 +10,9 @@ from skfem.helpers import dot
 from estimators.patch_data import BalancingLoad
 from estimators.rigid_duals import RigidChain
 from formulations import get_formulation, solve
-from formulations.contact_boundary import gauss_legendre
 from formulations.elasticity import assemble_elasticity
 from formulations.evaluation import normal_trace_matrix
+from formulations.reference_facets import gauss_legendre
 from formulations.slack_friction import tangential_rows
 from scenes import get_scene
 

@@ -11,9 +11,9 @@ import pytest
 from formulations import get_formulation, solve
 from formulations.contact import contact_trace
 from formulations.contact_patches import free_normal_vertices, patch_sizes, patches
-from formulations.contact_surface import triangle_rule
 from formulations.diagnostics import inf_sup_constant
 from formulations.elasticity import assemble_elasticity
+from formulations.reference_facets import triangle_rule
 from scenes import get_scene
 
 

@@ -10,13 +10,13 @@ from bench.measure.difference import solution_difference
 from conftest import square_scene
 from formulations import get_formulation, solve
 from formulations.contact import contact_trace
-from formulations.contact_boundary import gauss_legendre
 from formulations.diagnostics import inf_sup_constant
 from formulations.elasticity import assemble_elasticity, count_free_dofs, vector_element
 from formulations.evaluation import normal_trace_matrix
 from formulations.load import body_load
 from formulations.mixed import bernstein, multiplier_segments
 from formulations.penalty import PRESSURE_CONSISTENCY
+from formulations.reference_facets import gauss_legendre
 from scenes import get_scene
 
 ORDERS = (2, 3)

@@ -5,7 +5,7 @@ import pytest
 
 from bench.measure.difference import solution_difference
 from formulations import get_formulation, solve
-from formulations.contact_boundary import gauss_legendre
+from formulations.reference_facets import gauss_legendre
 from formulations.solvers import semismooth_newton
 from formulations.solvers.backends import available_backends
 from scenes import get_scene

@@ -4,7 +4,8 @@
 import numpy as np
 import pytest
 
-from formulations.contact_surface import ContactSurface, triangle_rule
+from formulations.contact_surface import ContactSurface
+from formulations.reference_facets import triangle_rule
 from formulations.surface_nodes import (
     BERNSTEIN_MOMENTS,
     lagrange_values,

@@ -17,6 +17,7 @@ from scenes import get_scene
 
 HARD_SCENE_LEVEL = 3  # refinements of each hard scene's initial mesh (544..4752 DOFs)
 HARD_SCENE_LEVEL_3D = 1  # of a 3D one: a uniform refinement multiplies the elements by 8
+HARD_SCENE_LEVELS = {2: HARD_SCENE_LEVEL, 3: HARD_SCENE_LEVEL_3D}
 # a discretisation is "settled" when the contact force changes by at most this much from one
 # uniform level to the next (the well-resolved cases here change by a few per cent)
 SETTLED = 0.1
@@ -25,7 +26,7 @@ SETTLED = 0.1
 def hard_level(scene) -> int:
     """Uniform refinements of a hard scene's initial mesh (2D: 544..4752 DOFs; 3D:
     1.1e3..1.6e4)."""
-    return HARD_SCENE_LEVEL if scene.dim == 2 else HARD_SCENE_LEVEL_3D
+    return HARD_SCENE_LEVELS[scene.dim]
 
 
 def applied_load(solution) -> float:
