@@ -94,6 +94,6 @@ def averaging_indicators(solution: DiscreteSolution) -> np.ndarray:
 @register_estimator("averaging", "Zienkiewicz-Zhu nodal stress averaging in the energy norm "
                                  "plus the geometric and complementarity contact terms of (8); "
                                  "with friction the friction complementarity",
-                    families=("tri", "tet", "quad"), friction=(2, 3))
+                    families=("tri", "tet", "quad", "hex"), friction=(2, 3))
 def estimate(scene, solution: DiscreteSolution) -> Estimate:
     return combine("averaging", averaging_indicators(solution), contact_terms(scene, solution))

@@ -1,11 +1,16 @@
 """The contact boundary Gamma_C of one mesh (docs/theory.md, section 1): the registered kind
 its cell family declares (``formulations.contact_boundary``; edges in
-``formulations.contact_edges``, triangles in ``formulations.contact_surface``), and the gap's
+``formulations.contact_edges``, triangles in ``formulations.contact_surface``, quadrilateral
+faces in ``formulations.contact_faces``), and the gap's
 interpolant on it."""
 
 from __future__ import annotations
 
-from formulations import contact_edges, contact_surface  # noqa: F401  (register themselves)
+from formulations import (  # noqa: F401  (register themselves)
+    contact_edges,
+    contact_faces,
+    contact_surface,
+)
 from formulations.contact_boundary import boundary_kind
 from scenes import Scene
 

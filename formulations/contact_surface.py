@@ -16,7 +16,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 from skfem import Mesh
 
-from formulations.contact_boundary import ContactBoundary, register_boundary
+from formulations.contact_boundary import register_boundary
 from formulations.reference_facets import (
     P2_CHILDREN,
     TRIANGLE_SAMPLES,
@@ -24,15 +24,15 @@ from formulations.reference_facets import (
     triangle_lagrange,
     triangle_rule,
 )
+from formulations.surface_boundary import SurfaceBoundary
 from scenes.base import simplex_measures, simplex_points
 
-DISC_DEGREE = 10  # 25 points per contact triangle for the area of the contact zone
 # candidate facets per located point: the nearest centroids (in contact coordinates) tried
 CANDIDATES = 8
 
 
 @dataclass(frozen=True, eq=False)
-class ContactSurface(ContactBoundary):
+class ContactSurface(SurfaceBoundary):
     """Contact facets of a tetrahedral ``mesh``. ``vertices`` (3, n) are each facet's corners,
     ``normal`` (3, n) the outer unit normals, ``measure`` (n,) the areas, ``diameter`` (n,) the
     longest edges, ``coordinate`` (2, 3, n) the scene's contact coordinates of the corners and
@@ -47,8 +47,6 @@ class ContactSurface(ContactBoundary):
     coordinate: np.ndarray
     element: np.ndarray
     name = "triangles"
-    dim = 3
-    kink_degree = 10  # 25 points per triangle
 
     @classmethod
     def of(cls, scene, mesh) -> ContactSurface:
@@ -73,11 +71,6 @@ class ContactSurface(ContactBoundary):
         """Contact coordinates at local coordinates t (2, nq); shape (2, n, nq) (affine on a
         facet of a plane Gamma_C)."""
         return simplex_points(self.coordinate, t)
-
-    def row_coordinates(self, t: np.ndarray) -> np.ndarray:
-        """Contact coordinates (2, n * nq) of the points t of every facet, one column per row
-        (facet f, point q -> f * nq + q)."""
-        return self.coordinates_at(t).reshape(2, -1)
 
     @staticmethod
     def rule(degree: int) -> tuple[np.ndarray, np.ndarray]:
@@ -116,13 +109,6 @@ class ContactSurface(ContactBoundary):
         nodes = triangle_lagrange(min(order, 2))[0]
         return nodes, (np.array([[0, 1, 2]]) if order == 1 else P2_CHILDREN)
 
-    def surface_tangents(self) -> list[np.ndarray]:
-        """Two orthogonal unit directions in each facet: along its first edge, and n x that."""
-        first = self.points(np.array([[1.0], [0.0]]))[:, :, 0] - self.points(
-            np.array([[0.0], [0.0]]))[:, :, 0]
-        first /= np.linalg.norm(first, axis=0)
-        return [first, np.cross(self.normal, first, axis=0)]
-
     # --- nodal contact (formulations.surface_nodes) ------------------------------------------
     def nodes(self, order: int):
         from formulations.surface_nodes import surface_nodes
@@ -144,96 +130,6 @@ class ContactSurface(ContactBoundary):
         from formulations.surface_nodes import surface_pressure
 
         return lambda t: surface_pressure(values, t)
-
-    # --- tractions and zones ----------------------------------------------------------------
-    @staticmethod
-    def shear(components: np.ndarray, tangents: list[np.ndarray]) -> np.ndarray:
-        """The shear vector sum_k sigma_k t_k (3, n, nq) from its components (n, nq, 2)."""
-        from formulations.slack_friction import shear_vectors
-
-        return shear_vectors(components, tangents)
-
-    @staticmethod
-    def slide_component(traction: np.ndarray) -> np.ndarray:
-        """The shear traction along the obstacle's slide (x): the vector's first component."""
-        return traction[0]
-
-    @staticmethod
-    def shear_vector(traction: np.ndarray) -> np.ndarray:
-        """The shear traction, a vector already (3, n, nq)."""
-        return traction
-
-    def slide_vector(self, slide: float) -> np.ndarray:
-        """The obstacle's slide w = slide e_x at every facet (3, n)."""
-        return np.outer(np.eye(3)[0] * float(slide), np.ones(self.size))
-
-    @staticmethod
-    def ordered_breaks(coordinates: np.ndarray) -> np.ndarray:
-        """A surface has no order along it: no breaks."""
-        return np.zeros(0)
-
-    @staticmethod
-    def around(centre: float, radius: float) -> np.ndarray:
-        """Contact coordinates (2, m) over a disc's surroundings: a grid of 201 x 201 points
-        over +-2 radii about (centre, 0)."""
-        line = np.linspace(-2 * radius, 2 * radius, 201)
-        return np.array(np.meshgrid(centre + line, line)).reshape(2, -1)
-
-    def zone(self, pressure) -> tuple[float, float]:
-        """A 3D contact zone as (c - r, c + r): r the radius of the disc of the same area as
-        the part of Gamma_C where ``pressure`` > ACTIVE_FRACTION x its maximum (by
-        quadrature), c the first contact coordinate of its centroid (docs/theory.md, 14.2)."""
-        from formulations.kkt import ACTIVE_FRACTION
-
-        t, w = self.rule(DISC_DEGREE)
-        values = pressure(t)
-        pressed = values > ACTIVE_FRACTION * values.max(initial=0.0)
-        area = self.integrate(pressed.astype(float), w).sum()
-        if area <= 0:
-            return float("nan"), float("nan")
-        centre = self.integrate(pressed * self.coordinates_at(t)[0], w).sum() / area
-        radius = float(np.sqrt(area / np.pi))
-        return float(centre - radius), float(centre + radius)
-
-    def pressure_samples(self, solution) -> tuple[np.ndarray, np.ndarray]:
-        """A reference's pressure on tetrahedra: -sigma_nn(u_h) at the P2 nodes and the
-        centroid of every contact triangle, clipped at 0, and 0 on the triangles where
-        lambda_h is 0 throughout: the pressure of the displacement itself, not one recovered
-        from the VI's nodal reactions (docs/theory.md, section 14.6). Contact coordinates
-        (2, m) and values, each point once."""
-        from formulations.elasticity import stress_tensor_from_gradient
-        from formulations.evaluation import gradients_at
-
-        t, nq = TRIANGLE_SAMPLES, TRIANGLE_SAMPLES.shape[1]
-        x, normal = self.points(t).reshape(3, -1), self.at_points(self.normal, nq)
-        grad = gradients_at(solution.elasticity.basis, solution.u, x,
-                            np.repeat(self.element, nq))
-        sigma = stress_tensor_from_gradient(grad, *solution.elasticity.lame)
-        values = np.maximum(-np.einsum("in,ijn,jn->n", normal, sigma, normal), 0.0)
-        pressed = (solution.pressure(t) > 0).any(axis=1)  # per facet: the nodal one dips to 0
-        values[~np.repeat(pressed, nq)] = 0.0
-        s, index = np.unique(self.coordinates_at(t).reshape(2, -1).round(14), axis=1,
-                             return_index=True)
-        return s, values[index]
-
-    def pressure_at(self, pressure, s: np.ndarray, samples: int = 17) -> np.ndarray:
-        """lambda_h at contact coordinates s (2, m), each in its facet: the quadratic
-        interpolant of its values at the facet's six P2 nodes (exact for P1 and P2 pressures;
-        for the penalty's kinked one, error O(h^2) where the kink crosses)."""
-        facet, t = self.locate(s)
-        nodes, basis = triangle_lagrange(2)
-        values = pressure(nodes)  # (n_facets, 6)
-        return np.einsum("km,km->m", values[facet].T, basis(t))
-
-    @staticmethod
-    def variation(pressure, samples: int) -> float:
-        """A surface has no order along it: NaN."""
-        return float("nan")
-
-    @staticmethod
-    def graded(marked: np.ndarray, n_elements: int) -> np.ndarray:
-        """No grading closure on a surface: ``marked`` as it is."""
-        return marked
 
     def locate(self, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The facet holding each contact coordinate s (2, m) and the local coordinates there

@@ -149,12 +149,21 @@ def checked_options(h_over_H: float, order: int, multiplier_degree: int | None):
     return order, degree
 
 
+def no_multiplier_space(scene=None, family=None, **_) -> str | None:
+    """Why the mixed method cannot run on ``family``'s cells: no multiplier space is built on
+    their contact boundary (``MULTIPLIER_SPACES``), or None."""
+    if family is None or family.contact_boundary in MULTIPLIER_SPACES:
+        return None
+    return (f"the mixed method has no multiplier space on {family.contact_boundary} (it has "
+            f"one on {', '.join(MULTIPLIER_SPACES)})")
+
+
 @register_formulation("mixed", "Haslinger's mixed method: multiplier of degree p - 1 "
                                "(piecewise constant for P1) on a coarser contact mesh, "
                                "h/H <= 1/2 (seed paper, eq. (3)); in 3D piecewise constant "
                                "on vertex-star patches of contact triangles; Tresca or "
                                "Coulomb friction with a tangential multiplier in the same "
-                               "space (2D and 3D)", friction=(2, 3))
+                               "space (2D and 3D)", no_multiplier_space, friction=(2, 3))
 def discretise(scene: Scene, mesh: MeshTri, h_over_H: float = 0.5, order: int = 1,
                multiplier_degree: int | None = None) -> Discretisation:
     """``h_over_H``: the largest allowed ratio of a facet to its multiplier segment. The
@@ -164,11 +173,11 @@ def discretise(scene: Scene, mesh: MeshTri, h_over_H: float = 0.5, order: int = 
     p - 1, docs/theory.md, section 9). On a quadrilateral hierarchy h_over_H = 2^-k takes the
     edges k levels up (module docstring). On tetrahedra (``discretise_surface``) h_over_H = 1/2
     means star patches, 1 the contact triangles, and q is 0."""
-    boundary = family_of(mesh).contact_boundary
-    if boundary not in MULTIPLIER_SPACES:
-        raise ValueError(f"the mixed method has no multiplier space on {boundary} (it has one "
-                         f"on {', '.join(MULTIPLIER_SPACES)})")
-    return MULTIPLIER_SPACES[boundary](scene, mesh, h_over_H, order, multiplier_degree)
+    why = no_multiplier_space(family=family_of(mesh))
+    if why is not None:
+        raise ValueError(why)
+    return MULTIPLIER_SPACES[family_of(mesh).contact_boundary](scene, mesh, h_over_H, order,
+                                                               multiplier_degree)
 
 
 def discretise_segments(scene: Scene, mesh, h_over_H: float, order: int,

@@ -1,5 +1,7 @@
 """Formulation registry: name -> ``discretise(scene, mesh) -> Discretisation``."""
 
+import inspect
+
 from scenes.registry import Registry
 
 FORMULATIONS = Registry("formulation")
@@ -25,15 +27,21 @@ def frictionless_only(kind: str, name: str, applies=None, dims: tuple[int, ...] 
             where = f" in {scene.dim}D" if dims else ""
             return (f"{kind} {name!r} does not model friction{where} (the scene's law is "
                     f"{scene.friction.label})")
-        return applies(scene=scene, **context) if applies is not None else None
+        if applies is None:
+            return None
+        accepted = inspect.signature(applies).parameters  # a plugin's may take scene only
+        if not any(p.kind is p.VAR_KEYWORD for p in accepted.values()):
+            context = {k: v for k, v in context.items() if k in accepted}
+        return applies(scene=scene, **context)
 
     return check
 
 
 def register_formulation(name: str, description: str, applies=None, *,
                          friction: bool | tuple[int, ...] = False, traits: tuple[str, ...] = ()):
-    """Register ``discretise(scene, mesh, **options)`` under ``name``; ``applies(scene=...)``
-    says why a scene is refused (optional); ``friction``: whether it models a scene's
+    """Register ``discretise(scene, mesh, **options)`` under ``name``; ``applies(scene=...,
+    family=...)`` says why a scene or a cell family (``formulations.cells``) is refused
+    (optional; it may take either keyword only); ``friction``: whether it models a scene's
     friction law (True: in 2D; or the dimensions, e.g. (2, 3)), else a scene with friction is
     refused with that reason; ``traits``: what an estimator may ask of it (TRAITS)."""
     unknown = [t for t in traits if t not in TRAITS]

@@ -136,10 +136,11 @@ def _rigid(lam: float, corner: Corner, kappa: float) -> bool:
     return _stress(lam, null, np.linspace(0.0, corner.angle, 33)) < 1e-8
 
 
-def predicted_rate(exponents, order: int) -> float:
-    """The uniform-refinement rate of the energy error in N (DOFs): -min(lambda, p) / 2, with
-    lambda the smallest exponent of the solution (corners and contact-zone ends)."""
-    return -min(min(exponents), order) / 2.0
+def predicted_rate(exponents, order: int, dim: int = 2) -> float:
+    """The uniform-refinement rate of the energy error in N (DOFs): -min(lambda, p) / d (h is
+    N^(-1/d)), with lambda the smallest exponent of the solution (corners and contact-zone
+    ends)."""
+    return -min(min(exponents), order) / dim
 
 
 @dataclass(frozen=True)

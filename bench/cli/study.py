@@ -7,7 +7,6 @@ import dataclasses
 from bench.cli import option_types as options
 from bench.cli.guards import InputError
 from bench.study import QUICK, StudyConfig, run_study
-from bench.study.quads import as_frame, hex_sequence, write_hex_report
 from bench.study.run import STUDY_FILE, StudyFile, report_study
 from formulations.cells import family_for
 from scenes import get_scene, scene_names
@@ -17,7 +16,6 @@ DEFAULTS = STUDY_FILE.settings
 STUDY_FLAGS = {"scenes": "scene", "orders": "order", "uniform_max_dofs": "uniform-max-dofs",
                "adaptive_max_dofs": "adaptive-max-dofs", "reference_dofs": "reference-dofs",
                "workers": "workers", "out": "out", "report": "report"}
-HEX_SCENE = "free-boundary-3d"  # the 3D scene with an exact solution
 
 
 def add_study_parser(sub, study_file: StudyFile | None = None) -> None:
@@ -34,8 +32,8 @@ def add_study_parser(sub, study_file: StudyFile | None = None) -> None:
         "sequence.")
     study.add_argument("--scene", type=options.name_list("scene", scene_names()),
                        default=None,
-                       help=f"scene(s) (default: {','.join(d.scenes)}; with --cell hex: "
-                            f"{HEX_SCENE})")
+                       help=f"scene(s) (default: {','.join(d.scenes)}; with --cell quad or hex: "
+                            "the study file's [cells.NAME] table's)")
     study.add_argument("--order", type=options.order_list, default=list(d.orders),
                        help="polynomial order(s) (default: 1)")
     study.add_argument("--uniform-max-dofs", type=options.positive_int("uniform_max_dofs"),
@@ -54,14 +52,15 @@ def add_study_parser(sub, study_file: StudyFile | None = None) -> None:
                        help=f"adaptive sequences run in parallel on a local Dask cluster of "
                             f"this many processes; uniform ones one at a time "
                             f"(default: {d.workers})")
-    study.add_argument("--cell", choices=("tri", "quad", "hex"), default=d.cell,
+    study.add_argument("--cell", choices=study_file.cell_names(), default=d.cell,
                        help="tri (default): every formulation x estimator on triangles; quad: "
                             "the study file's [cells.quad] table, the seed's own discretisation "
                             "(Q1, Q2 with --order 2, on hierarchical quadrilateral meshes with "
                             "hanging nodes, vi and the mixed method with lambda_H one and two "
                             "levels coarser, the residual estimator), run by the matrix, with "
-                            "the seed's Fig. 1 and Fig. 2 in the report; hex: Q1 on the 3D "
-                            "scenes' cubes, vi, uniform (REPORT/hexes.md)")
+                            "the seed's Fig. 1 and Fig. 2 in the report; hex: [cells.hex], Q1 on "
+                            "the hexahedra of a 3D scene's grid of cubes, uniform, every "
+                            "formulation with a contact space on quadrilateral faces")
     study.add_argument("--quick", action="store_true",
                        help=f"the reduced study of the default tests ([quick] of study.toml): "
                             f"{','.join(QUICK.scenes)}, uniform to {QUICK.uniform_max_dofs} and "
@@ -79,24 +78,6 @@ def add_study_parser(sub, study_file: StudyFile | None = None) -> None:
                             "bench/study/study.toml (its keys: scenes, orders, "
                             "uniform-max-dofs, ...); options given override them")
     study.set_defaults(study_file=study_file)
-
-
-def hex_study_command(args) -> int:
-    """``study --cell hex``: uniform Q1 on hexahedra of the 3D scenes given (default:
-    free-boundary-3d) and its report."""
-    scenes = args.scene or [HEX_SCENE]
-    budget = 30000 if args.quick else args.uniform_max_dofs
-    rows = []
-    try:
-        for scene in scenes:
-            rows += hex_sequence(scene, budget)
-            print(f"{scene}/vi/hex-Q1/uniform: {len(rows)} levels", flush=True)
-    except ValueError as error:
-        raise InputError(str(error)) from None
-    report = write_hex_report(as_frame(rows), args.report,
-                              " ".join(["python -m bench", *args.argv]))
-    print(f"{len(rows)} levels; wrote {report}")
-    return 0
 
 
 def study_config(args) -> StudyConfig:
@@ -121,9 +102,10 @@ def study_config(args) -> StudyConfig:
 
 
 def study_command(args) -> int:
-    if args.cell == "hex":
-        return hex_study_command(args)
-    config = study_config(args)
+    try:
+        config = study_config(args)
+    except ValueError as error:
+        raise InputError(str(error)) from None
     if args.report_only:
         try:
             table, report, verdicts = report_study(config)

@@ -177,9 +177,10 @@ def check_formulation_options(spec: SequenceSpec, scene=None) -> None:
                          "--order (RunConfig.orders), not as a formulation option")
     discretise = get_formulation(spec.formulation)
     check_parameters("formulation", spec.formulation, spec.formulation_options, discretise)
-    if scene is not None and why_no_cells(spec, scene) is None and \
-            FORMULATIONS.why_not(spec.formulation, scene=scene) is None:  # else a skipped row
-        mesh = family_for(spec.cell, scene.dim).starting_mesh(scene)
+    family = family_for(spec.cell, scene.dim) if scene is not None else None
+    if scene is not None and why_no_cells(spec, scene) is None and FORMULATIONS.why_not(
+            spec.formulation, scene=scene, family=family) is None:  # else a skipped row
+        mesh = family.starting_mesh(scene)
         try:
             discretise(scene, mesh, order=spec.order, **dict(spec.formulation_options))
         except (ValueError, TypeError) as error:

@@ -41,7 +41,7 @@ def why_skipped(scene: Scene, formulation: str, solver: str, estimator: str,
     except ValueError as error:
         return str(error)
     reason = (family.why_not(scene, strategy) or why_no_element(order, scene.dim, cell)
-              or FORMULATIONS.why_not(formulation, scene=scene)
+              or FORMULATIONS.why_not(formulation, scene=scene, family=family)
               or (SOLVERS.why_not(solver, scene=scene, formulation=formulation)
                   if solver in SOLVERS.names() else None)
               or ESTIMATORS.why_not(estimator, scene=scene, formulation=formulation)

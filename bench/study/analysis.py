@@ -56,16 +56,18 @@ def fitted_slope(ndofs, values, levels: int = FIT_LEVELS) -> tuple[float, float]
 
 
 def predictions(scenes, orders=(1,)) -> pd.DataFrame:
-    """Per scene and order: its smallest singular exponent, where, and the predicted slopes."""
+    """Per scene and order: its smallest singular exponent, where, and the predicted slopes
+    (h is N^(-1/d) in d dimensions)."""
     rows = []
     for name in scenes:
-        found = singularities(get_scene(name))
+        scene = get_scene(name)
+        found = singularities(scene)
         for order in orders:
             rows.append({"scene": name, "order": order, "exponent": found[0].exponent,
                          "where": found[0].where,
                          "predicted_uniform": predicted_rate([s.exponent for s in found],
-                                                             order),
-                         "predicted_adaptive": -order / 2.0})
+                                                             order, scene.dim),
+                         "predicted_adaptive": -order / scene.dim})
     return pd.DataFrame(rows)
 
 

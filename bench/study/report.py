@@ -184,7 +184,8 @@ def _report_text(table, asymptotic, predicted, nearly, figures, wall_seconds, pl
              "## Predictions", "",
              "Smallest singular exponent lambda of each scene (u ~ r^lambda; corners from "
              "their eigenvalue equation, contact-zone ends 3/2) and the slopes it predicts: "
-             "uniform -min(lambda, p)/2, adaptive -p/2.", "", _markdown(predicted), "",
+             "uniform -min(lambda, p)/d, adaptive -p/d (h is N^(-1/d) in d dimensions).", "",
+             _markdown(predicted), "",
              "## Asymptotic slopes", "",
              "Least-squares slopes over the last levels with their standard errors; "
              f"effectivity over every level from {EFFECTIVITY_FROM} DOFs. For uniform "

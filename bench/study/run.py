@@ -19,7 +19,7 @@ from bench.study.report import write_study_report
 from bench.verify import load_expected
 from estimators import estimator_names
 from formulations import formulation_names
-from formulations.cells import DEFAULT_CELL, check_cell
+from formulations.cells import DEFAULT_CELL, cell_names, check_cell
 from formulations.solvers.registry import FAST_SOLVER
 
 STUDY_SETTINGS = Path(__file__).with_name("study.toml")  # the defaults, and [quick]
@@ -28,14 +28,18 @@ STUDY_KEYS = ["scenes", "orders", "uniform_max_dofs", "adaptive_max_dofs", "refe
 
 
 def _study_tables(path: str | Path) -> tuple[dict, dict, dict]:
-    """A study file's settings, its ``[quick]`` table's and its ``[cells.NAME]`` tables', as
-    ``StudyConfig`` fields."""
+    """A study file's settings, its ``[quick]`` table's and its ``[cells.NAME]`` tables' (each
+    with its own ``quick`` table), as ``StudyConfig`` fields."""
     data = read_toml(path, "a study file")
     quick, cells = data.pop("quick", {}), data.pop("cells", {})
     where = f"config={str(path)!r}"
-    return (dataclass_fields(data, STUDY_KEYS, where),
-            dataclass_fields(quick, STUDY_KEYS, f"{where} [quick]"),
-            {check_cell(cell): dataclass_fields(table, STUDY_KEYS, f"{where} [cells.{cell}]")
+
+    def fields(table: dict, name: str) -> dict:
+        return dataclass_fields(table, STUDY_KEYS, f"{where} [{name}]")
+
+    return (fields(data, "top"), fields(quick, "quick"),
+            {cell: (fields({k: v for k, v in table.items() if k != "quick"}, f"cells.{cell}"),
+                    fields(table.get("quick", {}), f"cells.{cell}.quick"))
              for cell, table in cells.items()})
 
 
@@ -81,20 +85,33 @@ class StudyFile:
 
     settings: StudyConfig
     quick: tuple[tuple[str, object], ...] = ()
-    cells: tuple[tuple[str, tuple[tuple[str, object], ...]], ...] = ()
+    # per cell name: its table's settings and its quick table's
+    cells: tuple[tuple[str, tuple, tuple], ...] = ()
+
+    def cell_names(self) -> list[str]:
+        """What ``--cell`` takes: the matrix's cell shapes and the file's ``[cells.NAME]``."""
+        return sorted({*cell_names(), *(name for name, _, _ in self.cells)})
 
     def config(self, cell: str | None = None, quick: bool = False) -> StudyConfig:
-        """The study on ``cell`` (default: the file's), reduced to ``[quick]`` if asked."""
-        cell = check_cell(cell or self.settings.cell)
-        config = replace(self.settings, cell=cell, **dict(dict(self.cells).get(cell, ())))
-        return replace(config, **dict(self.quick)) if quick else config
+        """The study on ``cell`` (default: the file's): its ``[cells.NAME]`` table (whose own
+        ``cell`` key, if any, is the matrix's cell axis: ``hex`` runs ``quad`` cells on 3D
+        scenes), reduced to ``[quick]`` if asked."""
+        name = cell or self.settings.cell
+        tables = {cell: (table, reduced) for cell, table, reduced in self.cells}
+        if name not in self.cell_names():
+            raise ValueError(f"cell={name!r} is not one of {', '.join(self.cell_names())}")
+        table, reduced = tables.get(name, ((), ()))
+        config = replace(self.settings, cell=name, **(dict(self.quick) if quick else {}))
+        config = replace(config, **{**dict(table), **(dict(reduced) if quick else {})})
+        return replace(config, cell=check_cell(config.cell))
 
 
 def read_study_file(path: str | Path = STUDY_SETTINGS) -> StudyFile:
     """A study file (the package's study.toml, or a copy given with ``--config``)."""
     settings, quick, cells = _study_tables(path)
     return StudyFile(StudyConfig(**settings), tuple(quick.items()),
-                     tuple((cell, tuple(table.items())) for cell, table in cells.items()))
+                     tuple((cell, tuple(table.items()), tuple(reduced.items()))
+                           for cell, (table, reduced) in cells.items()))
 
 
 # the default tests' version: the paper scene to a few thousand DOFs

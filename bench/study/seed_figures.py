@@ -125,7 +125,7 @@ def write_seed_figures(table: pd.DataFrame, results: str | Path, folder: Path,
     within = adaptive[adaptive["ndofs"] <= fig1_dofs]
     artifact = (load_artifact(level_artifact_path(results, next(within.tail(1).itertuples())))
                 if len(within) else None)
-    if artifact is not None:
+    if artifact is not None and artifact["p"].shape[0] == 2:  # Fig. 1 is a plane picture
         title = f"{scenes[0]}, {sequence_name(within.iloc[-1])}, adaptive"
         mesh_and_stress(artifact, title).savefig(folder / "seed-fig1.png", dpi=110)
         names.append("seed-fig1.png")

@@ -6,11 +6,12 @@ so, and ``python -m bench study --cell hex`` runs the VI on them."""
 from __future__ import annotations
 
 import numpy as np
-from skfem import ElementHex1, MeshHex
+from skfem import Basis, ElementHex1, MeshHex
 from skfem.mesh import MeshHex1
 
 from formulations.cells.base import CellFamily, register_family
 from formulations.cells.quadrilateral import not_a_grid, tensor_axes
+from formulations.quad_load import quad_body_load
 
 
 class Hexahedra(CellFamily):
@@ -37,7 +38,12 @@ class Hexahedra(CellFamily):
         return int(3 * (mesh.p.shape[1] - clamped))
 
     def stiffness_intorder(self, order: int) -> int:
-        return 2  # 2 x 2 x 2 Gauss points: exact on parallelepipeds
+        return 2 * order  # (p + 1)^3 Gauss points: exact on parallelepipeds
+
+    def body_load(self, body_force, basis, order: int) -> np.ndarray:
+        """The cell rule, refined where f jumps (``formulations.quad_load``)."""
+        rule = Basis(basis.mesh, basis.elem, intorder=2 * order + 1)
+        return quad_body_load(body_force, rule)
 
 
 HEXAHEDRA = register_family(Hexahedra(), "hexahedra: Q1 on tensor grids, uniform refinement")

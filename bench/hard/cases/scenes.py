@@ -67,7 +67,8 @@ def force_change(scene, formulation: str, coarse_mesh, fine: float) -> float:
 
 def scene_case(name: str, cell: str = DEFAULT_CELL) -> list[dict]:
     scene = get_scene(name)
-    why = family_for(cell, scene.dim).why_not(scene)
+    family = family_for(cell, scene.dim)
+    why = family.why_not(scene)
     if why is not None:
         return [dict(case=name, scene=name, formulation="", solver="", variant=cell, level=0,
                      status="skipped", reason=why, verdict=REFUSED, finding=why)]
@@ -75,7 +76,7 @@ def scene_case(name: str, cell: str = DEFAULT_CELL) -> list[dict]:
     variant = "" if cell == DEFAULT_CELL else cell
     records = []
     for formulation in FORMULATIONS.names():
-        if FORMULATIONS.why_not(formulation, scene=scene) is not None:
+        if FORMULATIONS.why_not(formulation, scene=scene, family=family) is not None:
             continue
         rows, sols = solve_both(name, scene, formulation, mesh, variant=variant,
                                 level=hard_level(scene))

@@ -63,7 +63,8 @@ def test_a_scene_whose_mesh_is_not_a_tensor_grid_has_no_quadrilaterals():
         family_for("quad", 2).starting_mesh(scene)
 
 
-def test_hexahedra_refine_uniformly_only_and_say_why_they_pose_no_contact():
+def test_hexahedra_refine_uniformly_only_and_pose_contact_on_their_faces():
     family = family_for("quad", 3)
     assert "uniform only" in family.why_not(get_scene("paper-3d"), "adaptive")
-    assert "contact boundary of hexahedra" in family.why_not(get_scene("paper-3d"), "uniform")
+    assert family.why_not(get_scene("paper-3d"), "uniform") is None
+    assert family.contact_boundary == "quadrilaterals"
