@@ -1,7 +1,7 @@
-"""Hexahedra: Q1 on tensor grids, refined uniformly (docs/theory.md, sections 15.3-15.4). Adaptive
-refinement would need hanging nodes on faces and edges, and the formulations a contact surface
-of quadrilateral faces: neither is built, so a run on hexahedra is a skipped row that says
-so, and ``python -m bench study --cell hex`` runs the VI on them."""
+"""Hexahedra: Q1 on tensor grids, refined uniformly (docs/theory.md, sections 15.4-15.6). Their
+contact boundary is the quadrilateral faces on Gamma_C (``formulations.contact_faces``).
+Adaptive refinement would need hanging nodes on faces and edges: not built, so an adaptive run
+on hexahedra is a skipped row that says so."""
 
 from __future__ import annotations
 
