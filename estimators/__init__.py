@@ -1,19 +1,16 @@
 """Estimators: how the error of a discrete solution is estimated (docs/theory.md, section 4).
 
-Importing this package registers every estimator module listed below; adding an estimator is one
-new module with a ``@register_estimator`` ``estimate(scene, solution)`` function and one import
-line here.
+Importing this package registers every estimator: ``averaging`` here, the residual family
+(``estimators.residual``) and the guaranteed bounds (``estimators.guaranteed``), each a package
+whose ``__init__`` imports its estimators. Adding an estimator is one new module with a
+``@register_estimator`` ``estimate(scene, solution)`` function and one import line here (or in
+its family's ``__init__``).
 """
 
 from estimators import (  # noqa: F401  (register themselves)
     averaging,
-    equilibrated,
-    equilibrated_3d,
-    equilibrated_local,
-    nitsche_residual,
-    quad_residual,
+    guaranteed,
     residual,
-    residual_3d,
 )
 from estimators.base import (
     Estimate,

@@ -2,7 +2,8 @@
 interior-point method on the sparse normal equations, then active-set steps to the exact
 minimiser (docs/theory.md, 13.3): the non-negative pressures that
 reproduce nodal reactions (``formulations.surface_nodes`` for vi's P2 pressure on a 3D
-contact surface, ``estimators.nonnegative_traction`` for the guaranteed bound's lambda*)."""
+contact surface, ``estimators.guaranteed.nonnegative_traction`` for the guaranteed bound's
+lambda*)."""
 
 from __future__ import annotations
 

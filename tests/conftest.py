@@ -123,8 +123,8 @@ CUBE_STRAIN = np.array([[0.3, 0.1, -0.2], [0.05, -0.1, 0.2], [0.1, 0.3, 0.15]]) 
 def cube_problem(n, order, body_force, traction):
     """P_order elasticity on the unit cube (x = 0 clamped at u = CUBE_STRAIN x, t on the other
     faces), solved by scikit-fem alone, on a mesh whose tetrahedra list their vertices in
-    random order; the sorted mesh's patch data (``estimators.patch_data``), the boundary flux,
-    the clamped vertices, the free faces and rho."""
+    random order; the sorted mesh's patch data (``estimators.guaranteed.patch_data``), the boundary
+    flux, the clamped vertices, the free faces and rho."""
     from skfem import (
         Basis,
         ElementTetP1,
@@ -140,10 +140,10 @@ def cube_problem(n, order, body_force, traction):
     from skfem.helpers import dot
     from skfem.models.elasticity import linear_elasticity
 
-    from estimators.equilibrated_3d import INTORDER
-    from estimators.equilibration import BoundaryData, boundary_balance, boundary_fluxes
-    from estimators.patch_data import interior_data, rebalanced
-    from estimators.raviart_thomas_tet import sorted_tetrahedra
+    from estimators.guaranteed.equilibrated_3d import INTORDER
+    from estimators.guaranteed.equilibration import BoundaryData, boundary_balance, boundary_fluxes
+    from estimators.guaranteed.patch_data import interior_data, rebalanced
+    from estimators.guaranteed.raviart_thomas_tet import sorted_tetrahedra
     from formulations.elasticity import stress_tensor_from_gradient
     from formulations.evaluation import gradients_at
 

@@ -15,8 +15,8 @@ from bench.hard.registry import HARD_CASES
 from bench.matrix import RunConfig, run
 from bench.report import figures, panels, write_report
 from conftest import square_scene
-from estimators import residual
 from estimators.base import ESTIMATORS, register_estimator
+from estimators.residual import triangles as residual
 from formulations import mixed
 from formulations.registry import FORMULATIONS, register_formulation
 from scenes.registry import SCENES, register_scene

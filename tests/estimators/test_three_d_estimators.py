@@ -49,7 +49,7 @@ def test_every_3d_estimator_has_a_bounded_effectivity(estimator, order):
 
 
 def test_3d_face_jumps_do_not_depend_on_the_block_size(monkeypatch):
-    import estimators.residual_3d as residual_3d
+    import estimators.residual.tetrahedra as residual_3d
 
     sol = solve(get_formulation("vi")(SCENE, SCENE.mesh.refined(1), order=2), "active-set")
     whole = residual_3d.interior_jumps_3d(sol)

@@ -3,7 +3,7 @@ eq. (8), to show what those terms add."""
 
 from estimators import register_estimator
 from estimators.base import Estimate
-from estimators.residual import edge_residuals, element_residual
+from estimators.residual.triangles import edge_residuals, element_residual
 
 
 @register_estimator("residual-volume", "example plugin: the residual eta_0 alone (no contact "
