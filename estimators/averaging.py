@@ -29,9 +29,9 @@ from estimators.base import Estimate, combine, register_estimator
 from estimators.contact_terms import contact_terms
 from formulations import DiscreteSolution
 from formulations.cells import family_of
+from formulations.cells.evaluation import gradients_at_reference
+from formulations.cells.p1_stiffness import barycentric_gradients
 from formulations.elasticity import stress_from_gradient, stress_tensor_from_gradient
-from formulations.evaluation import gradients_at_reference
-from formulations.p1_stiffness import barycentric_gradients
 
 
 def element_areas(mesh) -> np.ndarray:

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from formulations import DiscreteSolution
-from formulations.evaluation import evaluate_on_trace
+from formulations.cells.evaluation import evaluate_on_trace
 
 # w has kinks where u_hn crosses g inside a facet: the contact boundary's ``kink_degree`` (10
 # Gauss points on an edge, 25 points on a triangle) keeps that quadrature error far below the

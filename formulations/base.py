@@ -15,9 +15,9 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import sparse
 
-from formulations.contact_edges import ContactTrace
+from formulations.cells.evaluation import normal_trace_matrix
+from formulations.contact.edges import ContactTrace
 from formulations.elasticity import Elasticity
-from formulations.evaluation import normal_trace_matrix
 
 STATUS_OK, STATUS_INACCURATE, STATUS_FAILED = "ok", "inaccurate", "failed"
 STATUS_SKIPPED = "skipped"
@@ -233,7 +233,7 @@ class DiscreteSolution:
     max_h_over_H: float = float("nan")
     backend: str = ""
     # the QP multipliers (clipped at 0) and the formulation's own arrays (a frozen dataclass
-    # of the formulation module, e.g. ``formulations.mixed.MixedDetails``)
+    # of the formulation module, e.g. ``formulations.methods.mixed.MixedDetails``)
     multipliers: np.ndarray | None = None
     details: object | None = None
     # relative disagreement of the formulation's pressure with its QP multipliers, where the

@@ -15,7 +15,7 @@ from formulations.base import (
     Residuals,
     slack_warm_start,
 )
-from formulations.contact_edges import ContactTrace
+from formulations.contact.edges import ContactTrace
 from formulations.elasticity import Elasticity
 from formulations.kkt import final_status, qp_residuals
 from formulations.semismooth import SemismoothSystem

@@ -18,8 +18,8 @@ from scipy import sparse
 from skfem import Basis, ElementVector, MeshTri
 
 from formulations.cells import DEFAULT_CELL, family_for, family_of
+from formulations.cells.dof_basis import DofBasis
 from formulations.cells.triangle import TRIANGLES
-from formulations.dof_basis import DofBasis
 from scenes import Scene
 from scenes.base import is_integer
 from scenes.topology import ensure_topology

@@ -1,7 +1,7 @@
 """Bound-constrained least squares, argmin_{x >= 0} ||A x - b||^2 + ||w x||^2, by Clarabel's
 interior-point method on the sparse normal equations, then active-set steps to the exact
 minimiser (docs/theory.md, 13.3): the non-negative pressures that
-reproduce nodal reactions (``formulations.surface_nodes`` for vi's P2 pressure on a 3D
+reproduce nodal reactions (``formulations.contact.surface_nodes`` for vi's P2 pressure on a 3D
 contact surface, ``estimators.guaranteed.nonnegative_traction`` for the guaranteed bound's
 lambda*)."""
 

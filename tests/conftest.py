@@ -144,8 +144,8 @@ def cube_problem(n, order, body_force, traction):
     from estimators.guaranteed.equilibration import BoundaryData, boundary_balance, boundary_fluxes
     from estimators.guaranteed.patch_data import interior_data, rebalanced
     from estimators.guaranteed.raviart_thomas_tet import sorted_tetrahedra
+    from formulations.cells.evaluation import gradients_at
     from formulations.elasticity import stress_tensor_from_gradient
-    from formulations.evaluation import gradients_at
 
     cube = MeshTet.init_tensor(*[np.linspace(0, 1, n + 1)] * 3)
     rng = np.random.default_rng(3)

@@ -38,7 +38,7 @@ LOSS_TOLERANCE = 1e-6  # the same bar as a residual for status "ok" (formulation
 # the pressure is a pointwise, derived quantity: the reference (tolerances 1e-10) gets the mixed
 # multipliers to ~1e-8, but the penalty pressure only to 1e-5..4e-4 at the default eps_0 = 1e-3
 # (measured), which is still a usable answer; 0.1 % (as the penalty's own self-check,
-# formulations.penalty.PRESSURE_CONSISTENCY) separates that from a wrong pressure
+# formulations.methods.penalty.PRESSURE_CONSISTENCY) separates that from a wrong pressure
 PRESSURE_TOLERANCE = 1e-3
 ACCURATE, INACCURATE, FAILED, REFUSED = "accurate", "inaccurate", "failed", "refused"
 

@@ -20,7 +20,7 @@ from skfem import Basis
 from bench.measure.contact import contact_zone, zone_error
 from formulations import DiscreteSolution
 from formulations.elasticity import stress_from_gradient, stress_tensor_from_gradient
-from formulations.friction_state import traction_size
+from formulations.friction.state import traction_size
 
 EXACT_INTORDER = 6  # plus 2 (p - 1) for P_p: the u_h part of the integrand stays exact
 PRESSURE_POINTS = 6  # Gauss points per contact facet for ||lambda - lambda_h||

@@ -22,9 +22,9 @@ from skfem import Basis, MeshTri
 
 from bench.measure.locator_3d import TetLocator
 from bench.measure.walk import element_neighbours, walk
+from formulations.cells.evaluation import gradients_at_reference, p1_gradients
+from formulations.cells.p1_stiffness import barycentric_gradients
 from formulations.elasticity import vector_element
-from formulations.evaluation import gradients_at_reference, p1_gradients
-from formulations.p1_stiffness import barycentric_gradients
 
 CHUNK = 50_000  # points per block when evaluating: small temporaries are reused, not faulted in
 # afresh (measured at 10^6 DOFs against the P3 reference: 0.96-1.14 s against 1.14-1.30 s with

@@ -6,7 +6,7 @@ Each cell is split along its diagonal v0-v2 into two triangles. On a parallelogr
 map is affine, so the gradient of a Q_p field is, on each half, a polynomial of degree at most
 2p - 1 in x (Q1: linear; Q2: cubic): it is sampled at the lattice of that degree on the half
 and stored exactly, as ``GradientField.from_solution`` does for P_p (the values from the
-cell's own gradient polynomials, ``formulations.quad_evaluation``; cells that are not
+cell's own gradient polynomials, ``formulations.cells.quad_evaluation``; cells that are not
 parallelograms are refused there).
 """
 
@@ -17,7 +17,7 @@ from skfem import Basis, MeshTri
 
 from bench.measure.fields import GradientField, Locator, _lattice, _powers, monomials
 from formulations.cells import family_of
-from formulations.quad_evaluation import QuadGradient
+from formulations.cells.quad_evaluation import QuadGradient
 
 # the halves of the reference square [0, 1]^2: corners (v0, v1, v2) and (v0, v2, v3)
 HALVES = (np.array([[0.0, 1.0, 1.0], [0.0, 0.0, 1.0]]),

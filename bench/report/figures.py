@@ -16,7 +16,7 @@ from bench.sequence.loop import STRATEGIES
 from estimators import estimator_names
 from formulations import formulation_names
 from formulations.cells.base import vertex_diameters
-from formulations.reference_facets import facet_coordinates
+from formulations.contact.reference_facets import facet_coordinates
 
 COLOUR_CYCLE = [f"C{k}" for k in range(10)]
 STYLE_CYCLE = ["-", "--", ":", "-."]

@@ -12,7 +12,7 @@ from bench.matrix.config_files import run_fields
 from bench.matrix.spec import build_scene
 from bench.matrix.task import why_skipped
 from bench.sequence.loop import run_sequence
-from formulations.friction_state import traction_size
+from formulations.friction.state import traction_size
 
 PEAK_SAMPLES = 20001  # points over +-b where the predicted peak shear is sought
 FACET_SAMPLES = 9  # where sigma_t,h is sampled on each facet (the contact boundary's samples)

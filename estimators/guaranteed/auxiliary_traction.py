@@ -22,7 +22,7 @@ from estimators.guaranteed.guaranteed_contact import (
 )
 from estimators.guaranteed.nonnegative_traction import nonnegative_pressure
 from estimators.guaranteed.strip_extension import relaxed
-from formulations.reference_facets import gauss_legendre
+from formulations.contact.reference_facets import gauss_legendre
 
 
 def contact_traction(scene, solution, interior, reaction: np.ndarray, clamped: np.ndarray,

@@ -39,8 +39,8 @@ from estimators.guaranteed.guaranteed_friction import (
 )
 from estimators.guaranteed.nonnegative_traction import EPSILON, bernstein_polynomial, hat_moments
 from formulations.base import STATUS_OK
-from formulations.reference_facets import gauss_legendre
-from formulations.slack_friction import contact_tangent
+from formulations.contact.reference_facets import gauss_legendre
+from formulations.friction.slack import contact_tangent
 from formulations.solvers.box import box_bvls
 
 

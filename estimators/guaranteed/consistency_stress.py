@@ -23,7 +23,7 @@ import numpy as np
 
 from estimators.guaranteed.patch_data import Interior, hat_moments, vertex_totals
 from formulations import DiscreteSolution
-from formulations.p1_stiffness import barycentric_gradients
+from formulations.cells.p1_stiffness import barycentric_gradients
 
 
 def consistency_stress(solution: DiscreteSolution) -> np.ndarray | None:

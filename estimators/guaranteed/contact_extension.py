@@ -20,8 +20,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from estimators.averaging import element_areas
+from formulations.cells.p1_stiffness import barycentric_gradients
 from formulations.elasticity import stress_from_gradient
-from formulations.p1_stiffness import barycentric_gradients
 
 SAMPLES = 33  # points per contact facet at which d . n <= w is imposed (ends included)
 # Three edge midpoints, weights 1/3: exact for the quadratic energy density of a P2 field.

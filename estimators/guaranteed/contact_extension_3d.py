@@ -26,8 +26,8 @@ from skfem.quadrature import get_quadrature
 from skfem.refdom import RefTet
 
 from estimators.guaranteed.contact_extension import discrete_gap, vertex_field
+from formulations.cells.p1_stiffness import barycentric_gradients
 from formulations.elasticity import stress_tensor_from_gradient
-from formulations.p1_stiffness import barycentric_gradients
 
 SAMPLE_DIVISIONS = 8   # d . n <= w is imposed on this lattice per contact triangle
 ENERGY_ORDER = 5       # the bubble's energy density is quartic; this rule's weights are positive

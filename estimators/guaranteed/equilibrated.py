@@ -49,8 +49,8 @@ from estimators.guaranteed.patch_data import interior_data, rebalanced
 from estimators.guaranteed.symmetrisation import symmetrised
 from estimators.residual.triangles import stress_at, stress_tensor
 from formulations import DiscreteSolution
+from formulations.cells.evaluation import gradients_at_reference
 from formulations.elasticity import stress_from_gradient
-from formulations.evaluation import gradients_at_reference
 
 # The bound needs the patch data to balance (docs/theory.md, 13.2); past this relative
 # imbalance (round-off is ~1e-12) the stress is not equilibrated and no bound is claimed.

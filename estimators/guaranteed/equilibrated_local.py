@@ -53,7 +53,7 @@ from estimators.guaranteed.proved_constants import proved_constants
 from estimators.guaranteed.rigid_duals import RigidChain
 from estimators.guaranteed.weak_symmetry import weakly_symmetrised
 from formulations import DiscreteSolution
-from formulations.reference_facets import gauss_legendre
+from formulations.contact.reference_facets import gauss_legendre
 
 NAME = "equilibrated-local"
 

@@ -20,7 +20,7 @@ from scipy.sparse.linalg import spsolve
 from estimators.guaranteed.contact_extension import Extension, discrete_gap, vertex_normals
 from estimators.guaranteed.equilibration import BoundaryData, boundary_balance, boundary_fluxes
 from estimators.guaranteed.strip_extension import StripExtension
-from formulations.reference_facets import gauss_legendre
+from formulations.contact.reference_facets import gauss_legendre
 
 QUADRATURE = 10     # Gauss points per contact facet for the kinked integrands
 

@@ -28,7 +28,7 @@ from estimators.guaranteed.contact_extension_3d import (
 )
 from estimators.guaranteed.equilibration import BoundaryData, boundary_balance, boundary_fluxes
 from estimators.guaranteed.guaranteed_contact import ContactBound, bound_of, contact_mass
-from formulations.reference_facets import triangle_rule
+from formulations.contact.reference_facets import triangle_rule
 
 QUADRATURE_DEGREE = 8  # the rule on each contact triangle for lambda*_+ and the slack (kinked)
 PROJECTION_DEGREE = 8  # the rule for projecting lambda_h onto P1 per triangle

@@ -29,9 +29,9 @@ from estimators.guaranteed.guaranteed_contact import (
     traction_at,
 )
 from estimators.guaranteed.strip_extension import StripExtension
-from formulations.evaluation import evaluate_on_trace
-from formulations.reference_facets import gauss_legendre
-from formulations.slack_friction import contact_tangent
+from formulations.cells.evaluation import evaluate_on_trace
+from formulations.contact.reference_facets import gauss_legendre
+from formulations.friction.slack import contact_tangent
 
 QUADRATURE = 10  # Gauss points per contact facet for the kinked integrands
 

@@ -37,8 +37,8 @@ from estimators.guaranteed.guaranteed_contact_3d import (
     traction_balance,
 )
 from estimators.guaranteed.guaranteed_friction import FrictionBound
-from formulations.evaluation import evaluate_on_trace
-from formulations.reference_facets import triangle_rule
+from formulations.cells.evaluation import evaluate_on_trace
+from formulations.contact.reference_facets import triangle_rule
 
 
 @dataclass(frozen=True, eq=False)

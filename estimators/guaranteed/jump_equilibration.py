@@ -5,7 +5,8 @@ sigma* balances Pi_k f, the P_k projection of f per element, and the bound charg
 r = f - Pi_k f, through (r, v)_T <= (h_T / pi) ||r||_T ||grad v||_T. Where f jumps inside T,
 r is O(1) on all of T, and this Poincare bound is several times the true dual norm of r (r is
 orthogonal to P_k: it oscillates on T). On the elements where f is rough (those the load rule
-of ``formulations.load`` refines), each cut SUB_LEVELS times into 4^SUB_LEVELS sub-triangles S,
+of ``formulations.cells.load`` refines), each cut SUB_LEVELS times into 4^SUB_LEVELS sub-triangles
+S,
 
     r = (f - Pi_S f) + (Pi_S f - Pi_k f) = r_1 + r_2,
 
@@ -46,8 +47,8 @@ from estimators.guaranteed.rt_reference import (
     summed_matrix,
 )
 from estimators.guaranteed.weighted_stress import energy_blocks, stress_weight, weighted_moments
+from formulations.cells.load import MAX_DEPTH, body_load, refined_rule
 from formulations.elasticity import ELEMENTS, element_diameters
-from formulations.load import MAX_DEPTH, body_load, refined_rule
 
 SUB_LEVELS = 2  # each rough element in 16 sub-triangles
 SUB_ADAPTIVE = 0  # then refinements of the sub-triangles f is rough on

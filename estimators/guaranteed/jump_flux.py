@@ -2,8 +2,8 @@
 a lowest-order Raviart-Thomas flux on sub-simplices (docs/theory.md, section 13.2, "Where f
 jumps, element by element"); used on tetrahedra.
 
-On a rough element T (one the load rule refines, ``formulations.load``), r = f - Pi_k f is O(1)
-and (h_T / pi) ||r||_T is several times its dual norm. T's reference simplex is refined
+On a rough element T (one the load rule refines, ``formulations.cells.load``), r = f - Pi_k f is
+O(1) and (h_T / pi) ||r||_T is several times its dual norm. T's reference simplex is refined
 SUB_LEVELS times into sub-simplices S (the load rule's red refinement, mapped), and
 
     r = r_0 + r_1,   r_0 = (1/|S|) int_S r on each S,   r_1 = r - r_0.
@@ -34,7 +34,7 @@ from estimators.guaranteed.jump_equilibration import rough_elements
 from estimators.guaranteed.patch_data import scalar_lagrange
 from estimators.guaranteed.rt_reference import scalar_values
 from estimators.guaranteed.sub_simplices import SubSimplices, sub_simplices
-from formulations.load import mapped_rule
+from formulations.cells.load import mapped_rule
 
 SUB_LEVELS = 2  # 8^2 = 64 sub-tetrahedra per rough element
 # where f is smooth, 8 sub-tetrahedra: (sum osc_T^2)^(1/2) 2.3x below Poincare's on T in a

@@ -11,7 +11,7 @@ int_w skw grad v = 0 satisfies
 equilibration; it rests on Horgan and Payne's K = 2 (1 + Gamma) = 2 / beta^2 and a lower
 bound of the inf-sup constant beta of the divergence by the angle, whose proofs Costabel and
 Dauge revisited for star-shaped domains). Sharp on a disc (theta = pi / 2, K = 4); checked
-against discrete Korn constants in tests/estimators/test_local_korn.py. As |grad v|^2 =
+against discrete Korn constants in tests/estimators/guaranteed/test_local_korn.py. As |grad v|^2 =
 |eps(v)|^2 + |skw grad v|^2 pointwise, the skew part then deviates from its mean by at most
 (K - 1)^(1/2) ||eps(v)||_w.
 

@@ -11,8 +11,8 @@ from estimators.guaranteed.equilibration import BoundaryData
 from estimators.guaranteed.jump_equilibration import JumpOscillation
 from estimators.guaranteed.jump_flux import FluxOscillation
 from estimators.guaranteed.patch_data import scalar_lagrange
+from formulations.cells.p1_stiffness import barycentric_gradients
 from formulations.elasticity import element_diameters
-from formulations.p1_stiffness import barycentric_gradients
 from scenes.base import simplex_measures
 
 

@@ -22,9 +22,9 @@ from estimators.guaranteed.rt_reference import (
     patch_rhs,
     scalar_values,
 )
+from formulations.cells.load import body_load
+from formulations.cells.p1_stiffness import barycentric_gradients
 from formulations.elasticity import ELEMENTS, scalar_elements
-from formulations.load import body_load
-from formulations.p1_stiffness import barycentric_gradients
 
 # scalar Lagrange triangles by degree, to P4: the load moments and the stream functions of
 # ``estimators.guaranteed.symmetrisation`` use P_(k+1)
@@ -90,8 +90,8 @@ def vertex_totals(mesh, data: np.ndarray) -> np.ndarray:
 
 def load_moments(mesh, body_force, k: int) -> np.ndarray:
     """int_T f_r psi_a q_l per element, local vertex a, row r and P_k DG function q_l
-    (n_el, d + 1, d, n_dg), with the load rule of ``formulations.load`` (refined where f is rough,
-    as for the load vector of the discrete problem): psi_a q_l is P_(k+1), so these are
+    (n_el, d + 1, d, n_dg), with the load rule of ``formulations.cells.load`` (refined where f is
+    rough, as for the load vector of the discrete problem): psi_a q_l is P_(k+1), so these are
     combinations of the P_(k+1) DG load entries with its values at the P_(k+1) nodes."""
     d = mesh.dim()
     fine = scalar_lagrange(k + 1, d)

@@ -35,7 +35,7 @@ from estimators.guaranteed.chained_constants import (
     strain_floor,
     triangle_rule,
 )
-from formulations.slack_friction import contact_tangent
+from formulations.friction.slack import contact_tangent
 from formulations.solvers.backends import factorise
 
 

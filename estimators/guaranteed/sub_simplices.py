@@ -11,7 +11,7 @@ from math import factorial
 import numpy as np
 from skfem.quadrature import get_quadrature
 
-from formulations.load import children, mapped_rule
+from formulations.cells.load import children, mapped_rule
 
 
 @dataclass(frozen=True, eq=False)

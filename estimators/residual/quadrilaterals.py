@@ -8,7 +8,8 @@ coarse one across it: R_e = 1/2 ||[sigma_n(u_h)]||_e on interior edges and halve
 ||sigma_n(u_h) - q||_e on Gamma_N, ||sigma_nn(u_h) + lambda_h||_e + ||sigma_nt(u_h)||_e on
 Gamma_C. The contact terms, E ||w||_0 ||w||_1 and |(lambda_h, w)| with w = (g - u_hn)_-, are
 ``estimators.contact_terms``'s, as on every cell.
-The stress is evaluated from the exact gradient polynomials of ``formulations.quad_evaluation``.
+The stress is evaluated from the exact gradient polynomials of
+``formulations.cells.quad_evaluation``.
 """
 
 from __future__ import annotations
@@ -18,11 +19,11 @@ import numpy as np
 from estimators.base import Estimate, register_cell_variant
 from estimators.contact_terms import contact_terms
 from estimators.residual.nitsche import nitsche_estimate
+from formulations.cells.quad_evaluation import QuadGradient
+from formulations.cells.quad_load import affine_maps
+from formulations.cells.tensor_stiffness import tensor_rule
+from formulations.contact.reference_facets import gauss_legendre
 from formulations.elasticity import element_diameters, stress_tensor_from_gradient
-from formulations.quad_evaluation import QuadGradient
-from formulations.quad_load import affine_maps
-from formulations.reference_facets import gauss_legendre
-from formulations.tensor_stiffness import tensor_rule
 from scenes.quad_hierarchy import edge_keys
 
 EDGE_POINTS = 4  # Gauss points on Neumann and contact edges: q and lambda_h are not polynomials

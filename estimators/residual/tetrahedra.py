@@ -22,10 +22,10 @@ from estimators.contact_terms import contact_terms
 from estimators.residual.nitsche import nitsche_estimate
 from estimators.residual.triangles import element_residual
 from formulations import DiscreteSolution
-from formulations.contact_surface import outer_triangle_normals
+from formulations.cells.evaluation import gradients_at, gradients_at_reference
+from formulations.contact.reference_facets import triangle_rule
+from formulations.contact.triangles import outer_triangle_normals
 from formulations.elasticity import stress_tensor_from_gradient
-from formulations.evaluation import gradients_at, gradients_at_reference
-from formulations.reference_facets import triangle_rule
 from scenes.base import simplex_measures, simplex_points
 
 BOUNDARY_DEGREE = 6  # Neumann and contact faces: q and lambda_h are not polynomials

@@ -24,10 +24,10 @@ from skfem import Basis, ElementTetP0, ElementTriP0
 from estimators.base import Estimate, combine, register_estimator
 from estimators.contact_terms import contact_terms
 from formulations import DiscreteSolution
-from formulations.contact_edges import outer_normals
+from formulations.cells.evaluation import gradients_at, gradients_at_reference
+from formulations.contact.edges import outer_normals
+from formulations.contact.reference_facets import gauss_legendre
 from formulations.elasticity import ELEMENTS, element_diameters, stress_from_gradient
-from formulations.evaluation import gradients_at, gradients_at_reference
-from formulations.reference_facets import gauss_legendre
 
 EDGE_QUADRATURE_POINTS = 4  # Neumann and contact edges: q and lambda_h are not polynomials
 

@@ -91,7 +91,7 @@ class CellFamily:
     def why_no_contact(self) -> str | None:
         """Why the formulations cannot pose contact on this family's meshes (its contact
         boundary is not a registered one), or None."""
-        from formulations.contact_boundary import CONTACT_BOUNDARIES
+        from formulations.contact.boundary import CONTACT_BOUNDARIES
 
         if self.contact_boundary in CONTACT_BOUNDARIES.names():
             return None

@@ -1,5 +1,5 @@
 """Hexahedra: Q1 on tensor grids, refined uniformly (docs/theory.md, sections 15.4-15.6). Their
-contact boundary is the quadrilateral faces on Gamma_C (``formulations.contact_faces``).
+contact boundary is the quadrilateral faces on Gamma_C (``formulations.contact.quadrilaterals``).
 Adaptive refinement would need hanging nodes on faces and edges: not built, so an adaptive run
 on hexahedra is a skipped row that says so."""
 
@@ -10,8 +10,8 @@ from skfem import Basis, ElementHex1, MeshHex
 from skfem.mesh import MeshHex1
 
 from formulations.cells.base import CellFamily, register_family
+from formulations.cells.quad_load import quad_body_load
 from formulations.cells.quadrilateral import not_a_grid, tensor_axes
-from formulations.quad_load import quad_body_load
 
 
 class Hexahedra(CellFamily):
@@ -41,7 +41,7 @@ class Hexahedra(CellFamily):
         return 2 * order  # (p + 1)^3 Gauss points: exact on parallelepipeds
 
     def body_load(self, body_force, basis, order: int) -> np.ndarray:
-        """The cell rule, refined where f jumps (``formulations.quad_load``)."""
+        """The cell rule, refined where f jumps (``formulations.cells.quad_load``)."""
         rule = Basis(basis.mesh, basis.elem, intorder=2 * order + 1)
         return quad_body_load(body_force, rule)
 

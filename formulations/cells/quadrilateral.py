@@ -1,5 +1,6 @@
 """Quadrilaterals: Q1 and Q2 on 1-irregular hierarchies (``scenes.quad_hierarchy``), hanging
-nodes joined by the constraints of ``formulations.hanging_nodes`` (docs/theory.md, section 15).
+nodes joined by the constraints of ``formulations.cells.hanging_nodes`` (docs/theory.md, section
+15).
 
 A scene runs on quadrilaterals when its starting mesh is a tensor grid of triangles (every
 built-in 2D scene): the grid's lines give the root cells, so no second scene definition is
@@ -12,9 +13,9 @@ import numpy as np
 from skfem import Basis, ElementQuad1, ElementQuad2
 
 from formulations.cells.base import CellFamily, Plan, register_family
-from formulations.hanging_nodes import prolongation
-from formulations.quad_load import quad_body_load
-from formulations.tensor_stiffness import tensor_stiffness
+from formulations.cells.hanging_nodes import prolongation
+from formulations.cells.quad_load import quad_body_load
+from formulations.cells.tensor_stiffness import tensor_stiffness
 from scenes.quad_hierarchy import QuadHierarchy, QuadLeafMesh, coarse_edges
 
 
@@ -69,7 +70,8 @@ class Quadrilaterals(CellFamily):
         return int(2 * (nodes - clamped))
 
     def stiffness(self, basis, lam: float, mu: float, order: int):
-        """Vectorised over cells on the (p + 1)^2 Gauss points (formulations.tensor_stiffness):
+        """Vectorised over cells on the (p + 1)^2 Gauss points
+        (formulations.cells.tensor_stiffness):
         exact on parallelograms."""
         return tensor_stiffness(basis, lam, mu, order)
 
@@ -80,7 +82,7 @@ class Quadrilaterals(CellFamily):
         return 2 * order + 2
 
     def body_load(self, body_force, basis, order: int) -> np.ndarray:
-        """The cell rule, refined where f jumps (``formulations.quad_load``)."""
+        """The cell rule, refined where f jumps (``formulations.cells.quad_load``)."""
         rule = Basis(basis.mesh, basis.elem, intorder=self.stiffness_intorder(order))
         return quad_body_load(body_force, rule)
 

@@ -8,8 +8,8 @@ from skfem import ElementTetP1, ElementTetP2
 from skfem.mesh import MeshTet1
 
 from formulations.cells.base import CellFamily, register_family
+from formulations.cells.tet_stiffness import tet_stiffness
 from formulations.cells.triangle import Triangles
-from formulations.tet_stiffness import tet_stiffness
 
 
 class Tetrahedra(Triangles):

@@ -8,9 +8,9 @@ from skfem import Basis, ElementTriP1, ElementTriP2, ElementTriP3
 from skfem.mesh import MeshTri1
 
 from formulations.cells.base import CellFamily, Plan, register_family
-from formulations.load import body_load
-from formulations.p1_stiffness import p1_stiffness
-from formulations.p2_stiffness import p2_stiffness
+from formulations.cells.load import body_load
+from formulations.cells.p1_stiffness import p1_stiffness
+from formulations.cells.p2_stiffness import p2_stiffness
 from scenes.topology import refinement_plan
 
 
@@ -68,7 +68,7 @@ class Triangles(CellFamily):
 
     def body_load(self, body_force, basis, order: int) -> np.ndarray:
         """scikit-fem's default rule, of order 2p, refined where f jumps
-        (``formulations.load``)."""
+        (``formulations.cells.load``)."""
         return body_load(body_force, Basis(basis.mesh, basis.elem))
 
 

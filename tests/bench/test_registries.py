@@ -17,7 +17,7 @@ from bench.report import figures, panels, write_report
 from conftest import square_scene
 from estimators.base import ESTIMATORS, register_estimator
 from estimators.residual import triangles as residual
-from formulations import mixed
+from formulations.methods import mixed
 from formulations.registry import FORMULATIONS, register_formulation
 from scenes.registry import SCENES, register_scene
 

@@ -45,7 +45,7 @@ hard_case("plugin-case", "test plugin: one accurate record")(lambda: [dict(
 '''
 BROKEN_MODULE = '''
 from formulations import register_formulation
-from formulations.mixed import discretise
+from formulations.methods.mixed import discretise
 register_formulation("half-registered", "registered before the import fails")(discretise)
 raise RuntimeError("this plugin is broken on purpose")
 '''

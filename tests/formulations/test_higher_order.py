@@ -9,14 +9,14 @@ from skfem.helpers import dot
 from bench.measure.difference import solution_difference
 from conftest import square_scene
 from formulations import get_formulation, solve
+from formulations.cells.evaluation import normal_trace_matrix
+from formulations.cells.load import body_load
 from formulations.contact import contact_trace
+from formulations.contact.reference_facets import gauss_legendre
 from formulations.diagnostics import inf_sup_constant
 from formulations.elasticity import assemble_elasticity, count_free_dofs, vector_element
-from formulations.evaluation import normal_trace_matrix
-from formulations.load import body_load
-from formulations.mixed import bernstein, multiplier_segments
-from formulations.penalty import PRESSURE_CONSISTENCY
-from formulations.reference_facets import gauss_legendre
+from formulations.methods.mixed import bernstein, multiplier_segments
+from formulations.methods.penalty import PRESSURE_CONSISTENCY
 from scenes import get_scene
 
 ORDERS = (2, 3)
@@ -133,7 +133,7 @@ def test_normal_trace_and_mixed_rows_integrate_polynomials_exactly(order):
 @pytest.mark.parametrize("order", ORDERS)
 @pytest.mark.parametrize("formulation", ["mixed", "penalty", "vi"])
 def test_fast_solver_agrees_with_reference(formulation, order):
-    # the same tolerances as P1 (tests/formulations/test_active_set.py): Clarabel at 1e-10
+    # the same tolerances as P1 (tests/formulations/solvers/test_active_set.py): Clarabel at 1e-10
     # leaves ~1e-8 in energy and ~1e-7 in lambda; a wrong active set gives >= 1e-3
     scene = get_scene("paper")
     disc = get_formulation(formulation)(scene, scene.mesh.refined(2), order=order)

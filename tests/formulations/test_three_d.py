@@ -10,8 +10,8 @@ from bench.measure.discretisation_error import exact_errors
 from bench.measure.slope import fit_slope
 from formulations import get_formulation, solve
 from formulations.contact import contact_trace
+from formulations.contact.reference_facets import triangle_rule
 from formulations.elasticity import assemble_elasticity
-from formulations.reference_facets import triangle_rule
 from scenes import get_scene
 
 FORMULATIONS_3D = ("vi", "penalty", "nitsche", "mixed")
@@ -36,8 +36,8 @@ def test_tetrahedral_stiffness_is_scikit_fems(order):
     from skfem import Basis, asm
     from skfem.models.elasticity import linear_elasticity
 
+    from formulations.cells.tet_stiffness import tet_stiffness
     from formulations.elasticity import dof_basis
-    from formulations.tet_stiffness import tet_stiffness
 
     scene = get_scene("hertz-3d", initial_divisions=2)
     mesh = scene.mesh.refined(np.arange(0, scene.mesh.t.shape[1], 3))
@@ -114,8 +114,8 @@ def test_uniform_p1_converges_against_the_exact_3d_solution(formulation):
 
 def test_p2_nodal_pressure_of_vi_converges():
     # P2 reactions as the moments of a quadratic with non-negative Bernstein coefficients
-    # (formulations.surface_nodes): the pressure error against the exact one falls 1.32e-3 ->
-    # 8.2e-4 (1944 -> 13 872 DOFs, then 2.49e-4 at 104 544); sub-triangle lumping stalled at
+    # (formulations.contact.surface_nodes): the pressure error against the exact one falls 1.32e-3
+    # -> 8.2e-4 (1944 -> 13 872 DOFs, then 2.49e-4 at 104 544); sub-triangle lumping stalled at
     # 1.4e-3 (a ratio near 1), which 0.7 catches
     scene = get_scene("free-boundary-3d")
     errors, zones = [], []

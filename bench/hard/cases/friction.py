@@ -14,7 +14,7 @@ from formulations.solvers.registry import FAST_SOLVER
 from scenes import get_scene
 
 # mu = 30, where the fixed point contracts too slowly and fails (vi, penalty), is a unit test
-# (tests/formulations/test_nodal_friction.py): its reference solves alone take ~25 s
+# (tests/formulations/friction/test_nodal_friction.py): its reference solves alone take ~25 s
 COEFFICIENTS = (0.0, 0.3, 10.0)
 LEVEL = 3  # 2112 P1 DOFs: at level 2 every mu >= 1 sticks everywhere, no cycle to see
 

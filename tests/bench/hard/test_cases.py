@@ -89,7 +89,7 @@ def test_the_fast_solver_is_exact_on_every_hard_case(hard):
     system = fast["formulation"] == "nitsche"
     # Nitsche's nonlinear residual: round-off times its conditioning, which grows with
     # gamma_0 (measured 4e-14 at the default, 5e-12 at gamma_0 = 1e4, 5e-11 for theta = -1
-    # at 1e-4); 1e-10 as in tests/formulations/test_nitsche.py
+    # at 1e-4); 1e-10 as in tests/formulations/methods/test_nitsche.py
     solved = fast[system & (fast["verdict"] != "failed")]
     assert (solved["max_residual"] < 1e-10).all()
     # it fails only where the symmetric variant is not coercive (gamma_0 < 2.37 here)

@@ -9,7 +9,7 @@ from skfem import MeshTri
 from bench.measure.contact import contact_zone
 from bench.measure.zone_edge import square_root_zone
 from formulations.contact import contact_trace
-from formulations.contact_surface import ContactSurface
+from formulations.contact.triangles import ContactSurface
 from scenes import get_scene
 
 HALF_WIDTH = 0.3

@@ -15,8 +15,8 @@ from estimators.guaranteed.guaranteed_friction import (
 )
 from estimators.guaranteed.nonnegative_traction import bernstein_polynomial
 from formulations import get_formulation, solve
-from formulations.reference_facets import gauss_legendre
-from formulations.slack_friction import contact_tangent
+from formulations.contact.reference_facets import gauss_legendre
+from formulations.friction.slack import contact_tangent
 from scenes import get_scene
 
 

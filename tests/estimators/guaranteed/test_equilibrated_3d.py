@@ -1,5 +1,5 @@
 """The 3D patch data balance where the body force jumps: the estimator's load and the
-formulation's are one rule (``formulations.load.first_children``), so the load rho that the
+formulation's are one rule (``formulations.cells.load.first_children``), so the load rho that the
 bound charges with C_F is round-off (docs/theory.md, 13.2, "Balance")."""
 
 import numpy as np

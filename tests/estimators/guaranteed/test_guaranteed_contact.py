@@ -11,7 +11,7 @@ from estimators.guaranteed.contact_extension import vertex_normals
 from estimators.guaranteed.equilibrated import equilibrate
 from estimators.guaranteed.guaranteed_contact import FacetPolynomial, balanced_traction
 from formulations import get_formulation, solve
-from formulations.reference_facets import gauss_legendre
+from formulations.contact.reference_facets import gauss_legendre
 from scenes import get_scene
 
 

@@ -20,7 +20,7 @@ from estimators.guaranteed.guaranteed_friction_3d import (
     shear_balance,
 )
 from formulations import get_formulation, solve
-from formulations.reference_facets import triangle_rule
+from formulations.contact.reference_facets import triangle_rule
 from formulations.registry import FORMULATIONS
 from scenes import get_scene
 

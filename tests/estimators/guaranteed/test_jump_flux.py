@@ -28,8 +28,8 @@ from estimators.guaranteed.oscillation import oscillation
 from estimators.guaranteed.raviart_thomas_tet import sorted_tetrahedra
 from estimators.guaranteed.rt_reference import ReferenceRT
 from estimators.guaranteed.sub_simplices import sub_simplices
+from formulations.cells.load import mapped_rule
 from formulations.elasticity import element_diameters
-from formulations.load import mapped_rule
 from scenes import get_scene
 
 CORNERS = np.array([[0.1, 0.0, 0.0], [1.2, 0.1, 0.0], [0.2, 0.9, 0.1], [0.0, 0.3, 1.1]]).T

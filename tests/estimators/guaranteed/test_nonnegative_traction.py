@@ -10,7 +10,7 @@ from estimators.guaranteed.equilibrated import equilibrate
 from estimators.guaranteed.guaranteed_contact import traction_balance
 from estimators.guaranteed.nonnegative_traction import hat_moments, nonnegative_pressure
 from formulations import get_formulation, solve
-from formulations.reference_facets import gauss_legendre
+from formulations.contact.reference_facets import gauss_legendre
 from scenes import get_scene
 
 

@@ -10,10 +10,10 @@ from skfem.helpers import dot
 from estimators.guaranteed.patch_data import BalancingLoad
 from estimators.guaranteed.rigid_duals import RigidChain
 from formulations import get_formulation, solve
+from formulations.cells.evaluation import normal_trace_matrix
+from formulations.contact.reference_facets import gauss_legendre
 from formulations.elasticity import assemble_elasticity
-from formulations.evaluation import normal_trace_matrix
-from formulations.reference_facets import gauss_legendre
-from formulations.slack_friction import tangential_rows
+from formulations.friction.slack import tangential_rows
 from scenes import get_scene
 
 

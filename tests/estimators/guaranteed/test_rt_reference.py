@@ -16,8 +16,8 @@ from estimators.guaranteed.rt_reference import (
     scalar_values,
 )
 from formulations import get_formulation, solve
+from formulations.cells.p1_stiffness import barycentric_gradients
 from formulations.elasticity import ELEMENTS
-from formulations.p1_stiffness import barycentric_gradients
 from scenes import get_scene
 
 

@@ -2,7 +2,7 @@
 what a soft penalty costs in penetration and in accuracy."""
 
 from formulations import register_formulation
-from formulations.penalty import discretise as penalty
+from formulations.methods.penalty import discretise as penalty
 
 EPSILON_0 = 0.1
 

@@ -1,0 +1,116 @@
+"""grad u_h of a Q1 or Q2 field at any points of given cells, and its derivatives, exactly
+(docs/theory.md, section 15).
+
+On a parallelogram the map x = v0 + A xi from the reference square is affine, so each
+component of grad u_h is, in xi, a polynomial of degree at most p in each variable (Q_p with
+one degree lost in the direction of differentiation). It is stored per cell by its values at
+the (p + 1)^2 tensor lattice (a Vandermonde solve) and evaluated or differentiated anywhere.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from skfem import Basis
+
+from formulations.cells.quad_load import affine_maps
+
+# tolerance of the parallelogram check, relative to the cell's size
+PARALLELOGRAM_TOLERANCE = 1e-10
+
+
+def tensor_exponents(degree: int) -> np.ndarray:
+    """Exponents (2, M) of xi^a eta^b with a, b <= degree."""
+    a, b = np.meshgrid(np.arange(degree + 1), np.arange(degree + 1), indexing="ij")
+    return np.array([a.ravel(), b.ravel()])
+
+
+def monomial_values(xi: np.ndarray, exponents: np.ndarray, derivative: int | None = None):
+    """xi^a eta^b (M, n) at reference points xi (2, n), or its derivative along xi_r."""
+    if derivative is None:
+        return xi[0][None] ** exponents[0][:, None] * xi[1][None] ** exponents[1][:, None]
+    power = exponents.copy()
+    factor = power[derivative].astype(float)
+    power[derivative] = np.maximum(power[derivative] - 1, 0)
+    return factor[:, None] * monomial_values(xi, power)
+
+
+def reference_gradients(scalar, exponents: np.ndarray) -> np.ndarray:
+    """D[j, r, m]: the coefficient of monomial m (``exponents``) in d phi_j / d xi_r of the
+    scalar element's basis functions (exact: sampled at a lattice of the monomials' degree)."""
+    degree = int(exponents.max())
+    lattice = exponents / max(degree, 1)
+    solve = np.linalg.inv(monomial_values(lattice, exponents).T)
+    return np.array([solve @ scalar.lbasis(lattice, j)[1].T
+                     for j in range(scalar.doflocs.shape[0])]).transpose(0, 2, 1)
+
+
+def combine(coefficients: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """sum_m coefficients[n, m, :] values[m, n] as the gradient (2, 2, n)."""
+    return np.einsum("nmc,mn->cn", coefficients, values).reshape(2, 2, -1)
+
+
+@dataclass(frozen=True, eq=False)
+class QuadGradient:
+    """grad u_h per cell: ``coefficients`` (nE, M, 4) of the monomials ``exponents`` in the
+    reference coordinates of each cell (origin v0, ``inverse`` of A), the last axis the
+    components (du_1/dx_1, du_1/dx_2, du_2/dx_1, du_2/dx_2): cell-major, so that gathering the
+    cells of many points reads contiguous rows."""
+
+    origin: np.ndarray
+    inverse: np.ndarray
+    exponents: np.ndarray
+    coefficients: np.ndarray
+
+    @classmethod
+    def from_solution(cls, basis: Basis, u: np.ndarray, degree: int) -> QuadGradient:
+        """The gradient of the cell-DOF vector ``u`` of a vector Q_degree ``basis``: on a
+        parallelogram grad u_h = sum_j u_j A^-T grad_xi phi_j, and grad_xi phi_j is one
+        polynomial in xi for every cell (its monomial coefficients found once, on the
+        reference square), so no basis is evaluated cell by cell."""
+        p = basis.mesh.p[:, basis.mesh.t]  # (2, 4, nE)
+        origin, A = affine_maps(basis.mesh)  # (2, nE), (2, 2, nE)
+        size = np.linalg.norm(A, axis=(0, 1))
+        if np.any(np.linalg.norm(origin + A[:, 0] + A[:, 1] - p[:, 2], axis=0)
+                  > PARALLELOGRAM_TOLERANCE * size):
+            raise ValueError("the quadrilaterals are not all parallelograms: their gradients "
+                             "are not polynomials in x")
+        exponents = tensor_exponents(degree)
+        inverse = np.linalg.inv(A.transpose(2, 0, 1)).transpose(1, 2, 0)  # rows: d xi_r / dx
+        D = reference_gradients(basis.elem.elem, exponents)  # (nb, 2 r, M)
+        nodal = u[basis.element_dofs].reshape(D.shape[0], 2, -1)  # (nb, component c, nE)
+        by_reference = np.einsum("jcE,jrm->Emcr", nodal, D, optimize=True)  # (nE, M, 2, 2)
+        coefficients = np.einsum("Emcr,rkE->Emck", by_reference, inverse, optimize=True)
+        return cls(origin, inverse, exponents,
+                   np.ascontiguousarray(coefficients.reshape(-1, exponents.shape[1], 4)))
+
+    def reference(self, x: np.ndarray, cells: np.ndarray) -> np.ndarray:
+        return np.einsum("rkn,kn->rn", self.inverse[:, :, cells], x - self.origin[:, cells])
+
+    def at(self, x: np.ndarray, cells: np.ndarray) -> np.ndarray:
+        """grad u_h (2, 2, n) at points x (2, n) of ``cells``."""
+        values = monomial_values(self.reference(x, cells), self.exponents)
+        return combine(self.coefficients[cells], values)
+
+    def derivatives_at(self, x: np.ndarray, cells: np.ndarray) -> np.ndarray:
+        """d/dx_k (grad u_h)_ij (2, 2, 2, n) at points x of ``cells``."""
+        xi = self.reference(x, cells)
+        coefficients = self.coefficients[cells]
+        by_reference = np.array([combine(coefficients, monomial_values(xi, self.exponents, r))
+                                 for r in range(2)])  # (r, 2, 2, n)
+        return np.einsum("rijn,rkn->ijkn", by_reference, self.inverse[:, :, cells])
+
+    def at_reference(self, X: np.ndarray) -> np.ndarray:
+        """grad u_h (2, 2, nE, nq) at the same reference points X (2, nq) of every cell."""
+        return np.einsum("Emc,mq->cEq", self.coefficients, monomial_values(X, self.exponents),
+                         optimize=True).reshape(2, 2, *self.coefficients.shape[:1], X.shape[1])
+
+    def derivatives_at_reference(self, X: np.ndarray) -> np.ndarray:
+        """d/dx_k (grad u_h)_ij (2, 2, 2, nE, nq) at the same reference points X (2, nq) of
+        every cell (no gathering: each cell's own coefficients)."""
+        by_reference = np.array([
+            np.einsum("Emc,mq->cEq", self.coefficients, monomial_values(X, self.exponents, r),
+                      optimize=True).reshape(2, 2, *self.coefficients.shape[:1], X.shape[1])
+            for r in range(2)])  # (r, 2, 2, nE, nq)
+        return np.einsum("rijEq,rkE->ijkEq", by_reference, self.inverse, optimize=True)
