@@ -66,14 +66,6 @@ class ContactFaces(SurfaceBoundary):
     the longer diagonals, ``coordinate`` (2, 4, n) the corners' contact coordinates and
     ``element`` (n,) the hexahedron of each face."""
 
-    mesh: object
-    facets: np.ndarray
-    vertices: np.ndarray
-    normal: np.ndarray
-    measure: np.ndarray
-    diameter: np.ndarray
-    coordinate: np.ndarray
-    element: np.ndarray
     name = "quadrilaterals"
 
     @classmethod

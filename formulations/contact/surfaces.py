@@ -2,10 +2,12 @@
 Gamma_C with pairs of contact coordinates, tangents in each facet, shear vectors, the contact
 zone as a disc and no order along Gamma_C (docs/theory.md, section 14). Triangles
 (``formulations.contact.triangles``) and quadrilateral faces
-(``formulations.contact.quadrilaterals``)
-derive from it and bring their reference facet, nodes and point location."""
+(``formulations.contact.quadrilaterals``) derive from it and bring their reference facet, nodes
+and point location."""
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -14,9 +16,21 @@ from formulations.contact.boundary import ContactBoundary
 DISC_DEGREE = 10  # quadrature degree on each facet for the area of the contact zone
 
 
+@dataclass(frozen=True, eq=False)
 class SurfaceBoundary(ContactBoundary):
-    """The shared part of a 3D body's contact boundary."""
+    """The shared part of a 3D body's contact boundary: its facets of ``mesh`` (``facets``),
+    their corners ``vertices`` (k, n), outer unit ``normal`` (3, n), areas ``measure`` (n,),
+    ``diameter`` (n,), the corners' contact coordinates ``coordinate`` (2, k, n) and the cell
+    each facet belongs to (``element``)."""
 
+    mesh: object
+    facets: np.ndarray
+    vertices: np.ndarray
+    normal: np.ndarray
+    measure: np.ndarray
+    diameter: np.ndarray
+    coordinate: np.ndarray
+    element: np.ndarray
     dim = 3
     kink_degree = 10  # 25 points per triangle, 36 per quadrilateral
 

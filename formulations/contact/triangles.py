@@ -38,14 +38,6 @@ class ContactSurface(SurfaceBoundary):
     longest edges, ``coordinate`` (2, 3, n) the scene's contact coordinates of the corners and
     ``element`` (n,) the tetrahedron each facet belongs to."""
 
-    mesh: Mesh
-    facets: np.ndarray
-    vertices: np.ndarray
-    normal: np.ndarray
-    measure: np.ndarray
-    diameter: np.ndarray
-    coordinate: np.ndarray
-    element: np.ndarray
     name = "triangles"
 
     @classmethod
