@@ -16,7 +16,7 @@ import numpy as np
 from scipy import sparse
 
 from formulations.cells.evaluation import normal_trace_matrix
-from formulations.contact.edges import ContactTrace
+from formulations.contact.boundary import ContactBoundary
 from formulations.elasticity import Elasticity
 
 STATUS_OK, STATUS_INACCURATE, STATUS_FAILED = "ok", "inaccurate", "failed"
@@ -220,7 +220,7 @@ class DiscreteSolution:
     formulation: str
     solver: str
     elasticity: Elasticity
-    trace: ContactTrace
+    trace: ContactBoundary  # a kind of formulations.contact (edges, triangles, quadrilaterals)
     u: np.ndarray
     pressure: Callable[[np.ndarray], np.ndarray]
     multiplier_breaks: np.ndarray

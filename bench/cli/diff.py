@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from bench.cli import option_types as options
+import bench.cli.option_types as options
 from bench.cli.guards import InputError
 from bench.matrix.diff import diff_results
 

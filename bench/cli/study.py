@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 
-from bench.cli import option_types as options
+import bench.cli.option_types as options
 from bench.cli.guards import InputError
 from bench.study import QUICK, StudyConfig, run_study
 from bench.study.run import STUDY_FILE, StudyFile, report_study

@@ -9,9 +9,12 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+import bench.report.figures as figures
+import bench.report.figures_3d as figures_3d
+import bench.report.friction_figures as friction_figures
+import bench.report.panels as panels
 from bench.matrix.artifacts import artifact_path, file_stem, load_artifact
 from bench.matrix.files import atomic_bytes
-from bench.report import figures, figures_3d, friction_figures, panels
 from bench.sequence.rows import KEYS
 from scenes import get_scene
 
