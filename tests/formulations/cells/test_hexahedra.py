@@ -70,3 +70,23 @@ def test_the_error_against_the_exact_solution_falls_at_order_h():
 def test_a_scene_without_a_grid_of_cubes_is_refused():
     with pytest.raises(ValueError, match="no hexahedral version"):
         HEXAHEDRA.starting_mesh(get_scene("paper"))
+
+
+@pytest.mark.slow
+def test_q1_hexahedra_converge_at_order_h_to_1e5_dofs():
+    """Uniform Q1 on free-boundary-3d to 104 544 DOFs: the error's slope over the last three
+    levels within 0.05 of -1/3 (O(h) in 3D; measured 2.26e-3, 1.14e-3, 5.91e-4 from 1 944 DOFs:
+    -0.33), and the active-set solve agreeing with Clarabel in energy at 13 872 DOFs."""
+    scene = get_scene("free-boundary-3d")
+    results = list(run_sequence(scene, "vi", "active-set", "averaging",
+                                LoopConfig(strategy="uniform", cell="quad", max_dofs=120000),
+                                truth=truth_for(scene, None)))
+    assert [r.row.ndofs for r in results][-1] == 104544
+    tail = results[-3:]
+    slope = fit_slope([r.row.ndofs for r in tail], [r.row.energy_error for r in tail]).slope
+    assert slope == pytest.approx(-1 / 3, abs=0.05)  # the issue's gate on the rate
+    mesh = HEXAHEDRA.starting_mesh(scene).refined(2)
+    fast = solve(get_formulation("vi")(scene, mesh), "active-set")
+    judge = solve(get_formulation("vi")(scene, mesh), "reference")
+    # Clarabel's interior point stops at a relative gap of about 1e-8
+    assert fast.energy == pytest.approx(judge.energy, rel=1e-7)
