@@ -1,4 +1,4 @@
-"""The refined load rule (formulations/load.py): the same rule whatever order an element lists
+"""The refined load rule (formulations/cells/load.py): the same rule whatever order an element lists
 its vertices in."""
 
 import numpy as np
