@@ -1,8 +1,9 @@
 """The contact boundary Gamma_C as a registered unit (docs/theory.md, sections 1 and 14).
 
 A contact boundary is the kind of facet Gamma_C is made of: edges of a 2D body, triangles of a
-tetrahedral one. Each kind is one class registered here (``register_boundary``) and declared by
-the cell families whose meshes have it (``CellFamily.contact_boundary``). Its instances hold one
+tetrahedral one, quadrilaterals of a hexahedral one. Each kind is one class registered here
+(``register_boundary``) and declared by the cell families whose meshes have it
+(``CellFamily.contact_boundary``). Its instances hold one
 mesh's contact facets in order and answer every question a formulation, an estimator or a
 measurement asks of them: the reference facet and its quadrature, the Lagrange nodes and their
 lumped surface mass, the normals and tangents, the constraint rows of nodal contact, the
@@ -10,8 +11,8 @@ pressure from nodal reactions, where a contact coordinate lies, the traction's s
 contact zone's measure. Code outside the classes never asks which kind it holds.
 
 Local coordinates t have shape (nq,) on an edge (a point of [0, 1]) and (2, nq) on a triangle
-(x = a + t_0 (b - a) + t_1 (c - a)); a contact coordinate is a number along a 2D Gamma_C and a
-pair (2,) on a 3D one.
+(x = a + t_0 (b - a) + t_1 (c - a)) or a quadrilateral (bilinear on the unit square); a contact
+coordinate is a number along a 2D Gamma_C and a pair (2,) on a 3D one.
 """
 
 from __future__ import annotations
@@ -93,18 +94,14 @@ class ContactBoundary:
         return [(scene.gap(x + h * tau[:, :, None]) - scene.gap(x - h * tau[:, :, None]))
                 / (2 * h[0]) for tau in self.surface_tangents()]
 
-    def lagrange_values(self, values: np.ndarray, order: int):
-        """The P_order interpolant on every facet of its nodal ``values`` (n, k) at the nodes
-        ``lagrange_points(order)``, as a function of local coordinates t: (n, nq)."""
+    def interpolant_of(self, function, order: int):
+        """The P_order Lagrange interpolant of ``function(x)`` (x (d, ...)) on every facet, as
+        a function of local coordinates t: (n, nq)."""
+        points = self.points(self.lagrange_points(order))
+        values = np.asarray(function(points.reshape(points.shape[0], -1)),
+                            dtype=float).reshape(self.size, -1)
         basis = self.lagrange_basis(order)
         return lambda t: values @ basis(np.asarray(t, dtype=float))
-
-    def interpolant_of(self, function, order: int):
-        """The P_order Lagrange interpolant of ``function(x)`` (x (d, ...)) on every facet."""
-        nodes = self.lagrange_points(order)
-        points = self.points(nodes)
-        values = np.asarray(function(points.reshape(points.shape[0], -1)), dtype=float)
-        return self.lagrange_values(values.reshape(self.size, -1), order)
 
 
 def register_boundary(cls, description: str):

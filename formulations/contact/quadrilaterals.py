@@ -24,7 +24,7 @@ from formulations.contact.reference_facets import (
     lagrange_basis_1d,
     lagrange_nodes,
 )
-from formulations.contact.surfaces import SurfaceBoundary
+from formulations.contact.surfaces import SurfaceBoundary, contact_faces, outward
 
 # the unit square's corners in a face's order (2, 4)
 SQUARE_CORNERS = np.array([[0.0, 1.0, 1.0, 0.0], [0.0, 0.0, 1.0, 1.0]])
@@ -70,20 +70,14 @@ class ContactFaces(SurfaceBoundary):
 
     @classmethod
     def of(cls, scene, mesh) -> ContactFaces:
-        facets = scene.contact_facets(mesh)
-        vertices = mesh.facets[:, facets]
-        corners = mesh.p[:, vertices]  # (3, 4, n)
-        element = mesh.f2t[0, facets]
+        facets, vertices, corners, element, coordinate = contact_faces(scene, mesh)
         # half the cross product of the diagonals: the area vector of a plane face
         area = 0.5 * np.cross(corners[:, 2] - corners[:, 0], corners[:, 3] - corners[:, 1],
                               axis=0)
         measure = np.linalg.norm(area, axis=0)
-        normal = area / measure
-        inside = mesh.p[:, mesh.t[:, element]].mean(axis=1)
-        normal *= np.where((normal * (corners.mean(axis=1) - inside)).sum(axis=0) < 0, -1, 1)
+        normal = outward(mesh, area / measure, corners, element)
         diameter = np.maximum(np.linalg.norm(corners[:, 2] - corners[:, 0], axis=0),
                               np.linalg.norm(corners[:, 3] - corners[:, 1], axis=0))
-        coordinate = np.asarray(scene.contact_coordinate(corners), dtype=float)
         return cls(mesh=mesh, facets=facets, vertices=vertices, normal=normal,
                    measure=measure, diameter=diameter, coordinate=coordinate, element=element)
 

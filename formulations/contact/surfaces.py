@@ -16,6 +16,24 @@ from formulations.contact.boundary import ContactBoundary
 DISC_DEGREE = 10  # quadrature degree on each facet for the area of the contact zone
 
 
+def contact_faces(scene, mesh):
+    """The contact facets of a 3D ``mesh`` (in its facet order): facet numbers, corner vertices
+    (k, n), corner points (3, k, n), the cell of each and the corners' contact coordinates."""
+    facets = scene.contact_facets(mesh)
+    vertices = mesh.facets[:, facets]
+    corners = mesh.p[:, vertices]
+    coordinate = np.asarray(scene.contact_coordinate(corners), dtype=float)
+    return facets, vertices, corners, mesh.f2t[0, facets], coordinate
+
+
+def outward(mesh, normal: np.ndarray, corners: np.ndarray, element: np.ndarray) -> np.ndarray:
+    """``normal`` (3, n) turned where it points into its cell (from the facet's centre to the
+    cell's): the outer normals."""
+    centroid = mesh.p[:, mesh.t[:, element]].mean(axis=1)
+    inward = np.einsum("in,in->n", normal, centroid - corners.mean(axis=1)) > 0
+    return np.where(inward, -normal, normal)
+
+
 @dataclass(frozen=True, eq=False)
 class SurfaceBoundary(ContactBoundary):
     """The shared part of a 3D body's contact boundary: its facets of ``mesh`` (``facets``),

@@ -24,7 +24,7 @@ from formulations.contact.reference_facets import (
     triangle_lagrange,
     triangle_rule,
 )
-from formulations.contact.surfaces import SurfaceBoundary
+from formulations.contact.surfaces import SurfaceBoundary, contact_faces, outward
 from scenes.base import simplex_measures, simplex_points
 
 # candidate facets per located point: the nearest centroids (in contact coordinates) tried
@@ -43,13 +43,9 @@ class ContactSurface(SurfaceBoundary):
     @classmethod
     def of(cls, scene, mesh) -> ContactSurface:
         """The contact facets of a tetrahedral mesh (in the mesh's facet order)."""
-        facets = scene.contact_facets(mesh)
-        vertices = mesh.facets[:, facets]
-        corners = mesh.p[:, vertices]  # (3, 3, n)
-        element = mesh.f2t[0, facets]
+        facets, vertices, corners, element, coordinate = contact_faces(scene, mesh)
         edges = [np.linalg.norm(corners[:, i] - corners[:, (i + 1) % 3], axis=0)
                  for i in range(3)]
-        coordinate = np.asarray(scene.contact_coordinate(corners), dtype=float)
         return cls(mesh=mesh, facets=facets, vertices=vertices,
                    normal=outer_triangle_normals(mesh, corners, element),
                    measure=simplex_measures(corners), diameter=np.max(edges, axis=0),
@@ -144,11 +140,7 @@ class ContactSurface(SurfaceBoundary):
 def outer_triangle_normals(mesh: Mesh, corners: np.ndarray, element: np.ndarray) -> np.ndarray:
     """Outer unit normals (3, n) of boundary triangles with corner points (3, 3, n)."""
     normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0], axis=0)
-    normal /= np.linalg.norm(normal, axis=0)
-    centroid = mesh.p[:, mesh.t[:, element]].mean(axis=1)
-    inward = np.einsum("in,in->n", normal, centroid - corners.mean(axis=1)) > 0
-    normal[:, inward] *= -1.0
-    return normal
+    return outward(mesh, normal / np.linalg.norm(normal, axis=0), corners, element)
 
 
 register_boundary(ContactSurface, "triangles: the faces of tetrahedra on Gamma_C, P1 and P2 "
