@@ -14,6 +14,7 @@ import pandas as pd
 from bench.matrix import RunConfig, run
 from bench.matrix.config_files import dataclass_fields, read_toml
 from bench.matrix.store import ResultStore
+from bench.sequence.options import option
 from bench.sequence.rows import FINISHED
 from bench.study.report import write_study_report
 from bench.verify import load_expected
@@ -46,19 +47,33 @@ def _study_tables(path: str | Path) -> tuple[dict, dict, dict]:
 _SETTINGS = _study_tables(STUDY_SETTINGS)[0]
 
 
+def _study(key: str, help: str, flag: str, kind: str, section: str = "what", **more):
+    """A study setting that is also an option of ``python -m bench study``, its default the
+    package's study.toml."""
+    return option(_SETTINGS[key], help, flag=flag, kind=kind, section=section, **more)
+
+
 @dataclass(frozen=True)
 class StudyConfig:
     """The rate study's settings; the defaults are the package's ``study.toml``."""
 
-    scenes: tuple[str, ...] = _SETTINGS["scenes"]
-    orders: tuple[int, ...] = _SETTINGS["orders"]
-    uniform_max_dofs: int = _SETTINGS["uniform_max_dofs"]
-    adaptive_max_dofs: int = _SETTINGS["adaptive_max_dofs"]
-    reference_dofs: int = _SETTINGS["reference_dofs"]
-    workers: int = _SETTINGS["workers"]  # adaptive sequences in parallel; uniform one by one
+    scenes: tuple[str, ...] = _study(
+        "scenes", "scene(s)", "scene", "scenes",
+        default_text="the study file's; with --cell quad or hex: its [cells.NAME] table's")
+    orders: tuple[int, ...] = _study("orders", "polynomial order(s)", "order", "orders")
+    uniform_max_dofs: int = _study("uniform_max_dofs", "DOF budget of the uniform sequences",
+                                   "uniform-max-dofs", "int>0")
+    adaptive_max_dofs: int = _study("adaptive_max_dofs",
+                                    "DOF budget of the adaptive sequences",
+                                    "adaptive-max-dofs", "int>0")
+    reference_dofs: int = _study("reference_dofs", "P3 reference budget", "reference-dofs",
+                                 "int>0")
+    workers: int = _study("workers", "adaptive sequences run in parallel on a local Dask "
+                          "cluster of this many processes; uniform ones one at a time",
+                          "workers", "int>=0", section="where")
     crosscheck: bool = _SETTINGS["crosscheck"]  # the P2 references too, compared in truth.json
-    out: str = _SETTINGS["out"]
-    report: str = _SETTINGS["report"]
+    out: str = _study("out", "results folder", "out", "text", section="where")
+    report: str = _study("report", "report folder", "report", "text", section="where")
     cell: str = _SETTINGS.get("cell", DEFAULT_CELL)  # the matrix's cell axis (one shape)
     # () runs every registered formulation, or estimator
     formulations: tuple[str, ...] = _SETTINGS.get("formulations", ())

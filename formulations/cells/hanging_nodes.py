@@ -65,11 +65,16 @@ def constraint_rows(hierarchy: QuadHierarchy, basis: Basis) -> tuple[np.ndarray,
 
 def prolongation(hierarchy: QuadHierarchy, basis: Basis) -> tuple[sparse.csr_matrix,
                                                                   np.ndarray]:
-    """P (basis.N x conforming DOFs) and the conforming DOFs (cell DOF numbers, sorted). A
-    constraint on a DOF that is itself constrained is substituted until none is left (on a
-    1-irregular mesh once at most)."""
-    rows, cols, weights = constraint_rows(hierarchy, basis)
-    n = basis.N
+    """P (basis.N x conforming DOFs) and the conforming DOFs of ``basis`` on ``hierarchy``."""
+    return substituted(*constraint_rows(hierarchy, basis), basis.N)
+
+
+def substituted(rows: np.ndarray, cols: np.ndarray, weights: np.ndarray,
+                n: int) -> tuple[sparse.csr_matrix, np.ndarray]:
+    """P (n x conforming DOFs) and the conforming DOFs (sorted) from constraints given as
+    (constrained DOF, DOF, weight) triplets. A constraint on a DOF that is itself constrained
+    is substituted until none is left (on a 1-irregular mesh a few times at most: an edge's
+    end may hang on a coarser edge or face)."""
     constrained = np.zeros(n, dtype=bool)
     constrained[rows] = True
     kept = np.flatnonzero(~constrained)
