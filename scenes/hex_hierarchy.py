@@ -79,12 +79,29 @@ def _find(keys: np.ndarray, table: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
     return np.where(sorted_keys[at] == keys, vertices[at], -1)
 
 
+def _table(keys: np.ndarray, values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A lookup table (sorted unique keys, their values) from keys and values of one shape."""
+    unique, first = np.unique(keys.ravel(), return_index=True)
+    return unique, values.ravel()[first]
+
+
 def _added(table: tuple[np.ndarray, np.ndarray], keys: np.ndarray, start: int):
     """``table`` with ``keys`` (unique, not in it) given the vertices start, start + 1, ..."""
     merged = np.concatenate([table[0], keys])
     vertices = np.concatenate([table[1], start + np.arange(keys.size)])
     order = np.argsort(merged)
     return merged[order], vertices[order]
+
+
+def _lattice_vertices(corners, edge_key, face_key, edge_table, face_table) -> np.ndarray:
+    """The lattice (27, m) of cells with ``corners`` (8, m), edge keys (12, m) and face keys
+    (6, m), the midpoints and centres looked up in the tables (-1 where not split)."""
+    lattice = np.full((27, corners.shape[1]), -1, dtype=np.int64)
+    on_corner, on_edge, on_face = LATTICE_CORNER >= 0, LATTICE_EDGE >= 0, LATTICE_FACE >= 0
+    lattice[on_corner] = corners[LATTICE_CORNER[on_corner]]
+    lattice[on_edge] = _find(edge_key[LATTICE_EDGE[on_edge]], edge_table)
+    lattice[on_face] = _find(face_key[LATTICE_FACE[on_face]], face_table)
+    return lattice
 
 
 @dataclass(frozen=True, eq=False)
@@ -188,12 +205,7 @@ class HexHierarchy:
         p = np.concatenate([self.p, self.p[:, ends].mean(axis=1),
                             self.p[:, face_corners].mean(axis=1),
                             self.p[:, corners].mean(axis=1)], axis=1)
-        lattice = np.empty((27, cells.size), dtype=np.int64)
-        on_corner, on_edge, on_face = (LATTICE_CORNER >= 0, LATTICE_EDGE >= 0,
-                                       LATTICE_FACE >= 0)
-        lattice[on_corner] = corners[LATTICE_CORNER[on_corner]]
-        lattice[on_edge] = _find(edge_key[LATTICE_EDGE[on_edge]], edge_table)
-        lattice[on_face] = _find(face_key[LATTICE_FACE[on_face]], face_table)
+        lattice = _lattice_vertices(corners, edge_key, face_key, edge_table, face_table)
         lattice[CENTRE] = start + new_edges.size + new_faces.size + np.arange(cells.size)
         children = lattice[CHILDREN]  # (8 children, 8 vertices, m)
         count, first_child = self.cells.shape[1], self.first_child.copy()
@@ -205,6 +217,16 @@ class HexHierarchy:
             first_child=np.concatenate([first_child, np.full(8 * cells.size, -1)]),
             level=np.concatenate([self.level, np.repeat(self.level[cells] + 1, 8)]),
             edges=edge_table, faces=face_table)
+
+    def lattice(self, cells: np.ndarray) -> np.ndarray:
+        """The vertex at each of the 27 lattice points of ``cells`` (27, m): the corners, the
+        midpoints of split edges and the centres of split faces, -1 where there is none (the
+        centre of a leaf)."""
+        corners = self.cells[:, cells]
+        a, b = self._leaf_edges(cells)
+        faces = self._leaf_faces(cells).transpose(1, 0, 2)
+        return _lattice_vertices(corners, edge_keys(a, b), face_keys(faces), self.edges,
+                                 self.faces)
 
     def hanging_edges(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Midpoints of leaf edges that are split, each once: (node, end a, end b)."""
@@ -241,6 +263,26 @@ class HexLeafMesh(MeshHex1):
 
     def boundary_facets(self) -> np.ndarray:
         return self._body_boundary
+
+    def edge_between(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        """The edge (a column of ``edges``) between hierarchy vertices a and b."""
+        return _find(edge_keys(a, b), self._edge_table)
+
+    def facet_with(self, corners: np.ndarray) -> np.ndarray:
+        """The facet (a column of ``facets``) with hierarchy vertices ``corners`` (4, ...) in
+        cyclic order."""
+        return _find(face_keys(corners), self._facet_table)
+
+    @functools.cached_property
+    def _edge_table(self) -> tuple[np.ndarray, np.ndarray]:
+        used, local = self.hierarchy.leaf_vertices()
+        keys = edge_keys(used[local[[i for i, _ in EDGES]]], used[local[[j for _, j in EDGES]]])
+        return _table(keys, self.t2e)
+
+    @functools.cached_property
+    def _facet_table(self) -> tuple[np.ndarray, np.ndarray]:
+        used, local = self.hierarchy.leaf_vertices()
+        return _table(face_keys(used[local[np.array(FACES)]].transpose(1, 0, 2)), self.t2f)
 
     @functools.cached_property
     def _body_boundary(self) -> np.ndarray:

@@ -61,7 +61,6 @@ class CellFamily:
     mesh_type: type = type(None)
     elements: dict = {}  # scalar Lagrange element class per order
     centroid_rule: tuple[np.ndarray, np.ndarray] = (np.zeros((2, 1)), np.ones(1))
-    adaptive: bool = True  # meshes refine where marked (else uniform only)
     tensor_product: bool = False  # Q_p on mapped squares or cubes (else P_p on simplices)
     contact_boundary: str = "edges"  # the kind of facet Gamma_C is made of (a registered one)
     # the registered formulations run on these cells and answer for friction themselves (else
@@ -77,8 +76,6 @@ class CellFamily:
 
     def why_not(self, scene, strategy: str = "uniform") -> str | None:
         """Why this family cannot run ``scene`` with ``strategy``, or None."""
-        if strategy == "adaptive" and not self.adaptive:
-            return f"adaptive refinement of {self.shape} is not built (uniform only)"
         if scene.friction.active and not self.friction:
             return (f"friction on {self.shape} is not built (the scene's law is "
                     f"{scene.friction.label})")

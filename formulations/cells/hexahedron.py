@@ -7,12 +7,15 @@ Gamma_C (``formulations.contact.quadrilaterals``)."""
 from __future__ import annotations
 
 import numpy as np
-from skfem import Basis, ElementHex1
+from skfem import Basis, ElementHex1, ElementHex2
+from skfem.assembly import Dofs
 
 from formulations.cells.base import CellFamily, Plan, register_family
 from formulations.cells.hanging_nodes import substituted
+from formulations.cells.hex_constraints import constraint_rows
 from formulations.cells.quad_load import quad_body_load
 from formulations.cells.quadrilateral import not_a_grid, tensor_axes
+from formulations.cells.tensor_stiffness import tensor_stiffness
 from scenes.hex_hierarchy import HexHierarchy, HexLeafMesh
 
 
@@ -20,7 +23,7 @@ class Hexahedra(CellFamily):
     name, cell, dim, shape = "hex", "quad", 3, "hexahedra"
     tensor_product = True
     mesh_type = HexLeafMesh
-    elements = {1: ElementHex1}
+    elements = {1: ElementHex1, 2: ElementHex2}
     centroid_rule = (np.full((3, 1), 0.5), np.array([1.0]))  # the unit cube
     contact_boundary = "quadrilaterals"
 
@@ -37,11 +40,18 @@ class Hexahedra(CellFamily):
         return plan.mesh.hierarchy.refined(plan.marked).mesh()
 
     def count_free_dofs(self, scene, mesh, order: int) -> int:
-        """Three per vertex that neither hangs nor lies on a clamped face."""
-        fixed = np.zeros(mesh.p.shape[1], dtype=bool)
-        fixed[mesh.facets[:, scene.dirichlet_facets(mesh)]] = True
-        fixed[hanging_vertices(mesh)[0]] = True
+        """Three per Lagrange node that neither hangs nor lies on a clamped face (counted on
+        scikit-fem's scalar numbering, before anything is assembled)."""
+        dofs, (rows, _, _) = scalar_constraints(mesh, order)
+        fixed = np.zeros(dofs.N, dtype=bool)
+        fixed[dofs.get_facet_dofs(scene.dirichlet_facets(mesh)).all()] = True
+        fixed[rows] = True
         return int(3 * np.count_nonzero(~fixed))
+
+    def stiffness(self, basis, lam: float, mu: float, order: int):
+        """Vectorised over cells on the (p + 1)^3 Gauss points
+        (formulations.cells.tensor_stiffness): exact on parallelepipeds."""
+        return tensor_stiffness(basis, lam, mu, order)
 
     def stiffness_intorder(self, order: int) -> int:
         return 2 * order  # (p + 1)^3 Gauss points: exact on parallelepipeds
@@ -59,27 +69,24 @@ class Hexahedra(CellFamily):
         return (P @ np.atleast_2d(values)[:, kept].T).T.reshape(np.shape(values))
 
 
-def hanging_vertices(mesh: HexLeafMesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The Q1 constraints of the leaf mesh's vertices as (hanging vertex, vertex, weight)
-    triplets: a split edge's midpoint is the mean of its ends, a split face's centre the mean
-    of its four corners (the trilinear trace there)."""
-    hierarchy = mesh.hierarchy
-    used, _ = hierarchy.leaf_vertices()
-    node, a, b = (np.searchsorted(used, v) for v in hierarchy.hanging_edges())
-    centre, corners = (np.searchsorted(used, v) for v in hierarchy.hanging_faces())
-    rows = np.concatenate([node, node, np.tile(centre, 4)])
-    cols = np.concatenate([a, b, corners.ravel()])
-    weights = np.concatenate([np.full(2 * node.size, 0.5), np.full(corners.size, 0.25)])
-    return rows, cols, weights
+def scalar_constraints(mesh, order: int):
+    """The scalar Q_order numbering of the leaf mesh and its hanging-node triplets
+    (``formulations.cells.hex_constraints``)."""
+    element = Hexahedra.elements[order]()
+    dofs = Dofs(mesh, element)
+    return dofs, constraint_rows(mesh, dofs, element, order)
 
 
 def prolongation(basis):
-    """P and the conforming DOFs of a vector Q1 basis on a leaf mesh (each component
-    constrained alike)."""
-    rows, cols, weights = hanging_vertices(basis.mesh)
-    nodal = basis.nodal_dofs  # (components, vertices)
-    return substituted(nodal[:, rows].ravel(), nodal[:, cols].ravel(),
-                       np.tile(weights, nodal.shape[0]), basis.N)
+    """P and the conforming DOFs of a scalar or vector Q1 or Q2 basis on a leaf mesh: each
+    component constrained alike (scikit-fem numbers component c of scalar DOF s as d s + c)."""
+    scalar = getattr(basis.elem, "elem", basis.elem)  # a vector element's component
+    order = next(p for p, kind in Hexahedra.elements.items() if type(scalar) is kind)
+    dofs, (rows, cols, weights) = scalar_constraints(basis.mesh, order)
+    d = basis.N // dofs.N
+    components = np.arange(d)[:, None]
+    return substituted((d * rows + components).ravel(), (d * cols + components).ravel(),
+                       np.tile(weights, d), basis.N)
 
 
 HEXAHEDRA = register_family(Hexahedra(), "hexahedra: Q1 on hierarchical meshes with hanging "

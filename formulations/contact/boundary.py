@@ -29,9 +29,10 @@ CONTACT_BOUNDARIES = Registry("contact boundary")
 @dataclass(frozen=True, eq=False)
 class TraceNodes:
     """The Lagrange nodes of the displacement on Gamma_C: the facets' vertices, then the nodes
-    inside them (2D: p - 1 per edge; 3D P2: the edges' midpoints). ``facet_rows`` (n_facets,
-    k) gives, per facet, the row of each of its nodes (2D: in order of t = k / p; 3D: in
-    ElementTriP2's order)."""
+    inside them (2D: p - 1 per edge; 3D P2: the edges' midpoints; Q2 faces: the edges'
+    midpoints, then the faces' centres). ``facet_rows`` (n_facets, k) gives, per facet, the
+    row of each of its nodes (2D: in order of t = k / p; triangles: in ElementTriP2's order;
+    quadrilaterals: in their Lagrange points' order)."""
 
     points: np.ndarray        # (d, m)
     normal: np.ndarray        # (d, m) unit, measure-weighted mean at a vertex
@@ -40,6 +41,8 @@ class TraceNodes:
     vertices: np.ndarray      # mesh vertex of each of the first rows
     edges: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))  # 3D P2: then
     # the mesh edge of each midpoint row
+    faces: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))  # Q2 faces:
+    # then the mesh facet of each centre row
 
 
 def tangent_frame(normal: np.ndarray) -> list[np.ndarray]:

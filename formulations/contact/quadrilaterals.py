@@ -6,7 +6,8 @@ square map bilinearly, x = c_0 (1 - t_0)(1 - t_1) + c_1 t_0 (1 - t_1) + c_2 t_0 
 + c_3 (1 - t_0) t_1, affinely on the parallelogram faces of a tensor grid. Nodal contact is
 Q1's: the faces' corners, each with a quarter of every face's area as its lumped mass (exact for
 a bilinear pressure's integral on parallelograms, and positive), the pressure bilinear between
-them, so lambda_h >= 0 wherever the nodal values are.
+them, so lambda_h >= 0 wherever the nodal values are. Q2 adds the edges' midpoints and the
+faces' centres with Simpson's positive weights.
 """
 
 from __future__ import annotations
@@ -50,6 +51,18 @@ def square_basis(order: int):
 
 
 CORNER_ORDER = np.array([0, 2, 3, 1])  # tensor nodes (0,0), (1,0), (1,1), (0,1)
+# Q2's tensor nodes (square_points(2): t0 = 0, 1/2, 1 slowest): the corners in the faces'
+# order, the midpoints of edges c0c1, c1c2, c2c3, c3c0, the centre at 4
+Q2_CORNERS, Q2_EDGES = np.array([0, 6, 8, 2]), np.array([3, 7, 5, 1])
+QUARTERS = np.full(4, 0.25)  # int of a Q1 corner function over the unit square
+SIMPSON = np.outer([1, 4, 1], [1, 4, 1]).ravel() / 36  # of the Q2 ones, tensor order
+
+
+def edge_index(mesh, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The mesh edge between vertices a and b (scikit-fem's edges: sorted pairs, in order)."""
+    n = mesh.p.shape[1]
+    keys = mesh.edges[0].astype(np.int64) * n + mesh.edges[1]
+    return np.searchsorted(keys, np.minimum(a, b).astype(np.int64) * n + np.maximum(a, b))
 
 
 def bilinear(corners: np.ndarray, t: np.ndarray) -> np.ndarray:
@@ -126,31 +139,53 @@ class ContactFaces(SurfaceBoundary):
         """The Q1 corners and the two triangles between them (Q2 drawn as Q1)."""
         return SQUARE_CORNERS, np.array([[0, 1, 2], [0, 2, 3]])
 
-    # --- nodal contact (Q1) -----------------------------------------------------------------
+    # --- nodal contact (Q1, Q2) ------------------------------------------------------------
     def nodes(self, order: int) -> TraceNodes:
-        """The faces' corners; lumped mass a quarter of each face's area."""
-        if order != 1:
-            raise ValueError(f"order={order}: nodal contact on quadrilateral faces is Q1 only")
+        """The faces' Q_order Lagrange nodes: corners, then (Q2) the edges' midpoints and the
+        faces' centres; lumped mass the integral of each node's basis function (Q1: a quarter
+        of the area; Q2: Simpson's 1/36, 4/36, 16/36, positive, so lambda_i = r_i / m_i >= 0
+        node by node)."""
+        if order not in (1, 2):
+            raise ValueError(f"order={order}: nodal contact on quadrilateral faces is Q1 or Q2")
         vertices, local = np.unique(self.vertices, return_inverse=True)
-        rows = local.reshape(self.vertices.shape).T  # (n_faces, 4)
-        m = vertices.size
-        mass = np.repeat(self.measure[:, None] / 4, 4, axis=1)
-        weight = np.bincount(rows.ravel(), mass.ravel(), m)
-        normal = np.array([np.bincount(rows.ravel(), (mass * self.normal[c][:, None]).ravel(), m)
-                           for c in range(3)])
+        rows = local.reshape(self.vertices.shape).T  # (n_faces, 4) in the faces' order
+        points = self.mesh.p[:, vertices]
+        edges, faces, mass = np.zeros(0, dtype=int), np.zeros(0, dtype=int), QUARTERS
+        if order == 2:
+            corners = self.vertices
+            face_edges = np.array([edge_index(self.mesh, corners[k], corners[(k + 1) % 4])
+                                   for k in range(4)])  # (4, n): c0c1, c1c2, c2c3, c3c0
+            edges, on_edge = np.unique(face_edges, return_inverse=True)
+            faces = self.facets
+            tensor = np.empty((self.size, 9), dtype=np.int64)
+            tensor[:, Q2_CORNERS] = rows
+            tensor[:, Q2_EDGES] = vertices.size + on_edge.reshape(face_edges.shape).T
+            tensor[:, 4] = vertices.size + edges.size + np.arange(self.size)
+            rows, mass = tensor, SIMPSON
+            points = np.concatenate([points, self.mesh.p[:, self.mesh.edges[:, edges]].mean(
+                axis=1), self.mesh.p[:, corners].mean(axis=1)], axis=1)
+        m = points.shape[1]
+        lumped = mass[None, :] * self.measure[:, None]
+        weight = np.bincount(rows.ravel(), lumped.ravel(), m)
+        normal = np.array([np.bincount(rows.ravel(), (lumped * self.normal[c][:, None]).ravel(),
+                                       m) for c in range(3)])
         normal /= np.linalg.norm(normal, axis=0)
-        return TraceNodes(points=self.mesh.p[:, vertices], normal=normal, weight=weight,
-                          facet_rows=rows, vertices=vertices)
+        return TraceNodes(points=points, normal=normal, weight=weight, facet_rows=rows,
+                          vertices=vertices, edges=edges, faces=faces)
 
     @staticmethod
     def node_rows(elasticity, nodes: TraceNodes,
                   directions: np.ndarray | None = None) -> sparse.csr_matrix:
-        """B_i = n_i' u_h(x_i): a corner's value is its own DOFs."""
+        """B_i = n_i' u_h(x_i): at a Lagrange node the value is the node's own DOFs."""
+        basis = elasticity.basis
         directions = nodes.normal if directions is None else directions
-        dofs = elasticity.basis.nodal_dofs[:, nodes.vertices]
+        dofs = basis.nodal_dofs[:, nodes.vertices]
+        if nodes.edges.size:
+            dofs = np.concatenate([dofs, basis.edge_dofs[:, nodes.edges],
+                                   basis.facet_dofs[:, nodes.faces]], axis=1)
         m = dofs.shape[1]
         rows = sparse.csr_matrix((directions.ravel(), (np.tile(np.arange(m), 3), dofs.ravel())),
-                                 shape=(m, elasticity.basis.N))
+                                 shape=(m, basis.N))
         rows.eliminate_zeros()  # a plane Gamma_C: one column per node in the Schur set
         return rows
 
@@ -160,8 +195,8 @@ class ContactFaces(SurfaceBoundary):
 
     @staticmethod
     def nodal_pressure(values: np.ndarray):
-        """lambda_h(t) (n, nq): bilinear between the corners' values (n, 4)."""
-        basis = square_basis(1)
+        """lambda_h(t) (n, nq): the Q1 or Q2 interpolant of the nodes' values (n, 4 or 9)."""
+        basis = square_basis(1 if values.shape[1] == 4 else 2)
         return lambda t: values @ basis(np.asarray(t, dtype=float))
 
     # --- location -------------------------------------------------------------------------
@@ -184,4 +219,5 @@ class ContactFaces(SurfaceBoundary):
         return near[best, columns], np.clip(local[:, best, columns], 0.0, 1.0)
 
 
-register_boundary(ContactFaces, "quadrilaterals: the faces of hexahedra on Gamma_C, Q1 nodes")
+register_boundary(ContactFaces, "quadrilaterals: the faces of hexahedra on Gamma_C, Q1 and Q2 "
+                                "nodes")

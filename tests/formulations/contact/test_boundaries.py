@@ -70,12 +70,20 @@ def test_located_points_are_found_again_and_the_pressure_there_is_exact(kind):
     assert np.allclose(trace.pressure_at(pressure, s), pressure(t).ravel(), rtol=1e-9)
 
 
-@pytest.mark.parametrize("kind", KINDS)
-def test_nodal_masses_sum_to_the_area_and_normals_point_out(kind):
+@pytest.mark.parametrize("kind, order", [(kind, 1) for kind in KINDS]
+                         + [("edges", 2), ("quadrilaterals", 2)])
+def test_nodal_masses_sum_to_the_area_and_normals_point_out(kind, order):
+    """Lumped masses are positive where they are the basis functions' integrals (P1, 2D P2,
+    Q1, Q2: Simpson's 1/36, 4/36, 16/36); the P2 triangles' fit their own (see
+    formulations.contact.surface_nodes)."""
     scene, trace = boundary(kind)
-    nodes = trace.nodes(1)
+    nodes = trace.nodes(order)
     assert nodes.weight.sum() == pytest.approx(KINDS[kind][2], rel=1e-12)
     assert np.all(nodes.weight > 0)
+    assert nodes.points.shape[1] == nodes.weight.size == np.unique(nodes.facet_rows).size
+    # each facet's rows are its Lagrange points, in their order
+    at = trace.points(trace.lagrange_points(order))  # (d, n_facets, k)
+    assert np.allclose(nodes.points[:, nodes.facet_rows], at, atol=1e-12)
     # Gamma_C is the bottom: the outer normal is -e_y in 2D, -e_z in 3D
     down = -np.eye(trace.dim)[:, -1][:, None]
     assert np.allclose(trace.normal, down, atol=1e-12)
