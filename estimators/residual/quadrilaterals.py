@@ -20,7 +20,7 @@ from estimators.base import Estimate, register_cell_variant
 from estimators.contact_terms import contact_terms
 from estimators.residual.nitsche import nitsche_estimate
 from formulations.cells.quad_evaluation import QuadGradient
-from formulations.cells.quad_load import affine_maps
+from formulations.cells.quad_load import affine_maps, volumes
 from formulations.cells.tensor_stiffness import tensor_rule
 from formulations.contact.reference_facets import gauss_legendre
 from formulations.elasticity import element_diameters, stress_tensor_from_gradient
@@ -47,26 +47,26 @@ class QuadStress:
         return self.divergence_of(self.field.derivatives_at(x, cells))
 
     def divergence_of(self, dgrad: np.ndarray) -> np.ndarray:
-        """div sigma from d_k (grad u)_ij (2, 2, 2, ...)."""
+        """div sigma from d_k (grad u)_ij (d, d, d, ...)."""
         lam, mu = self.lame
+        d = dgrad.shape[0]
         strain = 0.5 * (dgrad + np.swapaxes(dgrad, 0, 1))  # d_k eps_ij
-        d_trace = dgrad[0, 0] + dgrad[1, 1]  # d_k tr(eps)
-        return np.array([2 * mu * (strain[i, 0, 0] + strain[i, 1, 1]) + lam * d_trace[i]
-                         for i in range(2)])
+        d_trace = sum(dgrad[k, k] for k in range(d))  # d_i tr(eps)
+        return np.array([2 * mu * sum(strain[i, k, k] for k in range(d)) + lam * d_trace[i]
+                         for i in range(d)])
 
 
 def element_residuals(scene, solution, stress: QuadStress) -> np.ndarray:
-    """(h_T/p)^2 ||f + div sigma(u_h)||_T^2 per cell, on the (p + 1)^2 Gauss points of each
-    parallelogram x = v0 + A xi (dx = |det A| w)."""
+    """(h_T/p)^2 ||f + div sigma(u_h)||_T^2 per cell, on the (p + 1)^d Gauss points of each
+    parallelogram or parallelepiped x = v0 + A xi (dx = |det A| w)."""
     mesh, order = solution.elasticity.basis.mesh, solution.elasticity.order
-    X, w = tensor_rule(order + 1)
-    origin, A = affine_maps(mesh)  # (2, nE), (2, 2, nE)
-    x = origin[:, :, None] + np.einsum("ikE,kq->iEq", A, X)  # (2, nE, nq)
+    X, w = tensor_rule(order + 1, mesh.p.shape[0])
+    origin, A = affine_maps(mesh)  # (d, nE), (d, d, nE)
+    x = origin[:, :, None] + np.einsum("ikE,kq->iEq", A, X)  # (d, nE, nq)
     residual = stress.divergence_of(stress.field.derivatives_at_reference(X))
     if scene.body_force is not None:
         residual = residual + scene.body_force(x)
-    area = np.abs(A[0, 0] * A[1, 1] - A[0, 1] * A[1, 0])
-    norm2 = ((residual**2).sum(axis=0) * w).sum(axis=1) * area
+    norm2 = ((residual**2).sum(axis=0) * w).sum(axis=1) * volumes(A)
     return (element_diameters(mesh) / order) ** 2 * norm2
 
 

@@ -109,11 +109,17 @@ def face_residuals_3d(scene, solution: DiscreteSolution) -> np.ndarray:
             sn = sn - scene.traction(x)
         norm2 = ((sn**2).sum(axis=0).reshape(-1, nq) * w).sum(axis=1) * area
         out += np.bincount(element, h / order * norm2, n_elements)
-    trace = solution.trace
+    return out + contact_residuals(solution, lambda x, cells: stress_at(solution, x, cells))
+
+
+def contact_residuals(solution: DiscreteSolution, sigma_at) -> np.ndarray:
+    """(h_F / p) R_F^2 per cell on the contact faces of any 3D contact boundary, with
+    ``sigma_at(x, cells)`` the stress of u_h at points of given cells."""
+    trace, order = solution.trace, solution.elasticity.order
     t, w = trace.rule(BOUNDARY_DEGREE)
     nq = w.size
     normal = np.repeat(trace.normal, nq, axis=1)
-    sigma = stress_at(solution, trace.points(t).reshape(3, -1), np.repeat(trace.element, nq))
+    sigma = sigma_at(trace.points(t).reshape(3, -1), np.repeat(trace.element, nq))
     sn = np.einsum("ijn,jn->in", sigma, normal)
     snn = np.einsum("in,in->n", sn, normal)
     shear = sn - snn * normal
@@ -122,8 +128,8 @@ def face_residuals_3d(scene, solution: DiscreteSolution) -> np.ndarray:
     snt2 = (shear**2).sum(axis=0).reshape(-1, nq)
     normal_part = np.sqrt(trace.integrate((snn.reshape(-1, nq) + solution.pressure(t)) ** 2, w))
     r_f = normal_part + np.sqrt(trace.integrate(snt2, w))
-    out += np.bincount(trace.element, trace.diameter / order * r_f**2, n_elements)
-    return out
+    return np.bincount(trace.element, trace.diameter / order * r_f**2,
+                       solution.elasticity.mesh.t.shape[1])
 
 
 def volume_terms_3d(scene, solution: DiscreteSolution) -> np.ndarray:

@@ -1,8 +1,8 @@
-"""Hexahedra: Q1 on 1-irregular hierarchies of a scene's grid of cubes
-(``scenes.hex_hierarchy``), refined uniformly or where marked; hanging nodes at the midpoints
-of split edges and the centres of split faces take the coarse cell's trilinear trace there
-(docs/theory.md, sections 15.4-15.6). Their contact boundary is the quadrilateral faces on
-Gamma_C (``formulations.contact.quadrilaterals``)."""
+"""Hexahedra: Q1 and Q2 on 1-irregular hierarchies of a scene's grid of cubes
+(``scenes.hex_hierarchy``), refined uniformly or where marked; the nodes that finer neighbours
+put on a leaf's edges and faces take the leaf's field there
+(``formulations.cells.hex_constraints``; docs/theory.md, sections 15.4-15.6). Their contact
+boundary is the quadrilateral faces on Gamma_C (``formulations.contact.quadrilaterals``)."""
 
 from __future__ import annotations
 
@@ -89,5 +89,5 @@ def prolongation(basis):
                        np.tile(weights, d), basis.N)
 
 
-HEXAHEDRA = register_family(Hexahedra(), "hexahedra: Q1 on hierarchical meshes with hanging "
-                                         "nodes")
+HEXAHEDRA = register_family(Hexahedra(), "hexahedra: Q1-Q2 on hierarchical meshes with "
+                                         "hanging nodes")

@@ -20,6 +20,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy import sparse
 
 from scenes.registry import Registry
 
@@ -115,3 +116,44 @@ def register_boundary(cls, description: str):
 def boundary_kind(name: str):
     """The registered class of contact boundary ``name``; ValueError naming the built ones."""
     return CONTACT_BOUNDARIES.get(name)
+
+
+@dataclass(frozen=True, eq=False)
+class ConformingNodes:
+    """The contact nodes that are unknowns of their own (``kept``, indices into the nodes)
+    and the nodal prolongation S (all nodes x kept) that gives every node's value from
+    theirs: the identity on kept nodes, the hanging-node weights on the others."""
+
+    kept: np.ndarray
+    S: object  # scipy.sparse
+
+    def weights(self, weight: np.ndarray) -> np.ndarray:
+        """int phi_k of each kept node's conforming basis function sum_j S_jk phi_j."""
+        return self.S.T @ weight
+
+
+def conforming_nodes(elasticity, rows, m: int) -> ConformingNodes | None:
+    """Which of the ``m`` contact nodes hang (docs/theory.md, section 15.4): on a 3D
+    hierarchy a face's edge or centre may hold finer neighbours' nodes on Gamma_C, whose rows
+    would be combinations of their parents' and whose multipliers would not be unique. None
+    where none hangs. ``rows(directions)`` are the nodes' rows along given directions (d, m):
+    along e_1 each picks its node's first DOF, and P says on what that DOF depends. A node
+    whose value is one conforming DOF is kept (the first of several at one place: a Q2
+    vertex hanging at a coarse edge's midpoint and that edge's own node)."""
+    if elasticity.constraint is None:
+        return None
+    d = elasticity.basis.nodal_dofs.shape[0]
+    on = (rows(np.repeat(np.eye(d)[:, :1], m, axis=1)) @ elasticity.constraint).tocsr()
+    on.eliminate_zeros()
+    single = np.flatnonzero(np.diff(on.indptr) == 1)
+    single = single[np.isclose(on.data[on.indptr[single]], 1.0)]
+    _, first = np.unique(on.indices[on.indptr[single]], return_index=True)
+    kept = np.sort(single[first])
+    if kept.size == m:
+        return None
+    position = np.full(on.shape[1], -1)
+    position[on.indices[on.indptr[kept]]] = np.arange(kept.size)
+    if (position[on.indices] < 0).any():
+        raise ValueError("a hanging contact node depends on a node off Gamma_C")
+    S = sparse.csr_matrix((on.data, position[on.indices], on.indptr), shape=(m, kept.size))
+    return ConformingNodes(kept=kept, S=S)

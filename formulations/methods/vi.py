@@ -22,7 +22,7 @@ from skfem import MeshTri
 
 from formulations.base import ContactQP, DiscreteSolution, QPSolution, Residuals
 from formulations.contact import contact_trace
-from formulations.contact.boundary import tangent_frame
+from formulations.contact.boundary import conforming_nodes, tangent_frame
 from formulations.discretisation import Discretisation, discrete_solution
 from formulations.elasticity import assemble_elasticity, check_order
 from formulations.friction.nodal import friction_rows, interleaved, nodal_friction
@@ -50,9 +50,14 @@ def discretise(scene: Scene, mesh: MeshTri, order: int = 1) -> Discretisation:
     trace = contact_trace(scene, mesh)
     nodes = trace.nodes(elasticity.order)
     rows = partial(trace.node_rows, elasticity, nodes)
-    B = rows()  # along the normals; with a direction per node, along it
-    m = nodes.weight.size
-    G = np.asarray(scene.gap(nodes.points), dtype=float)
+    # a node hanging on Gamma_C (3D hierarchies) is no constraint of its own
+    conforming = conforming_nodes(elasticity, rows, nodes.weight.size)
+    if conforming is not None and scene.friction.active:
+        raise ValueError("friction with hanging nodes on Gamma_C is not built")
+    kept = np.arange(nodes.weight.size) if conforming is None else conforming.kept
+    B = rows()[kept]  # along the normals; with a direction per node, along it
+    m = kept.size
+    G = np.asarray(scene.gap(nodes.points), dtype=float)[kept]
     # rows of B are dimensionless (a normal), so the multipliers are forces; row_scale 1
     frame = tangent_frame(nodes.normal)
     friction = (friction_rows(scene, nodes, elasticity.restrict(
@@ -63,6 +68,7 @@ def discretise(scene: Scene, mesh: MeshTri, order: int = 1) -> Discretisation:
                    objective_scale=float(scene.material.young_modulus),
                    near_null=elasticity.rigid_modes, friction=friction)
     coordinate = np.asarray(scene.contact_coordinate(nodes.points), dtype=float)
+    row_coordinate = coordinate[..., kept]
 
     def tangential_of(answer: QPSolution) -> np.ndarray:  # NaN where a solve failed
         if answer.tangential is not None:
@@ -71,17 +77,19 @@ def discretise(scene: Scene, mesh: MeshTri, order: int = 1) -> Discretisation:
 
     def recover(answer: QPSolution, residuals: Residuals, status: str,
                 reason: str) -> DiscreteSolution:
-        reaction = np.maximum(answer.multipliers, 0.0)
-        lam = trace.node_pressures(nodes, reaction)
+        reaction = np.zeros(nodes.weight.size)
+        reaction[kept] = np.maximum(answer.multipliers, 0.0)
+        lam = (trace.node_pressures(nodes, reaction) if conforming is None else conforming.S
+               @ (reaction[kept] / conforming.weights(nodes.weight)))
         return discrete_solution(
             "vi", elasticity, trace, answer, residuals, status, reason, u_free=answer.u,
             pressure=trace.nodal_pressure(lam[nodes.facet_rows]),
             multiplier_breaks=trace.ordered_breaks(coordinate),
-            active_constraints=count_active(qp, answer.u, reaction),
+            active_constraints=count_active(qp, answer.u, reaction[kept]),
             details=NodalDetails(reactions=reaction, nodal_pressure=lam,
                                  contact_nodes=nodes.vertices),
             friction=None if friction is None else nodal_friction(
                 friction, answer.u, reaction, tangential_of(answer), nodes, coordinate, frame))
 
     return Discretisation(formulation="vi", elasticity=elasticity, trace=trace, qp=qp,
-                          recover=recover, row_coordinate=coordinate)
+                          recover=recover, row_coordinate=row_coordinate)

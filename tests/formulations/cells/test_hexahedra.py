@@ -70,6 +70,30 @@ def test_a_flat_push_is_reproduced_on_a_graded_mesh(pushed_cube, formulation, or
     assert solution.energy == pytest.approx(0.1, rel=1e-9)
     uz = solution.u[solution.elasticity.basis.nodal_dofs[2]]
     assert np.allclose(uz, 0.005 * (1 - mesh.p[2]), atol=1e-11)  # hanging nodes too
+    if formulation == "vi":  # hanging contact nodes take their parents' pressure
+        assert np.allclose(solution.details.nodal_pressure, 5.0, rtol=1e-9)
+
+
+def test_hanging_contact_nodes_are_no_constraints_of_their_own(pushed_cube):
+    """On a graded Gamma_C the VI constrains the conforming nodes only: the nodal
+    prolongation's rows sum to one (it interpolates), the kept nodes' conforming masses sum
+    to Gamma_C's area, and the constraints are fewer than the nodes."""
+    from functools import partial
+
+    from formulations.contact import contact_trace
+    from formulations.contact.boundary import conforming_nodes
+    from formulations.elasticity import assemble_elasticity
+
+    mesh = graded(HEXAHEDRA.starting_mesh(pushed_cube), (0.3, 0.2, -1.0), 3)
+    for order in (1, 2):
+        elasticity = assemble_elasticity(pushed_cube, mesh, order)
+        trace = contact_trace(pushed_cube, mesh)
+        nodes = trace.nodes(order)
+        kept = conforming_nodes(elasticity, partial(trace.node_rows, elasticity, nodes),
+                                nodes.weight.size)
+        assert 0 < kept.kept.size < nodes.weight.size
+        assert np.allclose(np.asarray(kept.S.sum(axis=1)).ravel(), 1.0, atol=1e-14)
+        assert kept.weights(nodes.weight).sum() == pytest.approx(4.0, rel=1e-12)
 
 
 def lagrange_1d(nodes: np.ndarray, t: np.ndarray) -> np.ndarray:
