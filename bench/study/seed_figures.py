@@ -18,6 +18,7 @@ from bench.measure.slope import fit_slope
 from bench.report.figures import VON_MISES_PERCENTILE, _slope_triangle, cell_polygons
 from bench.sequence.rows import with_labels
 from formulations import STATUS_OK
+from scenes.registry import scene_dim
 
 SEED_SETUP = {"formulation": "mixed", "formulation_options": "", "estimator": "residual"}
 FIG1_DOFS = 20000  # Fig. 1: the last adaptive level within this many DOFs
@@ -82,8 +83,8 @@ def mesh_and_stress(artifact: dict, title: str) -> Figure:
 
 def estimated_error(table: pd.DataFrame, scene: str) -> Figure:
     """Fig. 2: eta and the error against the DOFs, uniform and adaptive, of the seed's setup,
-    with the fitted slopes in the legend and the slopes -1/4 (the seed's O(h^1/2)) and -1/2
-    (O(h)) drawn."""
+    with the fitted slopes in the legend and the slopes of the seed's O(h^1/2) and of O(h)
+    drawn (-1/4 and -1/2 in 2D, -1/6 and -1/3 in 3D: h is N^(-1/d))."""
     fig = Figure(figsize=(6.5, 5))
     ax = fig.subplots()
     name = ""
@@ -100,8 +101,9 @@ def estimated_error(table: pd.DataFrame, scene: str) -> Figure:
     rows = seed_sequence(table, scene, "uniform")
     if len(rows):
         x0, y0 = rows["ndofs"].min() * 3, rows["eta"].max() / 3
-        _slope_triangle(ax, x0, y0, -0.25, "-1/4: O(h^1/2)")
-        _slope_triangle(ax, x0, y0 / 10, -0.5, "-1/2: O(h)")
+        d = scene_dim(scene) or 2
+        _slope_triangle(ax, x0, y0, -1 / (2 * d), f"-1/{2 * d}: O(h^1/2)")
+        _slope_triangle(ax, x0, y0 / 10, -1 / d, f"-1/{d}: O(h)")
     ax.set_xlabel("DOFs N")
     ax.set_ylabel("energy norm")
     ax.set_title(f"{scene}, {name}: estimated and true error", fontsize=9)
