@@ -23,7 +23,7 @@ from skfem import MeshHex
 from skfem.mesh import MeshHex1
 
 from scenes.budget import check_vertex_count
-from scenes.quad_hierarchy import edge_keys
+from scenes.quad_hierarchy import LeafCells, edge_keys, find_keys
 
 CORNERS = np.array([[0, 0, 0], [0, 1, 0], [1, 0, 0], [0, 0, 1],
                     [1, 1, 0], [0, 1, 1], [1, 0, 1], [1, 1, 1]])  # scikit-fem's local order
@@ -70,15 +70,6 @@ def face_keys(corners: np.ndarray) -> np.ndarray:
     return np.minimum(edge_keys(corners[0], corners[2]), edge_keys(corners[1], corners[3]))
 
 
-def _find(keys: np.ndarray, table: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
-    """The vertex that ``table`` (sorted keys, vertices) holds for each key, -1 where none."""
-    sorted_keys, vertices = table
-    if sorted_keys.size == 0:
-        return np.full(np.shape(keys), -1, dtype=np.int64)
-    at = np.minimum(np.searchsorted(sorted_keys, keys), sorted_keys.size - 1)
-    return np.where(sorted_keys[at] == keys, vertices[at], -1)
-
-
 def _table(keys: np.ndarray, values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """A lookup table (sorted unique keys, their values) from keys and values of one shape."""
     unique, first = np.unique(keys.ravel(), return_index=True)
@@ -99,13 +90,13 @@ def _lattice_vertices(corners, edge_key, face_key, edge_table, face_table) -> np
     lattice = np.full((27, corners.shape[1]), -1, dtype=np.int64)
     on_corner, on_edge, on_face = LATTICE_CORNER >= 0, LATTICE_EDGE >= 0, LATTICE_FACE >= 0
     lattice[on_corner] = corners[LATTICE_CORNER[on_corner]]
-    lattice[on_edge] = _find(edge_key[LATTICE_EDGE[on_edge]], edge_table)
-    lattice[on_face] = _find(face_key[LATTICE_FACE[on_face]], face_table)
+    lattice[on_edge] = find_keys(edge_key[LATTICE_EDGE[on_edge]], edge_table)
+    lattice[on_face] = find_keys(face_key[LATTICE_FACE[on_face]], face_table)
     return lattice
 
 
 @dataclass(frozen=True, eq=False)
-class HexHierarchy:
+class HexHierarchy(LeafCells):
     """Every cell ever made: ``cells`` (8, n) vertex numbers, ``parent`` (n,) (-1 for a root),
     ``first_child`` (n,) (-1 for a leaf; the children are first_child + 0..7), ``level``;
     ``edges`` and ``faces`` (sorted keys, vertex) hold the split edges' midpoints and the
@@ -130,10 +121,6 @@ class HexHierarchy:
         return cls(mesh.p, mesh.t.astype(np.int64), np.full(n, -1), np.full(n, -1),
                    np.zeros(n, dtype=np.int64), (empty, empty), (empty, empty))
 
-    @property
-    def leaves(self) -> np.ndarray:
-        return np.flatnonzero(self.first_child < 0)
-
     def mesh(self) -> HexLeafMesh:
         """The leaves as a scikit-fem mesh on the vertices they use (built once)."""
         return self._leaf_mesh
@@ -143,16 +130,6 @@ class HexHierarchy:
         used, local = self.leaf_vertices()
         return HexLeafMesh(np.ascontiguousarray(self.p[:, used]),
                            np.ascontiguousarray(local), hierarchy=self)
-
-    def leaf_vertices(self) -> tuple[np.ndarray, np.ndarray]:
-        """The hierarchy's vertices the leaves use, and the leaves renumbered on them."""
-        return self._leaf_vertices
-
-    @functools.cached_property
-    def _leaf_vertices(self) -> tuple[np.ndarray, np.ndarray]:
-        leaves = self.cells[:, self.leaves]
-        used, local = np.unique(leaves, return_inverse=True)
-        return used, local.reshape(leaves.shape)
 
     def refined(self, marked: np.ndarray | None = None) -> HexHierarchy:
         """Split the marked leaves (positions in ``leaves``; None: all), then as many more as
@@ -170,11 +147,11 @@ class HexHierarchy:
         keep faces and edges 1-irregular."""
         leaves = self.leaves
         a, b = self._leaf_edges(leaves)
-        middle = _find(edge_keys(a, b), self.edges)
+        middle = find_keys(edge_keys(a, b), self.edges)
         split = middle >= 0
         twice = np.zeros(a.shape, dtype=bool)
-        twice[split] = ((_find(edge_keys(a[split], middle[split]), self.edges) >= 0)
-                        | (_find(edge_keys(middle[split], b[split]), self.edges) >= 0))
+        twice[split] = ((find_keys(edge_keys(a[split], middle[split]), self.edges) >= 0)
+                        | (find_keys(edge_keys(middle[split], b[split]), self.edges) >= 0))
         return leaves[twice.any(axis=0)]
 
     def _leaf_edges(self, cells: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -193,9 +170,9 @@ class HexHierarchy:
         edge_key = edge_keys(a, b)  # (12, m)
         faces = self._leaf_faces(cells).transpose(1, 0, 2)  # (4 corners, 6 faces, m)
         face_key = face_keys(faces)  # (6, m)
-        fresh = _find(edge_key, self.edges) < 0
+        fresh = find_keys(edge_key, self.edges) < 0
         new_edges, first_edge = np.unique(edge_key[fresh], return_index=True)
-        fresh_face = _find(face_key, self.faces) < 0
+        fresh_face = find_keys(face_key, self.faces) < 0
         new_faces, first_face = np.unique(face_key[fresh_face], return_index=True)
         start = self.p.shape[1]
         edge_table = _added(self.edges, new_edges, start)
@@ -228,17 +205,10 @@ class HexHierarchy:
         return _lattice_vertices(corners, edge_keys(a, b), face_keys(faces), self.edges,
                                  self.faces)
 
-    def hanging_edges(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Midpoints of leaf edges that are split, each once: (node, end a, end b)."""
-        a, b = self._leaf_edges(self.leaves)
-        middle = _find(edge_keys(a, b), self.edges)
-        node, first = np.unique(middle[middle >= 0], return_index=True)
-        return node, a[middle >= 0][first], b[middle >= 0][first]
-
     def hanging_faces(self) -> tuple[np.ndarray, np.ndarray]:
         """Centres of leaf faces that are split, each once: (node, corners (4, n))."""
         faces = self._leaf_faces(self.leaves).transpose(1, 0, 2).reshape(4, -1)
-        centre = _find(face_keys(faces), self.faces)
+        centre = find_keys(face_keys(faces), self.faces)
         node, first = np.unique(centre[centre >= 0], return_index=True)
         return node, faces[:, centre >= 0][:, first]
 
@@ -266,12 +236,12 @@ class HexLeafMesh(MeshHex1):
 
     def edge_between(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         """The edge (a column of ``edges``) between hierarchy vertices a and b."""
-        return _find(edge_keys(a, b), self._edge_table)
+        return find_keys(edge_keys(a, b), self._edge_table)
 
     def facet_with(self, corners: np.ndarray) -> np.ndarray:
         """The facet (a column of ``facets``) with hierarchy vertices ``corners`` (4, ...) in
         cyclic order."""
-        return _find(face_keys(corners), self._facet_table)
+        return find_keys(face_keys(corners), self._facet_table)
 
     @functools.cached_property
     def _edge_table(self) -> tuple[np.ndarray, np.ndarray]:
@@ -294,6 +264,6 @@ class HexLeafMesh(MeshHex1):
         centres = self.hierarchy.hanging_faces()[0]
         split = np.zeros(facets.size, dtype=bool)
         for i, j in itertools.combinations(range(4), 2):  # one pair is the stored diagonal
-            split |= _find(edge_keys(corners[i], corners[j]), self.hierarchy.faces) >= 0
+            split |= find_keys(edge_keys(corners[i], corners[j]), self.hierarchy.faces) >= 0
         inner = split | np.isin(corners, centres).any(axis=0)
         return facets[~inner]

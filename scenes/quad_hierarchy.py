@@ -32,13 +32,43 @@ def edge_keys(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.minimum(a, b) * KEY_BASE + np.maximum(a, b)
 
 
+def find_keys(keys: np.ndarray, table: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
+    """The value that ``table`` (sorted keys, values) holds for each key, -1 where none."""
+    sorted_keys, values = table
+    keys = np.asarray(keys, dtype=np.int64)
+    if sorted_keys.size == 0:
+        return np.full(keys.shape, -1, dtype=np.int64)
+    at = np.minimum(np.searchsorted(sorted_keys, keys), sorted_keys.size - 1)
+    return np.where(sorted_keys[at] == keys, values[at], -1)
+
+
+class LeafCells:
+    """What a hierarchy of cells (``cells``, ``first_child``) gives of its leaves: which
+    cells they are, and the vertices they use with the leaves renumbered on them."""
+
+    @property
+    def leaves(self) -> np.ndarray:
+        """The cells of the current mesh (in the order they were made)."""
+        return np.flatnonzero(self.first_child < 0)
+
+    def leaf_vertices(self) -> tuple[np.ndarray, np.ndarray]:
+        """The hierarchy's vertices the leaves use, and the leaves renumbered on them."""
+        return self._leaf_vertices
+
+    @functools.cached_property
+    def _leaf_vertices(self) -> tuple[np.ndarray, np.ndarray]:
+        leaves = self.cells[:, self.leaves]
+        used, local = np.unique(leaves, return_inverse=True)
+        return used, local.reshape(leaves.shape)
+
+
 def cell_edges(cells: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The four edges (v_k, v_k+1) of each cell: start and end vertices, each (4, n)."""
     return cells, np.roll(cells, -1, axis=0)
 
 
 @dataclass(frozen=True, eq=False)
-class QuadHierarchy:
+class QuadHierarchy(LeafCells):
     """Every cell ever made: ``cells`` (4, n) vertex numbers, ``parent`` (n,) (-1 for a root),
     ``first_child`` (n,) (-1 for a leaf; the children are first_child + 0..3), ``level`` (n,);
     ``split_keys`` (sorted) and ``split_midpoints`` say which edges are split, and at which
@@ -71,11 +101,6 @@ class QuadHierarchy:
         return cls(p, cells, np.full(n, -1), np.full(n, -1), np.zeros(n, dtype=np.int64),
                    np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64))
 
-    @property
-    def leaves(self) -> np.ndarray:
-        """The cells of the current mesh (in the order they were made)."""
-        return np.flatnonzero(self.first_child < 0)
-
     def mesh(self) -> MeshQuad:
         """The leaves as a scikit-fem mesh on the vertices they use (hanging nodes included;
         ``leaf_vertices`` maps its vertices back to the hierarchy's). Built once: the mesh
@@ -92,23 +117,9 @@ class QuadHierarchy:
         mesh._f2t = build_f2t(mesh._t2f, mesh._facets.shape[1])
         return mesh
 
-    def leaf_vertices(self) -> tuple[np.ndarray, np.ndarray]:
-        """The hierarchy's vertices the leaves use, and the leaves renumbered on them."""
-        return self._leaf_vertices
-
-    @functools.cached_property
-    def _leaf_vertices(self) -> tuple[np.ndarray, np.ndarray]:
-        leaves = self.cells[:, self.leaves]
-        used, local = np.unique(leaves, return_inverse=True)
-        return used, local.reshape(leaves.shape)
-
     def midpoints(self, keys: np.ndarray) -> np.ndarray:
         """The midpoint vertex of each edge key, -1 where the edge is not split."""
-        keys = np.asarray(keys, dtype=np.int64)
-        if self.split_keys.size == 0:
-            return np.full(keys.shape, -1, dtype=np.int64)
-        at = np.minimum(np.searchsorted(self.split_keys, keys), self.split_keys.size - 1)
-        return np.where(self.split_keys[at] == keys, self.split_midpoints[at], -1)
+        return find_keys(keys, (self.split_keys, self.split_midpoints))
 
     def refined(self, marked: np.ndarray | None = None) -> QuadHierarchy:
         """Split the marked leaves (positions in ``leaves``; None: all of them), then as many

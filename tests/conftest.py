@@ -86,6 +86,22 @@ def free_scene():
                         body_force=lambda x: np.array([0.0 * x[0], -1.0 + 0.0 * x[0]]))
 
 
+@pytest.fixture
+def pushed_cube():
+    """(-1,1)^3 clamped on top, pushed up by delta = 0.01 on the bottom, nu = 0:
+    u = (0, 0, delta (1 - z) / 2), pressure E delta / 2 = 5 on all 4 of Gamma_C (force 20),
+    energy 1/2 (E delta^2 / 4) |Omega| = 0.1; trilinear, so Q1 holds it."""
+    from scenes.budget import tensor_mesh
+
+    grid = np.linspace(-1.0, 1.0, 3)
+    return Scene(name="pushed-cube", description="flat push", mesh=tensor_mesh(grid, grid, grid),
+                 material=Material(1000.0, 0.0, "strain"),
+                 is_dirichlet=lambda x: np.abs(x[2] - 1) < 1e-10,
+                 is_contact=lambda x: np.abs(x[2] + 1) < 1e-10,
+                 gap=lambda x: np.full(x.shape[1:], -0.01),
+                 contact_coordinate=lambda x: np.asarray(x)[:2])
+
+
 @pytest.fixture(scope="session")
 def finished_run(tmp_path_factory):
     """A results folder of two finished sequences (free-boundary, vi and mixed, active set, up

@@ -12,30 +12,15 @@ from estimators.residual.hexahedra import cyclic_facets, face_geometry, face_pie
 from estimators.residual.quadrilaterals import QuadStress
 from formulations import get_formulation, solve
 from formulations.cells import family_for
-from scenes import Material, Scene, get_scene
-from scenes.budget import tensor_mesh
+from scenes import get_scene
 
 HEXAHEDRA = family_for("quad", 3)
-TOL = 1e-10
 
 
 def graded(scene):
     """Two leaves split, then one of their children: hanging edges and faces, some on
     Gamma_C."""
     return HEXAHEDRA.starting_mesh(scene).refined([0, 5]).refined([1])
-
-
-@pytest.fixture(scope="module")
-def pushed_cube():
-    """(-1,1)^3 clamped on top, pushed up by 0.01 on the bottom, nu = 0: a trilinear
-    solution (tests/formulations/cells/test_hexahedra.py)."""
-    grid = np.linspace(-1.0, 1.0, 3)
-    return Scene(name="pushed-cube", description="flat push", mesh=tensor_mesh(grid, grid, grid),
-                 material=Material(1000.0, 0.0, "strain"),
-                 is_dirichlet=lambda x: np.abs(x[2] - 1) < TOL,
-                 is_contact=lambda x: np.abs(x[2] + 1) < TOL,
-                 gap=lambda x: np.full(x.shape[1:], -0.01),
-                 contact_coordinate=lambda x: np.asarray(x)[:2])
 
 
 @pytest.mark.parametrize("estimator, formulation", [

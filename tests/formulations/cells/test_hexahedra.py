@@ -15,25 +15,9 @@ from bench.sequence.loop import LoopConfig, run_sequence
 from bench.truth import truth_for
 from formulations import get_formulation, solve
 from formulations.cells import family_for
-from scenes import Material, Scene, get_scene
-from scenes.budget import tensor_mesh
+from scenes import get_scene
 
-TOL = 1e-10
 HEXAHEDRA = family_for("quad", 3)
-
-
-@pytest.fixture
-def pushed_cube():
-    """(-1,1)^3 clamped on top, pushed up by delta = 0.01 on the bottom, nu = 0:
-    u = (0, 0, delta (1 - z) / 2), pressure E delta / 2 = 5 on all 4 of Gamma_C (force 20),
-    energy 1/2 (E delta^2 / 4) |Omega| = 0.1; trilinear, so Q1 holds it."""
-    grid = np.linspace(-1.0, 1.0, 3)
-    return Scene(name="pushed-cube", description="flat push", mesh=tensor_mesh(grid, grid, grid),
-                 material=Material(1000.0, 0.0, "strain"),
-                 is_dirichlet=lambda x: np.abs(x[2] - 1) < TOL,
-                 is_contact=lambda x: np.abs(x[2] + 1) < TOL,
-                 gap=lambda x: np.full(x.shape[1:], -0.01),
-                 contact_coordinate=lambda x: np.asarray(x)[:2])
 
 
 @pytest.mark.parametrize("formulation", ["vi", "nitsche"])
