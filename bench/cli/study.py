@@ -35,10 +35,10 @@ def add_study_parser(sub, study_file: StudyFile | None = None) -> None:
                             "(Q1, Q2 with --order 2, on hierarchical quadrilateral meshes with "
                             "hanging nodes, vi and the mixed method with lambda_H one and two "
                             "levels coarser, the residual estimator), run by the matrix, with "
-                            "the seed's Fig. 1 and Fig. 2 in the report; hex: [cells.hex], Q1 on "
-                            "the hexahedra of a 3D scene's grid of cubes, uniform and adaptive "
-                            "with hanging nodes, every formulation with a contact space on "
-                            "quadrilateral faces")
+                            "the seed's Fig. 1 and Fig. 2 in the report; hex: [cells.hex], Q1 (Q2 "
+                            "with --order 2) on the hexahedra of a 3D scene's grid of cubes, "
+                            "uniform and adaptive with hanging nodes, every formulation with a "
+                            "contact space on quadrilateral faces, averaging and residual")
     study.add_argument("--quick", action="store_true",
                        help=f"the reduced study of the default tests ([quick] of study.toml): "
                             f"{','.join(QUICK.scenes)}, uniform to {QUICK.uniform_max_dofs} and "
