@@ -176,9 +176,27 @@ class SolverDiagnostics:
     condensed: np.ndarray | None = None  # B K^-1 B' when the solver formed it (pardiso, cholmod)
     phases: tuple[tuple[str, float], ...] = ()  # (phase, seconds) of the solve, in order
     krylov_iterations: tuple[int, ...] = ()  # per linear solve, on an iterative back-end
+    # the adaptive stopping rule ended the iteration before the fixed tolerances would have
+    # (formulations.solvers.stopping)
+    stopped_early: bool = False
+    # the last linear step's algebraic residual (an iterative back-end's Newton steps on a
+    # system; None where the step was solved directly)
+    algebraic_residual: np.ndarray | None = None
     # the final sets of a box-constrained solve (solvers.box: -1 at the lower bound, 0 free, 1
     # at the upper; normal rows, then tangential), the next Coulomb step's start
     sets: np.ndarray | None = None
+
+
+@dataclass(frozen=True)
+class IterateComponents:
+    """The iteration's part of the error of a returned iterate (docs/theory.md, 18.1):
+    eta_alg (the algebraic residual) and eta_lin (the linearisation residual) as loads of the
+    guaranteed bound, NaN where they were not measured; the stopping rule that ended it."""
+
+    eta_alg: float = float("nan")
+    eta_lin: float = float("nan")
+    rule: str = "fixed"
+    stopped_early: bool = False
 
 
 @dataclass(frozen=True, eq=False)
@@ -242,6 +260,7 @@ class DiscreteSolution:
     diagnostics: SolverDiagnostics = field(default_factory=SolverDiagnostics)
     friction: FrictionState | None = None  # with a friction law
     consistency: ConsistencyTerm | None = None  # Nitsche (theta != 0)
+    components: IterateComponents = field(default_factory=IterateComponents)
 
     @property
     def ok(self) -> bool:

@@ -20,6 +20,13 @@ from formulations.elasticity import Elasticity
 from formulations.kkt import final_status, qp_residuals
 from formulations.semismooth import SemismoothSystem
 from formulations.solvers.registry import SOLVERS, SYSTEM_SOLVERS
+from formulations.solvers.stopping import (
+    FIXED_STOPPING,
+    Stopping,
+    qp_components,
+    stopped_status,
+    system_components,
+)
 
 
 @dataclass(frozen=True, eq=False)
@@ -146,19 +153,27 @@ def qp_safeguard(discretisation: Discretisation, solver: str, options: dict,
             "the QP method", answer.diagnostics.safeguard))))), None
 
 
-def solve(discretisation: Discretisation, solver: str, **options) -> DiscreteSolution:
+def solve(discretisation: Discretisation, solver: str, stopping: Stopping = FIXED_STOPPING,
+          **options) -> DiscreteSolution:
     """Solve with the named solver, compute the residuals (KKT for a QP, the nonlinear
     residual for a system) from the returned arrays, and give the final status. A failed
     solve carries status ``failed`` and NaN arrays (never silently). A semismooth system whose
     Newton iteration fails is solved as the formulation's QP where it has one (the same
-    problem; that method has its own safeguards, the reference solver last)."""
+    problem; that method has its own safeguards, the reference solver last). ``stopping``
+    goes to a solver that takes one (``meta["stopping"]``); the iterate's error components
+    under it are measured here (``formulations.solvers.stopping``)."""
     why = why_unsolvable(discretisation, solver)
     if why is not None:
         raise ValueError(why)
     system = discretisation.system if uses_system(discretisation, solver) else None
+    registry = SYSTEM_SOLVERS if system is not None else SOLVERS
+    if registry.meta(solver, "stopping"):
+        options["stopping"] = stopping
     answer = SYSTEM_SOLVERS.get(solver)(system, **options) if system is not None else None
     if answer is not None and answer.status == STATUS_FAILED \
             and discretisation.qp is not None and solver in SOLVERS.names():
+        if not SOLVERS.meta(solver, "stopping"):
+            options.pop("stopping", None)
         answer, system = qp_safeguard(discretisation, solver, options, answer)
     elif answer is None:
         answer = SOLVERS.get(solver)(discretisation.qp, **options)
@@ -175,4 +190,8 @@ def solve(discretisation: Discretisation, solver: str, **options) -> DiscreteSol
                      qp_residuals(discretisation.qp, answer.u, answer.multipliers,
                                   answer.tangential))
         status, reason = final_status(answer, residuals)
-    return discretisation.recover(answer, residuals, status, reason)
+    components = (system_components(system, answer, stopping) if system is not None
+                  else qp_components(discretisation.qp, answer, stopping))
+    status, reason = stopped_status(answer, components, stopping, status, reason)
+    return replace(discretisation.recover(answer, residuals, status, reason),
+                   components=components)

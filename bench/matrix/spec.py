@@ -11,7 +11,8 @@ import itertools
 import json
 from dataclasses import dataclass, fields, replace
 
-from bench.sequence.loop import LoopConfig, memory_refusal
+from bench.sequence.loop import LoopConfig
+from bench.sequence.memory import memory_refusal
 from formulations import get_formulation
 from formulations.cells import DEFAULT_CELL, family_for
 from formulations.elasticity import why_no_element

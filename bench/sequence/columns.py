@@ -4,6 +4,7 @@ reference solver (docs/theory.md, section 7)."""
 
 from __future__ import annotations
 
+import math
 import time
 
 from bench.measure.contact import zone_error
@@ -29,6 +30,12 @@ def error_columns(truth, solution, estimate) -> dict:
                    / errors.energy_error)
     out["t_error"] = time.perf_counter() - start
     return out
+
+
+def total_effectivity(numbers: dict) -> dict:
+    """eta_total / error of a level's columns (NaN without both)."""
+    error, total = numbers.get("energy_error", math.nan), numbers.get("eta_total", math.nan)
+    return {"effectivity_total": total / error if error > 0 else math.nan}
 
 
 def friction_columns(scene, solution) -> dict:

@@ -16,9 +16,16 @@ from bench.sequence.columns import (
     error_columns,
     friction_columns,
     solver_columns,
+    total_effectivity,
 )
+from bench.sequence.components import Previous, component_columns, level_stopping
 from bench.sequence.marking import MARKINGS, check_marking, mark
-from bench.sequence.memory import MemoryRoute, available_gib, dense_block_route, memory_route
+from bench.sequence.memory import (
+    MemoryRoute,
+    dense_block_route,
+    level_memory,
+    level_refusal,
+)
 from bench.sequence.options import option
 from bench.sequence.rows import ResultRow, identity_columns
 from estimators.base import estimator_on
@@ -29,6 +36,13 @@ from formulations.discretisation import dense_block_size
 from formulations.elasticity import check_order, element_diameters
 from formulations.solvers.backends import backend_names, check_backend
 from formulations.solvers.registry import REFERENCE_SOLVER
+from formulations.solvers.stopping import (
+    GAMMA_ALG,
+    GAMMA_LIN,
+    STOPPING_RULES,
+    check_gamma,
+    check_stopping,
+)
 from scenes import Scene
 from scenes.base import is_integer, is_number
 
@@ -60,6 +74,19 @@ class LoopSettings:
         "multigrid with conjugate gradients, no factorisation)",
         flag="backend", kind="choice", section="how", choices=backend_names,
         default_text="the first of pardiso, cholmod, splu that is available")
+    stopping: str = option(
+        "fixed", "when the solvers stop: fixed (their own tolerances) or adaptive (when the "
+        "algebraic and linearisation error components fall below gamma-alg and gamma-lin "
+        "times the discretisation's; docs/theory.md, 18.3)", flag="stopping", kind="choice",
+        section="how", choices=lambda: list(STOPPING_RULES.names()))
+    gamma_alg: float = option(GAMMA_ALG, "adaptive stopping: the Krylov solve stops when "
+                              "eta_alg <= GAMMA (eta_disc + eta_lin), GAMMA in (0, 1)",
+                              flag="gamma-alg", kind="float>0", section="how",
+                              metavar="GAMMA")
+    gamma_lin: float = option(GAMMA_LIN, "adaptive stopping: the active-set (Newton) "
+                              "iteration stops when eta_lin <= GAMMA eta_disc, GAMMA in (0, 1)",
+                              flag="gamma-lin", kind="float>0", section="how",
+                              metavar="GAMMA")
     nested: bool = option(
         True, "solve every level from scratch instead of starting from the previous level's "
         "contact zone (nested iteration, the default)", flag="cold-start", kind="switch-off",
@@ -87,6 +114,9 @@ class LoopSettings:
             raise ValueError(f"max_memory_gib={self.max_memory_gib!r} is not a number > 0")
         if self.backend is not None:
             check_backend(self.backend)
+        check_stopping(self.stopping)
+        check_gamma("gamma_alg", self.gamma_alg)
+        check_gamma("gamma_lin", self.gamma_lin)
 
     def settings(self) -> dict:
         """The values of ``LoopSettings``' own fields (what a ``LoopConfig`` inherits)."""
@@ -165,33 +195,6 @@ def target_reason(config: LoopConfig, est) -> str | None:
     return f"target reached: guaranteed eta={est.eta:.4g} <= {config.target_error:g}"
 
 
-def level_memory(level: int, ndofs: int, solver: str, config: LoopConfig,
-                 dim: int = 2) -> MemoryRoute:
-    """The memory route of a level (``bench.sequence.memory.memory_route``) within
-    ``config.max_memory_gib``, or the memory available now."""
-    backend = check_backend(config.options().get("backend"))
-    limit = config.max_memory_gib if config.max_memory_gib is not None else available_gib()
-    return memory_route(level, ndofs, solver, backend, limit, config.order, dim)
-
-
-def memory_refusal(level: int, ndofs: int, solver: str, config: LoopConfig,
-                   dim: int = 2) -> str | None:
-    """Why a level of ``ndofs`` unknowns must not be built (its predicted peak memory does not
-    fit on any back-end), or None."""
-    return level_memory(level, ndofs, solver, config, dim).refusal
-
-
-def level_refusal(level: int, ndofs: int, config: LoopConfig,
-                  route: MemoryRoute) -> tuple[str, str] | None:
-    """Why a level of ``ndofs`` unknowns is not built, as (end of the sequence, the failed
-    row's reason, '' for none), or None: over the DOF budget (a failed row only for the
-    starting mesh) or over the memory (``route``, from ``level_memory``)."""
-    if ndofs > config.max_dofs:
-        return "budget", (f"budget: the starting mesh has {ndofs} DOFs, over max_dofs="
-                          f"{config.max_dofs}" if level == 0 else "")
-    return None if route.refusal is None else ("memory", route.refusal)
-
-
 def level_options(level: int, disc, solver: str, config: LoopConfig, route: MemoryRoute,
                   previous) -> tuple[dict, MemoryRoute]:
     """The solve's options on the level's ``route``, moved to an iterative back-end if the
@@ -226,7 +229,7 @@ def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
     ident = identity_columns(scene.name, formulation, solver, estimator, config, identity,
                              scene.dim)
     mesh = family.starting_mesh(scene) if mesh is None else mesh
-    t_refine, previous = 0.0, None
+    t_refine, previous, predicted = 0.0, None, None
     for level in range(config.max_levels):
         ndofs = family.count_free_dofs(scene, mesh, config.order)  # before any assembly
         # decided once, before the assembly: the prediction includes the assembly's memory,
@@ -246,7 +249,8 @@ def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
         disc = discretise(scene, mesh)
         t_assemble = time.perf_counter() - start
         options, route = level_options(level, disc, solver, config, route, previous)
-        sol = previous = solve(disc, solver, **options)
+        stopping = level_stopping(scene, disc, config, estimator, predicted)
+        sol = previous = solve(disc, solver, stopping=stopping, **options)
         failed = sol.status == STATUS_FAILED
         start = time.perf_counter()
         est = None if failed else estimate(scene, sol)
@@ -260,9 +264,12 @@ def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
             numbers.update(friction_columns(scene, sol))
             numbers.update(eta=est.eta, eta_0=est.eta_0, eta_geometric=est.eta_geometric,
                            eta_complementarity=est.eta_complementarity,
-                           **(est.bound.columns() if est.bound is not None else {}))
+                           **(est.bound.columns() if est.bound is not None else {}),
+                           **component_columns(sol, est))
+            predicted = Previous(numbers["eta_disc"], disc.ndofs)
             if truth is not None:
                 numbers.update(error_columns(truth, sol, est))
+                numbers.update(total_effectivity(numbers))
             if solver != REFERENCE_SOLVER and disc.ndofs <= crosscheck_dofs:
                 numbers.update(crosscheck_columns(disc, sol))
         reached = None if failed else target_reason(config, est)

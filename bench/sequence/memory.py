@@ -46,7 +46,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from formulations.solvers.backends import DENSE_COPIES
+from formulations.solvers.backends import DENSE_COPIES, check_backend
 from formulations.solvers.backends.base import REGISTRY as BACKENDS
 from formulations.solvers.registry import REFERENCE_SOLVER
 
@@ -182,3 +182,30 @@ def available_gib(meminfo: str | Path = "/proc/meminfo") -> float:
         return float("inf")
     gib = kib / 2**20
     return max(gib - max(MARGIN * gib, MIN_MARGIN_GIB), 0.0)
+
+
+def level_memory(level: int, ndofs: int, solver: str, config,
+                 dim: int = 2) -> MemoryRoute:
+    """The memory route of a level (``bench.sequence.memory.memory_route``) within
+    ``config.max_memory_gib``, or the memory available now."""
+    backend = check_backend(config.options().get("backend"))
+    limit = config.max_memory_gib if config.max_memory_gib is not None else available_gib()
+    return memory_route(level, ndofs, solver, backend, limit, config.order, dim)
+
+
+def memory_refusal(level: int, ndofs: int, solver: str, config,
+                   dim: int = 2) -> str | None:
+    """Why a level of ``ndofs`` unknowns must not be built (its predicted peak memory does not
+    fit on any back-end), or None."""
+    return level_memory(level, ndofs, solver, config, dim).refusal
+
+
+def level_refusal(level: int, ndofs: int, config,
+                  route: MemoryRoute) -> tuple[str, str] | None:
+    """Why a level of ``ndofs`` unknowns is not built, as (end of the sequence, the failed
+    row's reason, '' for none), or None: over the DOF budget (a failed row only for the
+    starting mesh) or over the memory (``route``, from ``level_memory``)."""
+    if ndofs > config.max_dofs:
+        return "budget", (f"budget: the starting mesh has {ndofs} DOFs, over max_dofs="
+                          f"{config.max_dofs}" if level == 0 else "")
+    return None if route.refusal is None else ("memory", route.refusal)

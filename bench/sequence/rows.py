@@ -86,6 +86,16 @@ class ResultRow:
     inf_sup: float = math.nan
     pressure_oscillation: float = math.nan
     t_diagnostics: float = math.nan
+    # the iterate's error components and the work of its solve (docs/theory.md, section 18)
+    eta_disc: float = math.nan
+    eta_lin: float = math.nan
+    eta_alg: float = math.nan
+    eta_total: float = math.nan
+    effectivity_total: float = math.nan
+    stopping: str = ""  # the stopping rule of the solve: fixed or adaptive
+    stopped_early: bool = False  # the adaptive rule ended it before the fixed tolerances
+    newton_steps: int = 0
+    krylov_iterations: int = 0
     scene_parameters: str = ""  # a sweep's scene parameters, "name=value:name=value"
     formulation_options: str = ""  # a sweep's formulation options, the same way
     sequence_key: str = ""  # hash of everything that determines the sequence

@@ -54,6 +54,7 @@ from formulations.solvers.lcp import CYCLING_EXAMPLE, condition_1, least_index_p
 from formulations.solvers.projected import solve_projected
 from formulations.solvers.reference import solve_reference
 from formulations.solvers.registry import FAST_SOLVER, register_solver
+from formulations.solvers.stopping import FIXED_STOPPING, QPLinearisation, Stopping
 
 
 def _fallback(qp: ContactQP, why: str, diagnostics: SolverDiagnostics,
@@ -82,12 +83,14 @@ def dense_block_size(qp: ContactQP, backend: str | None = None) -> int:
                               "B K^-1 B' from one factorisation (pardiso, cholmod), the "
                               "augmented saddle-point system (splu) or projected CG with "
                               "multigrid (amg); nested iteration",
-                 meta={"dense_block_size": dense_block_size})
+                 meta={"dense_block_size": dense_block_size, "stopping": True})
 def solve_active_set(qp: ContactQP, warm_start: np.ndarray | None = None,
-                     max_iter: int = 100, backend: str | None = None) -> QPSolution:
+                     max_iter: int = 100, backend: str | None = None,
+                     stopping: Stopping = FIXED_STOPPING) -> QPSolution:
     """``backend``: 'pardiso' or 'cholmod' (condensed iteration), 'splu' (augmented
     iteration, see ``augmented``) or 'amg' (projected CG, see ``projected``); default: the
-    fastest available, see ``backends``."""
+    fastest available, see ``backends``. ``stopping``: when to stop (``stopping``; adaptive
+    on the frictionless condensed and projected routes)."""
     start = time.perf_counter()
     backend = check_backend(backend)
     if warm_start is not None and np.shape(warm_start) != (qp.m,):
@@ -101,7 +104,7 @@ def solve_active_set(qp: ContactQP, warm_start: np.ndarray | None = None,
         active = (np.asarray(warm_start) > 0) if warm_start is not None else \
             initial_active_set(qp, backend)
         u, lam, iterations, status, reason, diagnostics = (
-            solve_projected(qp, active, max_iter, backend) if iterative(backend)
+            solve_projected(qp, active, max_iter, backend, stopping) if iterative(backend)
             else solve_augmented(qp, active, max_iter))
         if status != STATUS_OK:
             return _fallback(qp, f"plain active set failed ({reason})", diagnostics, start)
@@ -116,9 +119,10 @@ def solve_active_set(qp: ContactQP, warm_start: np.ndarray | None = None,
     phases = [*factor.phases, ("condense", time.perf_counter() - clock)]
     clock = time.perf_counter()
     active = (np.asarray(warm_start) > 0) if warm_start is not None else (r > 0)
-    result = pdas(S, r, active, max_iter)
+    result = pdas(S, r, active, max_iter, settled(qp, stopping))
     diagnostics = SolverDiagnostics(active_set_changes=tuple(result.changes),
-                                    cycled=result.cycled)
+                                    cycled=result.cycled,
+                                    stopped_early=bool(result.changes and result.changes[-1]))
     reason, iterations = "", result.iterations
     if result.status != STATUS_OK:
         reason = f"plain active set failed ({result.reason})"
@@ -144,6 +148,16 @@ def solve_active_set(qp: ContactQP, warm_start: np.ndarray | None = None,
     return QPSolution(u=u, multipliers=result.lam, status=STATUS_OK, reason=reason,
                       iterations=iterations, solve_time=time.perf_counter() - start,
                       solver=FAST_SOLVER, backend=factor.backend, diagnostics=diagnostics)
+
+
+def settled(qp: ContactQP, stopping: Stopping):
+    """The condensed iteration's early end under an adaptive ``stopping`` (None: fixed): its
+    slack y = G - B u and multipliers give eta_lin without a back-substitution."""
+    if not stopping.adaptive:
+        return None
+    linearisation = QPLinearisation(qp.K, qp.B, qp.G)
+    return lambda lam, y: stopping.newton_done(
+        linearisation.measure(-y, lam, stopping.load_norm))
 
 
 def cycling_qp() -> ContactQP:

@@ -69,8 +69,10 @@ def _solve_active(S, r, active):
     return lam, S @ lam - r
 
 
-def pdas(S: np.ndarray, r: np.ndarray, active: np.ndarray, max_iter: int) -> LCPResult:
-    """Primal-dual active sets from the initial ``active`` set."""
+def pdas(S: np.ndarray, r: np.ndarray, active: np.ndarray, max_iter: int,
+         settled=None) -> LCPResult:
+    """Primal-dual active sets from the initial ``active`` set; ``settled(lam, y)`` (optional,
+    a stopping rule's) ends the iteration at an iterate whose set still changes."""
     m = r.size
     c = 1.0 / max(float(np.mean(np.diag(S))), np.finfo(float).tiny) if m else 1.0
     seen, changes = set(), []
@@ -88,7 +90,7 @@ def pdas(S: np.ndarray, r: np.ndarray, active: np.ndarray, max_iter: int) -> LCP
                              active)
         new_active = lam - c * y > 0
         changes.append(int((new_active != active).sum()))
-        if changes[-1] == 0:
+        if changes[-1] == 0 or (settled is not None and settled(lam, y)):
             return LCPResult(lam, iteration, STATUS_OK, "", tuple(changes), False, active)
         active = new_active
     return LCPResult(lam, max_iter, STATUS_FAILED,

@@ -42,6 +42,9 @@ class Linearised:
     krylov: list[int] = field(default_factory=list)  # iterations per step (iterative back-end)
     # switch inexact steps to exact ones; True if they were inexact (the iteration goes on)
     tighten: Callable[[], bool] = lambda: False
+    # an adaptive stopping rule's end at an iterate whose active set still changes
+    settled: Callable[[np.ndarray], bool] = lambda x: False
+    adaptive: object | None = None  # what keeps the stopping rule's state (its own module's)
 
 
 def newton(problem: Linearised, x: np.ndarray, active: np.ndarray,
@@ -57,6 +60,9 @@ def newton(problem: Linearised, x: np.ndarray, active: np.ndarray,
         x = x + dx
         new = problem.argument(x) < 0
         changes.append(int((new != active).sum()))
+        if changes[-1] != 0 and problem.settled(x):
+            return NewtonResult(x, STATUS_OK, "", iteration, tuple(changes), False, "",
+                                condition)
         if changes[-1] == 0 and problem.tighten():  # settled inexactly: now solve exactly
             seen = {active.tobytes()}
             continue

@@ -21,6 +21,8 @@ whose multiplier is zero to that accuracy keeps its place (no flip-flop on weakl
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 from scipy import sparse
 from scipy.sparse.linalg import splu
@@ -30,6 +32,7 @@ from formulations.solvers.augmented import VIOLATION_TOLERANCE
 from formulations.solvers.backends import FactorisationError, factorise
 from formulations.solvers.backends.amg import MAX_ITERATIONS, RTOL
 from formulations.solvers.lcp import SINGULAR
+from formulations.solvers.stopping import FIXED_STOPPING, QPLinearisation, Stopping
 
 WEAKLY_ACTIVE = 1e-8  # |lambda_i| / max |lambda| below which a multiplier is zero (solve accuracy)
 # CG's relative residual while the active set is still changing: the set a step predicts
@@ -38,6 +41,9 @@ WEAKLY_ACTIVE = 1e-8  # |lambda_i| / max |lambda| below which a multiplier is ze
 # 120 / 99 / - at 104 544, 178 / 143 / 157 at 545 832, the same sets with 1e-4 and 1e-3;
 # with 1e-2 the set that looked settled changed again once solved exactly
 SEARCH_RTOL = 1e-3
+# CG solves of one set under the adaptive rule: its eta_alg criterion uses eta_lin, which the
+# solve itself changes; re-solved while eta_lin fell (twice at most was measured)
+RESOLVES = 4
 
 
 def projection(B_A: sparse.csr_matrix):
@@ -53,18 +59,21 @@ def projection(B_A: sparse.csr_matrix):
 
 
 def projected_cg(K, precondition, project, F: np.ndarray, u: np.ndarray, rtol: float,
-                 counts: list[int]) -> np.ndarray:
+                 counts: list[int], done=None) -> tuple[np.ndarray, str]:
     """min 1/2 u'Ku - F'u on the affine set of ``u`` (u + ker B_A) by preconditioned CG, to
-    the relative residual ``rtol``."""
+    the relative residual ``rtol`` or until ``done(r)`` (the stopping rule's, on the
+    residual r = F - K u - B_A' lambda_A); (u, "rule" if ``done`` stopped it, else
+    "tolerance")."""
     r = project(F - K @ u)
     # |F| + |K u|: the scale of the balance, also when the load is the obstacle's (F = 0)
     norm = np.linalg.norm(F) + np.linalg.norm(K @ u)
     z = project(precondition(r))
     p, rz = z.copy(), r @ z
     for iteration in range(1, MAX_ITERATIONS + 1):
-        if np.linalg.norm(r) <= rtol * norm:
+        met = done is not None and done(r)
+        if met or np.linalg.norm(r) <= rtol * norm:
             counts.append(iteration - 1)
-            return u
+            return u, "rule" if met else "tolerance"
         Kp = K @ p
         alpha = rz / (p @ Kp)
         u = u + alpha * p
@@ -93,20 +102,27 @@ def next_rows(qp: ContactQP, active: np.ndarray, u: np.ndarray, lam: np.ndarray)
     return np.where(active, lam > -zero, slack < -VIOLATION_TOLERANCE * scale)
 
 
-def solve_projected(qp: ContactQP, active: np.ndarray, max_iter: int, backend: str):
+def solve_projected(qp: ContactQP, active: np.ndarray, max_iter: int, backend: str,
+                    stopping: Stopping = FIXED_STOPPING):
     """(u, lambda, iterations, status, reason, diagnostics) as ``solve_augmented`` returns
     them; the diagnostics hold the CG iterations of every active set. While the set changes,
-    CG stops at SEARCH_RTOL; a set that stays is solved again to RTOL and checked again."""
+    CG stops at SEARCH_RTOL; a set that stays is solved again to RTOL and checked again.
+    An adaptive ``stopping`` also ends each CG solve by its eta_alg criterion and the
+    iteration at the first iterate whose eta_lin meets its criterion (docs/theory.md, 18.3)."""
     precondition = factorise(qp.K, backend, qp.near_null).preconditioner.matvec
     K = sparse.csr_matrix(qp.K)
     seen, changes, counts = set(), [], []
     u, lam, rtol = np.zeros(qp.n), np.zeros(qp.m), SEARCH_RTOL
+    linearisation, eta_lin = QPLinearisation(K, qp.B, qp.G), float("nan")
 
     def diagnostics(cycled):
         return SolverDiagnostics(active_set_changes=tuple(changes), cycled=cycled,
                                  krylov_iterations=tuple(counts))
 
     for iteration in range(1, max_iter + 1):
+        if (active.tobytes(), rtol) in seen and stopping.adaptive:
+            # the rule's inexact solves cycled between sets: go on with the fixed tolerances
+            stopping, rtol, seen = FIXED_STOPPING, RTOL, set()
         if (active.tobytes(), rtol) in seen:
             return (u, lam, iteration - 1, STATUS_FAILED, "active set cycles (a set repeated)",
                     diagnostics(True))
@@ -118,11 +134,30 @@ def solve_projected(qp: ContactQP, active: np.ndarray, max_iter: int, backend: s
             return u, lam, iteration, STATUS_FAILED, SINGULAR, diagnostics(False)
         u_p = particular(qp.G[rows])
         if not np.any(qp.F) and not np.any(u_p):  # no load, no gap to close: u = 0 exactly
-            u, counts = np.zeros(qp.n), counts + [0]
+            u, counts, solved, how = np.zeros(qp.n), counts + [0], True, "tolerance"
         else:  # the last u, moved onto the new set
-            u = projected_cg(K, precondition, project, qp.F, project(u) + u_p, rtol, counts)
+            u = project(u) + u_p
+            for _ in range(RESOLVES):  # until the rule holds with the new iterate's eta_lin
+                done = (lambda r, e=eta_lin: stopping.krylov_done(r, e)) \
+                    if stopping.adaptive else None
+                u, how = projected_cg(K, precondition, project, qp.F, u, rtol, counts, done)
+                lam, new_active = next_active_set(qp, active, u, K, multipliers)
+                if not stopping.adaptive:
+                    break
+                was, eta_lin = eta_lin, linearisation(u, lam, stopping.load_norm)
+                if how != "rule" or not eta_lin < was:
+                    break
+            solved = how == "rule" or rtol <= RTOL
         lam, new_active = next_active_set(qp, active, u, K, multipliers)
         changes.append(int((new_active != active).sum()))
+        if stopping.adaptive:
+            eta_lin = linearisation(u, lam, stopping.load_norm)
+            if solved and (changes[-1] == 0 or stopping.newton_done(eta_lin)):
+                if changes[-1] == 0:  # as below: the zero-to-accuracy ones exactly zero
+                    lam[rows] = np.maximum(lam[rows], 0.0)
+                return (u, lam, iteration, STATUS_OK, "",
+                        replace(diagnostics(False),
+                                stopped_early=changes[-1] != 0 or how == "rule"))
         if changes[-1] == 0 and rtol == RTOL:
             lam[rows] = np.maximum(lam[rows], 0.0)  # the zero-to-accuracy ones: exactly zero
             return u, lam, iteration, STATUS_OK, "", diagnostics(False)

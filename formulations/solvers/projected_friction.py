@@ -158,8 +158,8 @@ def solve_projected_tresca(qp: ContactQP, precondition, previous: QPSolution | N
         T = qp.friction.T
         F, J = qp.F - T.T @ force, (K + T.T @ springs @ T).tocsr()
         try:
-            u = projected_cg(J, precondition, project, F, project(u) + particular(rhs), rtol,
-                             counts)
+            u, _ = projected_cg(J, precondition, project, F, project(u) + particular(rhs),
+                                rtol, counts)
         except FactorisationError as error:
             return answer(STATUS_FAILED, str(error), iteration)
         lam_A = multipliers(F - J @ u)

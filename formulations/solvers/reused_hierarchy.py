@@ -61,9 +61,10 @@ class ReusedHierarchy:
     changed: int = -1
     failures: int = 0  # attempts in a row that ran out of budget
     iterations: list[int] = field(default_factory=list)
+    by_rule: bool = False  # a stopping rule ended the last solve
 
     def __call__(self, J: sparse.spmatrix, rhs: np.ndarray, rtol: float | None,
-                 active: np.ndarray | None = None) -> np.ndarray:
+                 active: np.ndarray | None = None, done=None) -> np.ndarray:
         self.changed = (-1 if active is None or self.held_active is None
                         or active.shape != self.held_active.shape
                         else int(np.count_nonzero(active != self.held_active)))
@@ -74,11 +75,12 @@ class ReusedHierarchy:
             if (self.failures < GIVE_UP and self.reused_per_digit * digits <= budget
                     and self.changed <= CHANGED_PER_ITERATION * budget):
                 reused = self.held.for_matrix(J, budget)
-                dx = self._attempt(reused, rhs, rtol)
+                dx = self._attempt(reused, rhs, rtol, done)
                 if reused.symmetric and reused.iterations:
                     self.reused_per_digit = reused.iterations[-1] / digits
                 if dx is not None:
                     self.failures = 0
+                    self.by_rule = bool(reused.by_rule and reused.by_rule[-1])
                     return dx
                 self.failures += reused.symmetric
         start = time.perf_counter()
@@ -86,7 +88,8 @@ class ReusedHierarchy:
         self.held_active = None if active is None else np.array(active, copy=True)
         built = time.perf_counter()
         self.setups += 1
-        dx = self.held(rhs, rtol=rtol)
+        dx = self.held(rhs, rtol=rtol, done=done)
+        self.by_rule = bool(self.held.by_rule and self.held.by_rule[-1])
         self.own_iterations = self.held.iterations[-1] if self.held.iterations else 0
         per_iteration = (time.perf_counter() - built) / max(self.own_iterations, 1)
         self.setup_iterations = (built - start) / max(per_iteration, 1e-9)
@@ -95,12 +98,13 @@ class ReusedHierarchy:
         self.iterations.extend(self.held.iterations)
         return dx
 
-    def _attempt(self, reused, rhs: np.ndarray, rtol: float | None) -> np.ndarray | None:
+    def _attempt(self, reused, rhs: np.ndarray, rtol: float | None,
+                 done=None) -> np.ndarray | None:
         """The reused hierarchy's answer, or None (not symmetric, or over budget)."""
         if not reused.symmetric:
             return None
         try:
-            return reused(rhs, rtol=rtol)
+            return reused(rhs, rtol=rtol, done=done)
         except FactorisationError:
             return None
         finally:

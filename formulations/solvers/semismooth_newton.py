@@ -53,6 +53,7 @@ from formulations.solvers.newton import Linearised, newton
 from formulations.solvers.registry import FAST_SOLVER, register_system_solver
 from formulations.solvers.reused_factorisation import ReusedFactorisation
 from formulations.solvers.reused_hierarchy import ReusedHierarchy
+from formulations.solvers.stopping import FIXED_STOPPING, Stopping
 
 # relative nonlinear residual at which iterative refinement stops (one step reaches 1e-13 ..
 # 3e-12 from the ~1e-9 the partial factorisation leaves, measured to 5e5 DOFs)
@@ -147,20 +148,24 @@ def condensed_problem(G: np.ndarray, P0: np.ndarray) -> Linearised:
                       lambda m: np.linalg.norm(P0) + np.linalg.norm(G @ m))
 
 
-def sparse_problem(system: SemismoothSystem, backend: str | None = None) -> Linearised:
+def sparse_problem(system: SemismoothSystem, backend: str | None = None,
+                   stopping: Stopping = FIXED_STOPPING) -> Linearised:
     """Newton on u with the full sparse Jacobian K + T' D_A T, factorised once a step: by the
     back-end ``backend`` (an SPD Jacobian: a system without S; or an iterative back-end,
     which takes any Jacobian), else by SuperLU. An iterative back-end's Krylov iterations of
-    every step are appended to ``krylov``."""
+    every step are appended to ``krylov``; under an adaptive ``stopping`` its CG solves end
+    by the rule's eta_alg criterion and the iteration by its eta_lin one (``AdaptiveSteps``)."""
     T = system.T
     krylov: list[int] = []
     direct = ReusedFactorisation(backend) if backend is not None else None
     hierarchy = ReusedHierarchy(backend, system.near_null) if iterative(backend) else None
+    steps = AdaptiveSteps(system, stopping)
     rtol = [SEARCH_RTOL if iterative(backend) else 0.0]  # an iterative back-end's, per step
 
     def tighten() -> bool:
-        """Solve to the back-end's own tolerance from now on; True if it was looser."""
-        looser, rtol[0] = rtol[0] == SEARCH_RTOL, None
+        """Solve to the back-end's own tolerance from now on; True if it was looser and the
+        stopping rule did not end the last solve."""
+        looser, rtol[0] = rtol[0] == SEARCH_RTOL and not steps.by_rule, None
         return looser
 
     def step(active, u):
@@ -170,16 +175,44 @@ def sparse_problem(system: SemismoothSystem, backend: str | None = None) -> Line
             if not np.any(system.F - T.T @ system.phi_affine(active)[1]):
                 return -u, float("nan")  # no load, no contact: u = 0 exactly, not round-off
             done = len(hierarchy.iterations)
-            dx = hierarchy(J, rhs, rtol[0], active)
+            dx = hierarchy(J, rhs, rtol[0], active, steps.krylov_rule())
             krylov.extend(hierarchy.iterations[done:])
+            steps.record(J @ dx - rhs, hierarchy.by_rule)
             return dx, float("nan")
+        steps.record(np.zeros_like(rhs), True)  # a direct solve: no algebraic residual
         if direct is not None:  # SPD: reuse an earlier factorisation (reused_factorisation)
             return direct(J, active, rhs), float("nan")
         return splu(J.tocsc()).solve(rhs), float("nan")
 
     return Linearised(system.residual, lambda u: system.pressure_argument(T @ u), step,
                       lambda u: np.linalg.norm(system.F) + np.linalg.norm(system.K @ u),
-                      krylov, tighten)
+                      krylov, tighten, steps.settled, steps)
+
+
+@dataclass(eq=False)
+class AdaptiveSteps:
+    """The adaptive stopping rule on Newton steps solved by CG (docs/theory.md, 18.3): each
+    step's algebraic residual a = J dx - rhs, and eta_lin = C_F ||rho(R(u) - a)||."""
+
+    system: SemismoothSystem
+    stopping: Stopping
+    algebraic: np.ndarray | None = None
+    by_rule: bool = False
+    eta_lin: float = float("nan")
+
+    def krylov_rule(self):
+        if not self.stopping.adaptive:
+            return None
+        return lambda r, e=self.eta_lin: self.stopping.krylov_done(r, e)
+
+    def record(self, algebraic: np.ndarray, by_rule: bool) -> None:
+        self.algebraic, self.by_rule = algebraic, by_rule
+
+    def settled(self, u: np.ndarray) -> bool:
+        if not self.stopping.adaptive or self.algebraic is None:
+            return False
+        self.eta_lin = self.stopping.algebraic(self.system.residual(u) - self.algebraic)
+        return self.by_rule and self.stopping.newton_done(self.eta_lin)
 
 
 def dense_block_size(system: SemismoothSystem, backend: str | None = None) -> int:
@@ -192,28 +225,35 @@ def dense_block_size(system: SemismoothSystem, backend: str | None = None) -> in
 
 @register_system_solver(FAST_SOLVER, "semismooth Newton (primal-dual active set) on the "
                                       "contact values, condensed from one factorisation",
-                        meta={"dense_block_size": dense_block_size})
+                        meta={"dense_block_size": dense_block_size, "stopping": True})
 def solve_semismooth(system: SemismoothSystem, warm_start: np.ndarray | None = None,
-                     max_iter: int = 50, backend: str | None = None) -> QPSolution:
-    """``warm_start``: a pressure per quadrature point (> 0 where active)."""
+                     max_iter: int = 50, backend: str | None = None,
+                     stopping: Stopping = FIXED_STOPPING) -> QPSolution:
+    """``warm_start``: a pressure per quadrature point (> 0 where active); ``stopping``: when
+    to stop (adaptive on the sparse-step routes; the condensed route stops when its active
+    set settles)."""
     start = time.perf_counter()
     backend = check_backend(backend)
     if warm_start is not None and np.shape(warm_start) != (system.nq,):
         raise ValueError(f"warm_start has shape {np.shape(warm_start)}, not ({system.nq},)")
     condensed, steps_on = newton_route(system, backend)
     try:
-        u, result, phases, krylov = run_newton(system, warm_start, max_iter, backend,
-                                               condensed, steps_on)
+        u, result, phases, krylov, steps = run_newton(system, warm_start, max_iter, backend,
+                                                      condensed, steps_on, stopping)
     except FactorisationError:  # a Jacobian with S that is not positive definite
         if condensed or not system.ns or iterative(backend) or not condenses(backend):
             raise
-        u, result, phases, krylov = run_newton(system, warm_start, max_iter, backend, True,
-                                               None)
+        u, result, phases, krylov, steps = run_newton(system, warm_start, max_iter, backend,
+                                                      True, None, stopping)
     ok = result.status == STATUS_OK
+    early = steps is not None and steps.stopping.adaptive and not result.safeguard and bool(
+        result.changes and (result.changes[-1] != 0 or steps.by_rule and iterative(backend)))
     diagnostics = SolverDiagnostics(active_set_changes=result.changes, cycled=result.cycled,
                                     safeguard=result.safeguard,
                                     condition_estimate=result.condition, phases=tuple(phases),
-                                    krylov_iterations=tuple(krylov))
+                                    krylov_iterations=tuple(krylov), stopped_early=early,
+                                    algebraic_residual=None if steps is None or not
+                                    iterative(backend) else steps.algebraic)
     return QPSolution(u=u if ok else None, multipliers=system.pressure(u) if ok else None,
                       status=result.status, reason=result.reason, iterations=result.iterations,
                       solve_time=time.perf_counter() - start, solver=FAST_SOLVER,
@@ -236,8 +276,9 @@ def newton_route(system: SemismoothSystem, backend: str) -> tuple[bool, str | No
 
 
 def run_newton(system: SemismoothSystem, warm_start, max_iter: int, backend: str,
-               condensed: bool, steps_on: str | None):
-    """(u, NewtonResult, phases, Krylov iterations) on the route ``newton_route`` chose."""
+               condensed: bool, steps_on: str | None, stopping: Stopping = FIXED_STOPPING):
+    """(u, NewtonResult, phases, Krylov iterations, the stopping rule's state or None) on the
+    route ``newton_route`` chose."""
     T = system.T
     if condensed:
         factor = factorise_condensed(system.K, np.unique(T.indices), backend)
@@ -249,7 +290,7 @@ def run_newton(system: SemismoothSystem, warm_start, max_iter: int, backend: str
         problem, x = condensed_problem(reduced.G, P0), np.zeros(system.nq)
     else:
         phases, x = [], np.zeros(system.n)
-        problem = sparse_problem(system, steps_on)
+        problem = sparse_problem(system, steps_on, stopping)
     active = (np.asarray(warm_start) > 0) if warm_start is not None else \
         problem.argument(x) < 0
     clock = time.perf_counter()
@@ -261,7 +302,7 @@ def run_newton(system: SemismoothSystem, warm_start, max_iter: int, backend: str
         u = refine(system, factor.solve, reduced,
                    u0 - factor.solve(T.T @ reduced.phi(s_free, result.x)))
         phases.append(("back-substitute", time.perf_counter() - clock))
-    return u, result, phases, problem.krylov
+    return u, result, phases, problem.krylov, problem.adaptive
 
 
 def refine(system: SemismoothSystem, solve: Callable, reduced: ReducedPressure, u: np.ndarray,

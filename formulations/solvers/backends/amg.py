@@ -59,6 +59,7 @@ class IterativeSolve:
     symmetric: bool
     iterations: list[int] = field(default_factory=list)
     max_iterations: int | None = None  # None: MAX_ITERATIONS
+    by_rule: list[bool] = field(default_factory=list)  # a stopping rule ended the solve
 
     def for_matrix(self, K: sparse.spmatrix, max_iterations: int) -> IterativeSolve:
         """A solve of another matrix K with this hierarchy as its preconditioner, that gives
@@ -67,8 +68,10 @@ class IterativeSolve:
         return IterativeSolve(K, self.preconditioner, is_symmetric(K),
                               max_iterations=max_iterations)
 
-    def __call__(self, b: np.ndarray, rtol: float | None = None) -> np.ndarray:
-        """K^-1 b to the relative residual ``rtol`` (None: RTOL)."""
+    def __call__(self, b: np.ndarray, rtol: float | None = None, done=None) -> np.ndarray:
+        """K^-1 b to the relative residual ``rtol`` (None: RTOL), or (CG only) until
+        ``done(r)`` holds for the residual r = b - K x (a stopping rule's; ``by_rule`` records
+        which ended each solve)."""
         rtol = RTOL if rtol is None else rtol
         b = np.asarray(b, dtype=float)
         if b.ndim == 2:
@@ -77,22 +80,39 @@ class IterativeSolve:
         if norm == 0.0:
             return np.zeros_like(b)
         count = [0]
+        done = done if self.symmetric else None  # GMRES hands out no iterate to judge
 
-        def tick(_):
+        def tick(x):
             count[0] += 1
+            if done is not None and done(b - self.K @ x):
+                raise RuleMet(np.array(x, copy=True))
 
         method = cg if self.symmetric else gmres
         extra = {} if self.symmetric else {"restart": 60, "callback_type": "pr_norm"}
         limit = self.max_iterations or MAX_ITERATIONS
-        x, info = method(self.K, b, rtol=rtol, atol=0.0, maxiter=limit,
-                         M=self.preconditioner, callback=tick, **extra)
+        try:
+            x, info = method(self.K, b, rtol=rtol, atol=0.0, maxiter=limit,
+                             M=self.preconditioner, callback=tick, **extra)
+        except RuleMet as met:
+            self.iterations.append(count[0])
+            self.by_rule.append(True)
+            return met.x
         self.iterations.append(count[0])
+        self.by_rule.append(False)
         residual = np.linalg.norm(b - self.K @ x) / norm
         if info != 0 and residual > 10 * rtol:
             raise FactorisationError(f"amg: {'CG' if self.symmetric else 'GMRES'} reached "
                                      f"a relative residual of {residual:.1e}, not {rtol:.0e}, "
                                      f"in {count[0]} iterations")
         return x
+
+
+class RuleMet(Exception):  # noqa: N818 - not an error: how a stopping rule ends scipy's CG
+    """Carries the iterate at which a stopping rule ended a Krylov solve."""
+
+    def __init__(self, x: np.ndarray):
+        super().__init__("stopping rule met")
+        self.x = x
 
 
 def is_symmetric(K: sparse.spmatrix) -> bool:
