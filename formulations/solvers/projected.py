@@ -102,6 +102,26 @@ def next_rows(qp: ContactQP, active: np.ndarray, u: np.ndarray, lam: np.ndarray)
     return np.where(active, lam > -zero, slack < -VIOLATION_TOLERANCE * scale)
 
 
+def solve_set(qp: ContactQP, K, precondition, project, multipliers, active: np.ndarray,
+              u: np.ndarray, rtol: float, counts: list[int], stopping: Stopping,
+              eta_lin: float) -> tuple[np.ndarray, str, float]:
+    """CG on one active set from ``u``: (u, how it ended, eta_lin). Under an adaptive rule
+    the solve ends by its eta_alg criterion, which uses eta_lin, which the solve itself
+    changes: solved on while eta_lin falls."""
+    linearisation = QPLinearisation(K, qp.B, qp.G)
+    for _ in range(RESOLVES):
+        done = (lambda r, e=eta_lin: stopping.krylov_done(r, e)) if stopping.adaptive \
+            else None
+        u, how = projected_cg(K, precondition, project, qp.F, u, rtol, counts, done)
+        if not stopping.adaptive:
+            break
+        lam, _ = next_active_set(qp, active, u, K, multipliers)
+        was, eta_lin = eta_lin, linearisation(u, lam, stopping.load_norm)
+        if how != "rule" or not eta_lin < was:
+            break
+    return u, how, eta_lin
+
+
 def solve_projected(qp: ContactQP, active: np.ndarray, max_iter: int, backend: str,
                     stopping: Stopping = FIXED_STOPPING):
     """(u, lambda, iterations, status, reason, diagnostics) as ``solve_augmented`` returns
@@ -136,17 +156,8 @@ def solve_projected(qp: ContactQP, active: np.ndarray, max_iter: int, backend: s
         if not np.any(qp.F) and not np.any(u_p):  # no load, no gap to close: u = 0 exactly
             u, counts, solved, how = np.zeros(qp.n), counts + [0], True, "tolerance"
         else:  # the last u, moved onto the new set
-            u = project(u) + u_p
-            for _ in range(RESOLVES):  # until the rule holds with the new iterate's eta_lin
-                done = (lambda r, e=eta_lin: stopping.krylov_done(r, e)) \
-                    if stopping.adaptive else None
-                u, how = projected_cg(K, precondition, project, qp.F, u, rtol, counts, done)
-                lam, new_active = next_active_set(qp, active, u, K, multipliers)
-                if not stopping.adaptive:
-                    break
-                was, eta_lin = eta_lin, linearisation(u, lam, stopping.load_norm)
-                if how != "rule" or not eta_lin < was:
-                    break
+            u, how, eta_lin = solve_set(qp, K, precondition, project, multipliers, active,
+                                        project(u) + u_p, rtol, counts, stopping, eta_lin)
             solved = how == "rule" or rtol <= RTOL
         lam, new_active = next_active_set(qp, active, u, K, multipliers)
         changes.append(int((new_active != active).sum()))
