@@ -101,7 +101,7 @@ def test_the_route_is_chosen_before_the_assembly_takes_its_memory(monkeypatch):
     def free_memory():  # the assembly of level 4 takes what amg would need
         return 0.05 if 8320 in built else 1.0
     monkeypatch.setattr(memory_module, "predict_peak_gib", predicted)
-    monkeypatch.setattr(loop_module, "available_gib", free_memory)
+    monkeypatch.setattr(memory_module, "available_gib", free_memory)
     rows = [r.row for r in run_sequence(get_scene("paper"), "mixed", "active-set", "residual",
                                         LoopConfig(strategy="uniform", max_dofs=8400))]
     assert rows[-1].ndofs == 8320 and rows[-1].status == "ok"

@@ -3,7 +3,6 @@ docs/theory.md, sections 7 and 16)."""
 
 import pytest
 
-import bench.sequence.loop as loop_module
 import bench.sequence.memory as memory_module
 from bench.sequence.loop import LoopConfig, run_sequence
 from bench.sequence.memory import MemoryRoute, dense_block_route
@@ -67,7 +66,7 @@ def test_the_sequence_solves_a_level_whose_block_does_not_fit_on_the_iterative_b
     against the back-end). With 1e5 copies the first block needs 3.2 GiB, the second 12.6."""
     monkeypatch.setattr(memory_module, "predict_peak_gib", fits)
     monkeypatch.setattr(memory_module, "DENSE_COPIES", 10**5)
-    monkeypatch.setattr(loop_module, "available_gib", lambda: 8.0)
+    monkeypatch.setattr(memory_module, "available_gib", lambda: 8.0)
     rows = [r.row for r in run_sequence(get_scene("paper"), "vi", FAST_SOLVER, "residual",
                                         LoopConfig(strategy="uniform", max_dofs=8400,
                                                    backend=CONDENSING[0]))]
