@@ -110,6 +110,13 @@ def uses_system(discretisation: Discretisation, solver: str) -> bool:
     return discretisation.system is not None and solver in SYSTEM_SOLVERS.names()
 
 
+def takes_initial(discretisation: Discretisation, solver: str) -> bool:
+    """Whether ``solver`` starts from a given displacement (``initial``: nested iteration on
+    an iterative back-end) for what the discretisation offers."""
+    registry = SYSTEM_SOLVERS if uses_system(discretisation, solver) else SOLVERS
+    return bool(registry.meta(solver, "initial"))
+
+
 def why_unsolvable(discretisation: Discretisation, solver: str) -> str | None:
     """Why ``solver`` has no method for what the discretisation offers, or None."""
     if uses_system(discretisation, solver) or (discretisation.qp is not None

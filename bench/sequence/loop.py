@@ -26,15 +26,16 @@ from bench.sequence.memory import (
     level_memory,
     level_refusal,
 )
+from bench.sequence.nested import initial_displacement
 from bench.sequence.options import option
 from bench.sequence.rows import ResultRow, identity_columns
 from estimators.base import estimator_on
 from formulations import STATUS_FAILED, get_formulation, solve
 from formulations.cells import DEFAULT_CELL, check_cell, family_for
 from formulations.cells.base import Plan
-from formulations.discretisation import dense_block_size
+from formulations.discretisation import dense_block_size, takes_initial
 from formulations.elasticity import check_order, element_diameters
-from formulations.solvers.backends import backend_names, check_backend
+from formulations.solvers.backends import backend_names, check_backend, iterative
 from formulations.solvers.registry import REFERENCE_SOLVER
 from formulations.solvers.stopping import (
     GAMMA_ALG,
@@ -208,6 +209,10 @@ def level_options(level: int, disc, solver: str, config: LoopConfig, route: Memo
         options["backend"] = route.backend
     if config.nested and previous is not None and previous.ok:
         options["warm_start"] = disc.warm_start(previous, solver)
+        if iterative(options.get("backend")) and takes_initial(disc, solver):
+            initial = initial_displacement(previous, disc)
+            if initial is not None:
+                options["initial"] = initial
     return options, route
 
 

@@ -83,14 +83,17 @@ def dense_block_size(qp: ContactQP, backend: str | None = None) -> int:
                               "B K^-1 B' from one factorisation (pardiso, cholmod), the "
                               "augmented saddle-point system (splu) or projected CG with "
                               "multigrid (amg); nested iteration",
-                 meta={"dense_block_size": dense_block_size, "stopping": True})
+                 meta={"dense_block_size": dense_block_size, "stopping": True,
+                       "initial": True})
 def solve_active_set(qp: ContactQP, warm_start: np.ndarray | None = None,
                      max_iter: int = 100, backend: str | None = None,
-                     stopping: Stopping = FIXED_STOPPING) -> QPSolution:
+                     stopping: Stopping = FIXED_STOPPING,
+                     initial: np.ndarray | None = None) -> QPSolution:
     """``backend``: 'pardiso' or 'cholmod' (condensed iteration), 'splu' (augmented
     iteration, see ``augmented``) or 'amg' (projected CG, see ``projected``); default: the
     fastest available, see ``backends``. ``stopping``: when to stop (``stopping``; adaptive
-    on the frictionless condensed and projected routes)."""
+    on the frictionless condensed and projected routes); ``initial``: the displacement the
+    projected route starts from (nested iteration; a slack form's slacks start at 0)."""
     start = time.perf_counter()
     backend = check_backend(backend)
     if warm_start is not None and np.shape(warm_start) != (qp.m,):
@@ -104,7 +107,8 @@ def solve_active_set(qp: ContactQP, warm_start: np.ndarray | None = None,
         active = (np.asarray(warm_start) > 0) if warm_start is not None else \
             initial_active_set(qp, backend)
         u, lam, iterations, status, reason, diagnostics = (
-            solve_projected(qp, active, max_iter, backend, stopping) if iterative(backend)
+            solve_projected(qp, active, max_iter, backend, stopping, initial)
+            if iterative(backend)
             else solve_augmented(qp, active, max_iter))
         if status != STATUS_OK:
             return _fallback(qp, f"plain active set failed ({reason})", diagnostics, start)

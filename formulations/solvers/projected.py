@@ -123,16 +123,19 @@ def solve_set(qp: ContactQP, K, precondition, project, multipliers, active: np.n
 
 
 def solve_projected(qp: ContactQP, active: np.ndarray, max_iter: int, backend: str,
-                    stopping: Stopping = FIXED_STOPPING):
+                    stopping: Stopping = FIXED_STOPPING, initial: np.ndarray | None = None):
     """(u, lambda, iterations, status, reason, diagnostics) as ``solve_augmented`` returns
     them; the diagnostics hold the CG iterations of every active set. While the set changes,
     CG stops at SEARCH_RTOL; a set that stays is solved again to RTOL and checked again.
     An adaptive ``stopping`` also ends each CG solve by its eta_alg criterion and the
-    iteration at the first iterate whose eta_lin meets its criterion (docs/theory.md, 18.3)."""
+    iteration at the first iterate whose eta_lin meets its criterion (docs/theory.md, 18.3).
+    ``initial``: the first u (its first entries; nested iteration), else 0."""
     precondition = factorise(qp.K, backend, qp.near_null).preconditioner.matvec
     K = sparse.csr_matrix(qp.K)
     seen, changes, counts = set(), [], []
     u, lam, rtol = np.zeros(qp.n), np.zeros(qp.m), SEARCH_RTOL
+    if initial is not None:
+        u[:min(initial.size, qp.n)] = initial[:qp.n]
     linearisation, eta_lin = QPLinearisation(K, qp.B, qp.G), float("nan")
 
     def diagnostics(cycled):

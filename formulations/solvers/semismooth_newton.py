@@ -36,9 +36,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import linalg, sparse
+from scipy import linalg
 from scipy.linalg.lapack import dgecon
-from scipy.sparse.linalg import splu
 
 from formulations.base import STATUS_OK, QPSolution, SolverDiagnostics
 from formulations.semismooth import SemismoothSystem
@@ -51,8 +50,7 @@ from formulations.solvers.backends import (
 )
 from formulations.solvers.newton import Linearised, newton
 from formulations.solvers.registry import FAST_SOLVER, register_system_solver
-from formulations.solvers.reused_factorisation import ReusedFactorisation
-from formulations.solvers.reused_hierarchy import ReusedHierarchy
+from formulations.solvers.sparse_newton import sparse_problem
 from formulations.solvers.stopping import FIXED_STOPPING, Stopping
 
 # relative nonlinear residual at which iterative refinement stops (one step reaches 1e-13 ..
@@ -64,10 +62,6 @@ REFINED = 1e-11
 # steps each): condensed 0.77 / 2.88 / 6.92 / 22.9 s against sparse 1.14 / 1.99 / 3.73 /
 # 8.29 s at nq = 1068 / 1810 / 2556 / 4262 (86k to 504k DOFs)
 SPARSE_NEWTON_FROM = 1500
-# an iterative back-end's relative residual while the active set changes. paper-3d P1,
-# V-cycles in all with 1e-4 / 1e-3, the same u: penalty 120 / 123 at 13 872 DOFs and
-# 561 / 290 at 104 544, nitsche 115 / 94 and 207 / 189
-SEARCH_RTOL = 1e-3
 
 
 
@@ -148,73 +142,6 @@ def condensed_problem(G: np.ndarray, P0: np.ndarray) -> Linearised:
                       lambda m: np.linalg.norm(P0) + np.linalg.norm(G @ m))
 
 
-def sparse_problem(system: SemismoothSystem, backend: str | None = None,
-                   stopping: Stopping = FIXED_STOPPING) -> Linearised:
-    """Newton on u with the full sparse Jacobian K + T' D_A T, factorised once a step: by the
-    back-end ``backend`` (an SPD Jacobian: a system without S; or an iterative back-end,
-    which takes any Jacobian), else by SuperLU. An iterative back-end's Krylov iterations of
-    every step are appended to ``krylov``; under an adaptive ``stopping`` its CG solves end
-    by the rule's eta_alg criterion and the iteration by its eta_lin one (``AdaptiveSteps``)."""
-    T = system.T
-    krylov: list[int] = []
-    direct = ReusedFactorisation(backend) if backend is not None else None
-    hierarchy = ReusedHierarchy(backend, system.near_null) if iterative(backend) else None
-    steps = AdaptiveSteps(system, stopping)
-    rtol = [SEARCH_RTOL if iterative(backend) else 0.0]  # an iterative back-end's, per step
-
-    def tighten() -> bool:
-        """Solve to the back-end's own tolerance from now on; True if it was looser and the
-        stopping rule did not end the last solve."""
-        looser, rtol[0] = rtol[0] == SEARCH_RTOL and not steps.by_rule, None
-        return looser
-
-    def step(active, u):
-        J = system_matrix(system, active)
-        rhs = -(J @ u + T.T @ system.phi_affine(active)[1] - system.F)
-        if backend is not None and iterative(backend):
-            if not np.any(system.F - T.T @ system.phi_affine(active)[1]):
-                return -u, float("nan")  # no load, no contact: u = 0 exactly, not round-off
-            done = len(hierarchy.iterations)
-            dx = hierarchy(J, rhs, rtol[0], active, steps.krylov_rule())
-            krylov.extend(hierarchy.iterations[done:])
-            steps.record(J @ dx - rhs, hierarchy.by_rule)
-            return dx, float("nan")
-        steps.record(np.zeros_like(rhs), True)  # a direct solve: no algebraic residual
-        if direct is not None:  # SPD: reuse an earlier factorisation (reused_factorisation)
-            return direct(J, active, rhs), float("nan")
-        return splu(J.tocsc()).solve(rhs), float("nan")
-
-    return Linearised(system.residual, lambda u: system.pressure_argument(T @ u), step,
-                      lambda u: np.linalg.norm(system.F) + np.linalg.norm(system.K @ u),
-                      krylov, tighten, steps.settled, steps)
-
-
-@dataclass(eq=False)
-class AdaptiveSteps:
-    """The adaptive stopping rule on Newton steps solved by CG (docs/theory.md, 18.3): each
-    step's algebraic residual a = J dx - rhs, and eta_lin = C_F ||rho(R(u) - a)||."""
-
-    system: SemismoothSystem
-    stopping: Stopping
-    algebraic: np.ndarray | None = None
-    by_rule: bool = False
-    eta_lin: float = float("nan")
-
-    def krylov_rule(self):
-        if not self.stopping.adaptive:
-            return None
-        return lambda r, e=self.eta_lin: self.stopping.krylov_done(r, e)
-
-    def record(self, algebraic: np.ndarray, by_rule: bool) -> None:
-        self.algebraic, self.by_rule = algebraic, by_rule
-
-    def settled(self, u: np.ndarray) -> bool:
-        if not self.stopping.adaptive or self.algebraic is None:
-            return False
-        self.eta_lin = self.stopping.algebraic(self.system.residual(u) - self.algebraic)
-        return self.by_rule and self.stopping.newton_done(self.eta_lin)
-
-
 def dense_block_size(system: SemismoothSystem, backend: str | None = None) -> int:
     """The columns of the dense Schur block ``solve_semismooth`` forms on ``backend`` (0: its
     route takes sparse steps, ``newton_route``)."""
@@ -225,13 +152,16 @@ def dense_block_size(system: SemismoothSystem, backend: str | None = None) -> in
 
 @register_system_solver(FAST_SOLVER, "semismooth Newton (primal-dual active set) on the "
                                       "contact values, condensed from one factorisation",
-                        meta={"dense_block_size": dense_block_size, "stopping": True})
+                        meta={"dense_block_size": dense_block_size, "stopping": True,
+                              "initial": True})
 def solve_semismooth(system: SemismoothSystem, warm_start: np.ndarray | None = None,
                      max_iter: int = 50, backend: str | None = None,
-                     stopping: Stopping = FIXED_STOPPING) -> QPSolution:
+                     stopping: Stopping = FIXED_STOPPING,
+                     initial: np.ndarray | None = None) -> QPSolution:
     """``warm_start``: a pressure per quadrature point (> 0 where active); ``stopping``: when
     to stop (adaptive on the sparse-step routes; the condensed route stops when its active
-    set settles)."""
+    set settles); ``initial``: the displacement the sparse-step routes start from (nested
+    iteration)."""
     start = time.perf_counter()
     backend = check_backend(backend)
     if warm_start is not None and np.shape(warm_start) != (system.nq,):
@@ -239,7 +169,8 @@ def solve_semismooth(system: SemismoothSystem, warm_start: np.ndarray | None = N
     condensed, steps_on = newton_route(system, backend)
     try:
         u, result, phases, krylov, steps = run_newton(system, warm_start, max_iter, backend,
-                                                      condensed, steps_on, stopping)
+                                                      condensed, steps_on, stopping,
+                                                      initial)
     except FactorisationError:  # a Jacobian with S that is not positive definite
         if condensed or not system.ns or iterative(backend) or not condenses(backend):
             raise
@@ -276,7 +207,8 @@ def newton_route(system: SemismoothSystem, backend: str) -> tuple[bool, str | No
 
 
 def run_newton(system: SemismoothSystem, warm_start, max_iter: int, backend: str,
-               condensed: bool, steps_on: str | None, stopping: Stopping = FIXED_STOPPING):
+               condensed: bool, steps_on: str | None, stopping: Stopping = FIXED_STOPPING,
+               initial: np.ndarray | None = None):
     """(u, NewtonResult, phases, Krylov iterations, the stopping rule's state or None) on the
     route ``newton_route`` chose."""
     T = system.T
@@ -289,7 +221,9 @@ def run_newton(system: SemismoothSystem, warm_start, max_iter: int, backend: str
         phases = [*factor.phases, ("condense", time.perf_counter() - clock)]
         problem, x = condensed_problem(reduced.G, P0), np.zeros(system.nq)
     else:
-        phases, x = [], np.zeros(system.n)
+        phases = []
+        x = np.array(initial, dtype=float) if initial is not None and initial.size == \
+            system.n else np.zeros(system.n)
         problem = sparse_problem(system, steps_on, stopping)
     active = (np.asarray(warm_start) > 0) if warm_start is not None else \
         problem.argument(x) < 0
@@ -326,9 +260,3 @@ def refine(system: SemismoothSystem, solve: Callable, reduced: ReducedPressure, 
             break
         u, r, scale = u + du, trial, trial_scale
     return u
-
-
-def system_matrix(system: SemismoothSystem, active: np.ndarray) -> sparse.csr_matrix:
-    """The Jacobian K + T' D_A T on the full DOFs (tests and diagnostics)."""
-    D, _ = system.phi_affine(active)
-    return (system.K + system.T.T @ D @ system.T).tocsr()

@@ -13,7 +13,7 @@ from formulations.discretisation import why_unsolvable
 from formulations.methods.nitsche import DEFAULT_GAMMA_0
 from formulations.registry import FORMULATIONS
 from formulations.solvers.backends import available_backends
-from formulations.solvers.semismooth_newton import system_matrix
+from formulations.solvers.sparse_newton import system_matrix
 from scenes import get_scene, scene_names
 
 THETAS = (1.0, 0.0, -1.0)
