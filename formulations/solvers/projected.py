@@ -133,7 +133,10 @@ def solve_projected(qp: ContactQP, active: np.ndarray, max_iter: int, backend: s
     precondition = factorise(qp.K, backend, qp.near_null).preconditioner.matvec
     K = sparse.csr_matrix(qp.K)
     seen, changes, counts = set(), [], []
-    u, lam, rtol = np.zeros(qp.n), np.zeros(qp.m), SEARCH_RTOL
+    # under an adaptive rule every solve ends by the rule (RTOL a floor): it is the search
+    # tolerance, loose while eta_lin is large
+    u, lam = np.zeros(qp.n), np.zeros(qp.m)
+    rtol = RTOL if stopping.adaptive else SEARCH_RTOL
     if initial is not None:
         u[:min(initial.size, qp.n)] = initial[:qp.n]
     linearisation, eta_lin = QPLinearisation(K, qp.B, qp.G), float("nan")
@@ -143,8 +146,9 @@ def solve_projected(qp: ContactQP, active: np.ndarray, max_iter: int, backend: s
                                  krylov_iterations=tuple(counts))
 
     for iteration in range(1, max_iter + 1):
-        if (active.tobytes(), rtol) in seen and stopping.adaptive:
-            # the rule's inexact solves cycled between sets: go on with the fixed tolerances
+        if (active.tobytes(), rtol) in seen and (stopping.adaptive or rtol > RTOL):
+            # inexact solves cycled between sets (a weakly active row they cannot decide):
+            # go on with exact ones, as the fixed tolerances would once the set settled
             stopping, rtol, seen = FIXED_STOPPING, RTOL, set()
         if (active.tobytes(), rtol) in seen:
             return (u, lam, iteration - 1, STATUS_FAILED, "active set cycles (a set repeated)",
