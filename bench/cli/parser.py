@@ -83,7 +83,8 @@ COMPARE_HELPS = {
                        f"{COMPARE_REFERENCE_DOFS} for the P3 references in 2D, "
                        f"{COMPARE_REFERENCE_DOFS_3D} for the P2 references in 3D"),
     "cells": "cell shape(s), comma-separated: tri, quad; the whole comparison runs on each"}
-COMPARE_OPTIONS = ("max_dofs", "cells", "reference_dofs", "max_memory_gib", "backend", "workers",
+COMPARE_OPTIONS = ("max_dofs", "cells", "reference_dofs", "max_memory_gib", "backend", "stopping",
+                   "gamma_alg", "gamma_lin", "workers",
                    "scheduler", "cache", "scene_files", "crosscheck_dofs", "timing_repeats", "out",
                    "overwrite")
 

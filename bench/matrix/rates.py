@@ -5,7 +5,9 @@ with its 95 % interval: columns ``*_rate_low`` and ``*_rate_high``) over the las
 ``RATE_LEVELS`` ok levels that have y > 0 (earlier levels are pre-asymptotic: on the paper
 scene nothing touches on the first two). In 2D, O(h^1/2) is slope -1/4 and O(h) is slope -1/2.
 Effectivity statistics use the same levels and skip rows whose reference is too coarse;
-``effectivity_all_min`` is the minimum over every level (for a guaranteed bound).
+``effectivity_all_min`` is the minimum over every level (for a guaranteed bound);
+``effectivity_total_all_min`` and ``effectivity_total_max`` those of eta_total / error, the
+second from TOTAL_FROM_DOFS unknowns.
 ``target_dofs_ratio`` prices ``--target-error`` against an oracle that knew the true error: for
 TOL = eta on each of those levels, the level's DOFs over the DOFs at which the error of the same
 sequence first falls to TOL (log-log interpolation between its judged levels); the largest
@@ -25,6 +27,7 @@ from bench.sequence.rows import KEYS, with_labels
 from formulations import STATUS_OK
 
 RATE_LEVELS = 4
+TOTAL_FROM_DOFS = 1000  # eta_total's effectivity from here: coarser levels are pre-asymptotic
 
 
 def slope_fit(group: pd.DataFrame, column: str, levels: int = RATE_LEVELS) -> SlopeFit:
@@ -73,6 +76,19 @@ def target_dofs_ratio(judged: pd.DataFrame, window: pd.DataFrame) -> float:
     return float(max(ratios)) if ratios else float("nan")
 
 
+def total_effectivity(judged: pd.DataFrame) -> dict:
+    """eta_total / error (docs/theory.md, 18) over every judged level (its minimum: where the
+    bound of the returned iterate must hold) and over those from TOTAL_FROM_DOFS unknowns (its
+    maximum); NaN where the levels have no eta_total."""
+    values = judged["effectivity_total"] if "effectivity_total" in judged else judged["ndofs"] * \
+        np.nan
+    values = values.astype(float)
+    late = values[judged["ndofs"] >= TOTAL_FROM_DOFS].dropna()
+    return {"effectivity_total_all_min": float(values.min()) if values.notna().any()
+            else float("nan"),
+            "effectivity_total_max": float(late.max()) if len(late) else float("nan")}
+
+
 def rates_table(table: pd.DataFrame, levels: int = RATE_LEVELS) -> pd.DataFrame:
     rows = []
     table = with_labels(table[table["level"] >= 0])
@@ -101,6 +117,7 @@ def rates_table(table: pd.DataFrame, levels: int = RATE_LEVELS) -> pd.DataFrame:
             "effectivity_all_min": float(judged["effectivity_index"].min()) if len(judged)
             else float("nan"),
             "target_dofs_ratio": target_dofs_ratio(judged, usable),
+            **total_effectivity(judged),
             "too_coarse_rows": int(tail["reference_too_coarse"].astype(bool).sum()),
             "truth": str(group["truth"].iloc[-1]),
         })

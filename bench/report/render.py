@@ -22,6 +22,7 @@ from bench.report.estimator_figures import ESTIMATOR_CAPTION, estimator_effectiv
 from bench.report.orders import order_section
 from bench.report.questions import questions
 from bench.report.sections import Figures, scene_section
+from bench.report.stopping_figures import STOPPING_CAPTION, components_figure, work_saved
 from bench.report.summary import first_screen
 from bench.report.tables import (
     accuracy_table,
@@ -137,6 +138,9 @@ def write_report(table: pd.DataFrame, out: str | Path, results: str | Path | Non
         "estimator_figure": figs.add(estimator_effectivity(judged_levels(rows))
                                      if len(rows) else None, "estimators", ESTIMATOR_CAPTION),
         "orders": orders,
+        "stopping_figure": figs.add(components_figure(rows) if len(rows) else None,
+                                    "stopping", STOPPING_CAPTION),
+        "stopping_table": work_saved(rows) if len(rows) else pd.DataFrame(),
         "hard_run": hard is not None, "hard_figures": hard_figures, "hard_matrix": hard_matrix,
         "n_rows": len(everything), "n_too_coarse": int(rows["reference_too_coarse"]
                                                         .fillna(False).astype(bool).sum()),

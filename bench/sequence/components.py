@@ -9,8 +9,24 @@ from dataclasses import dataclass
 
 from estimators.base import ESTIMATORS
 from estimators.guaranteed.constants import domain_constants
+from formulations.cells import DEFAULT_CELL
 from formulations.hat_loads import load_norm, simplex_mesh
-from formulations.solvers.stopping import ADAPTIVE, Stopping
+from formulations.solvers.stopping import ADAPTIVE, Stopping, check_gamma, check_stopping
+
+
+def check_stopping_settings(stopping: str, gamma_alg, gamma_lin) -> None:
+    """A registered rule and fractions in (0, 1), or ValueError naming the bad one."""
+    check_stopping(stopping)
+    check_gamma("gamma_alg", gamma_alg)
+    check_gamma("gamma_lin", gamma_lin)
+
+
+def check_stopping_cell(stopping: str, cell: str) -> None:
+    """The adaptive rule measures with the hats of a conforming simplicial mesh."""
+    if stopping == ADAPTIVE and cell != DEFAULT_CELL:
+        raise ValueError(f"stopping='adaptive' is measured on triangles and tetrahedra only "
+                         f"(cell={cell!r}: the hats of a mesh with hanging nodes are not "
+                         f"those of the bound); use cell='{DEFAULT_CELL}' or stopping='fixed'")
 
 
 @dataclass(frozen=True)
@@ -74,6 +90,6 @@ def component_columns(solution, estimate) -> dict:
     else:
         eta_disc = eta_total = float("nan")
     return dict(eta_disc=eta_disc, eta_lin=eta_lin, eta_alg=eta_alg, eta_total=eta_total,
-                stopping=parts.rule, stopped_early=parts.stopped_early,
+                stopped_early=parts.stopped_early,
                 newton_steps=solution.iterations,
                 krylov_iterations=int(sum(solution.diagnostics.krylov_iterations)))

@@ -18,7 +18,13 @@ from bench.sequence.columns import (
     solver_columns,
     total_effectivity,
 )
-from bench.sequence.components import Previous, component_columns, level_stopping
+from bench.sequence.components import (
+    Previous,
+    check_stopping_cell,
+    check_stopping_settings,
+    component_columns,
+    level_stopping,
+)
 from bench.sequence.marking import MARKINGS, check_marking, mark
 from bench.sequence.memory import (
     MemoryRoute,
@@ -37,13 +43,7 @@ from formulations.discretisation import dense_block_size, takes_initial
 from formulations.elasticity import check_order, element_diameters
 from formulations.solvers.backends import backend_names, check_backend, iterative
 from formulations.solvers.registry import REFERENCE_SOLVER
-from formulations.solvers.stopping import (
-    GAMMA_ALG,
-    GAMMA_LIN,
-    STOPPING_RULES,
-    check_gamma,
-    check_stopping,
-)
+from formulations.solvers.stopping import GAMMA_ALG, GAMMA_LIN, STOPPING_RULES
 from scenes import Scene
 from scenes.base import is_integer, is_number
 
@@ -115,9 +115,7 @@ class LoopSettings:
             raise ValueError(f"max_memory_gib={self.max_memory_gib!r} is not a number > 0")
         if self.backend is not None:
             check_backend(self.backend)
-        check_stopping(self.stopping)
-        check_gamma("gamma_alg", self.gamma_alg)
-        check_gamma("gamma_lin", self.gamma_lin)
+        check_stopping_settings(self.stopping, self.gamma_alg, self.gamma_lin)
 
     def settings(self) -> dict:
         """The values of ``LoopSettings``' own fields (what a ``LoopConfig`` inherits)."""
@@ -144,6 +142,7 @@ class LoopConfig(LoopSettings):
             raise ValueError(f"strategy={self.strategy!r} is not one of {', '.join(STRATEGIES)}")
         check_order(self.order)
         check_cell(self.cell)
+        check_stopping_cell(self.stopping, self.cell)
 
     def options(self) -> dict:
         """The solver's keywords: ``solver_options`` and the back-end."""

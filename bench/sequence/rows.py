@@ -92,7 +92,7 @@ class ResultRow:
     eta_alg: float = math.nan
     eta_total: float = math.nan
     effectivity_total: float = math.nan
-    stopping: str = ""  # the stopping rule of the solve: fixed or adaptive
+    stopping: str = "fixed"  # the stopping rule of the solves: fixed or adaptive
     stopped_early: bool = False  # the adaptive rule ended it before the fixed tolerances
     newton_steps: int = 0
     krylov_iterations: int = 0
@@ -113,7 +113,7 @@ class ResultRow:
 COLUMNS = [f.name for f in fields(ResultRow)]
 # identity of a combination (the sweep labels are empty outside sweeps)
 KEYS = ["scene", "formulation", "solver", "estimator", "strategy", "order", "cell",
-        "scene_parameters", "formulation_options"]
+        "stopping", "scene_parameters", "formulation_options"]
 LABELS = ["scene_parameters", "formulation_options"]
 # sequence_end of a complete sequence; INTERRUPTED (or no end at all) marks one cut short
 FINISHED = ("budget", "max_levels", "memory", "failed", "skipped", "target")
@@ -129,6 +129,7 @@ def identity_columns(scene: str, formulation: str, solver: str, estimator: str, 
     (``run``) and the body's dimension."""
     return dict(scene=scene, formulation=formulation, solver=solver, estimator=estimator,
                 strategy=config.strategy, order=config.order, dim=dim, cell=config.cell,
+                stopping=config.stopping,
                 marking=config.marking,
                 theta=config.theta,
                 **(run or {}))
@@ -137,7 +138,8 @@ def identity_columns(scene: str, formulation: str, solver: str, estimator: str, 
 def name_parts(row) -> list:
     """The values of KEYS of a row, the default cell left out: what names its files (so that
     a triangle sequence keeps the names it had before cells were an axis)."""
-    return [getattr(row, k) for k in KEYS if not (k == "cell" and getattr(row, k) == "tri")]
+    return [getattr(row, k) for k in KEYS if not (k == "cell" and getattr(row, k) == "tri")
+            and not (k == "stopping" and getattr(row, k) in ("fixed", ""))]
 
 
 def with_labels(frame):
@@ -149,6 +151,8 @@ def with_labels(frame):
     frame["dim"] = (frame["dim"].fillna(2).astype(int) if "dim" in frame else 2)
     frame["cell"] = (frame["cell"].astype(object).fillna("tri").astype(str) if "cell" in frame
                      else "tri")
+    frame["stopping"] = (frame["stopping"].astype(object).fillna("fixed").replace("", "fixed")
+                         .astype(str) if "stopping" in frame else "fixed")
     for column in LABELS + ["sequence_key", "sequence_end"]:
         frame[column] = (frame[column].astype(object).fillna("").astype(str) if column in frame
                          else "")

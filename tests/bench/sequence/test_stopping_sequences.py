@@ -72,3 +72,32 @@ def test_the_bound_holds_on_every_intermediate_iterate(formulation):
         if status == "ok":
             break
     assert checked >= 2  # at least one iterate before the last
+
+
+def test_fixed_rows_carry_the_components_and_the_report_prices_the_rule(tmp_path):
+    """With the fixed tolerances eta_alg is round-off and eta_total is eta; a results folder
+    with both rules gets the report's figure and its work-saved table."""
+    from bench.report import write_report
+    from bench.sequence.rows import COLUMNS
+
+    scene = get_scene("free-boundary")
+    tables = []
+    for rule in ("fixed", "adaptive"):
+        config = LoopConfig(strategy="adaptive", max_dofs=3000, backend="amg", stopping=rule)
+        result = rows(scene, "vi", config)
+        assert {r.stopping for r in result} == {rule}
+        tables += [r.as_dict() for r in result]
+        if rule == "fixed":
+            for r in result:  # RTOL 1e-10 leaves eta_alg ~1e-8 of eta (measured): round-off
+                assert r.eta_alg < 1e-6 * r.eta_total and r.eta_total == r.eta
+    import pandas as pd
+    frame = pd.DataFrame(tables, columns=COLUMNS)
+    readme = write_report(frame, tmp_path).read_text()
+    assert "### When the solvers stop" in readme and "figures/stopping.png" in readme
+    assert "Krylov saved" in readme
+
+
+def test_adaptive_stopping_is_refused_on_quadrilaterals():
+    with pytest.raises(ValueError, match="stopping='adaptive' is measured on triangles and "
+                                         "tetrahedra only"):
+        LoopConfig(cell="quad", stopping="adaptive")
