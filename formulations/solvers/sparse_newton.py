@@ -36,7 +36,9 @@ def sparse_problem(system: SemismoothSystem, backend: str | None = None,
     direct = ReusedFactorisation(backend) if backend is not None else None
     hierarchy = ReusedHierarchy(backend, system.near_null) if iterative(backend) else None
     steps = AdaptiveSteps(system, stopping)
-    rtol = [SEARCH_RTOL if iterative(backend) else 0.0]  # an iterative back-end's, per step
+    # an iterative back-end's relative residual, per step; under an adaptive rule the rule
+    # ends every solve (RTOL a floor)
+    rtol = [None if steps.stopping.adaptive else SEARCH_RTOL if iterative(backend) else 0.0]
 
     def tighten() -> bool:
         """Solve to the back-end's own tolerance from now on; True if it was looser and the
@@ -51,7 +53,7 @@ def sparse_problem(system: SemismoothSystem, backend: str | None = None,
             if not np.any(system.F - T.T @ system.phi_affine(active)[1]):
                 return -u, float("nan")  # no load, no contact: u = 0 exactly, not round-off
             done = len(hierarchy.iterations)
-            dx = hierarchy(J, rhs, rtol[0], active, steps.krylov_rule())
+            dx = hierarchy(J, rhs, rtol[0], active, steps.krylov_rule(u))
             krylov.extend(hierarchy.iterations[done:])
             steps.record(J @ dx - rhs, hierarchy.by_rule)
             return dx, float("nan")
@@ -76,10 +78,13 @@ class AdaptiveSteps:
     by_rule: bool = False
     eta_lin: float = float("nan")
 
-    def krylov_rule(self):
+    def krylov_rule(self, u: np.ndarray):
+        """The rule on a step's CG from u: its residual r = rhs - J dx against eta_lin of the
+        candidate u + dx (R(u + dx) less its linearised part -r), as the solve goes."""
         if not self.stopping.adaptive:
             return None
-        return lambda r, e=self.eta_lin: self.stopping.krylov_done(r, e)
+        return lambda r, dx: self.stopping.krylov_done(
+            r, self.stopping.algebraic(self.system.residual(u + dx) + r))
 
     def record(self, algebraic: np.ndarray, by_rule: bool) -> None:
         self.algebraic, self.by_rule = algebraic, by_rule

@@ -70,8 +70,8 @@ class IterativeSolve:
 
     def __call__(self, b: np.ndarray, rtol: float | None = None, done=None) -> np.ndarray:
         """K^-1 b to the relative residual ``rtol`` (None: RTOL), or (CG only) until
-        ``done(r)`` holds for the residual r = b - K x (a stopping rule's; ``by_rule`` records
-        which ended each solve)."""
+        ``done(r, x)`` holds for the iterate x and its residual r = b - K x (a stopping rule's;
+        ``by_rule`` records which ended each solve)."""
         rtol = RTOL if rtol is None else rtol
         b = np.asarray(b, dtype=float)
         if b.ndim == 2:
@@ -84,7 +84,7 @@ class IterativeSolve:
 
         def tick(x):
             count[0] += 1
-            if done is not None and done(b - self.K @ x):
+            if done is not None and done(b - self.K @ x, x):
                 raise RuleMet(np.array(x, copy=True))
 
         method = cg if self.symmetric else gmres
