@@ -68,11 +68,15 @@ def scaling_command(args) -> int:
 
 def sequence_command(args) -> int:
     def show(row):
-        print(f"{row['strategy']} to {row['max_dofs']} ({row['cell']}): {row['levels']} levels, "
+        print(f"{row['strategy']} to {row['max_dofs']} ({row['cell']}, {row['stopping']} "
+              f"stopping): {row['levels']} levels, "
               f"finest "
               f"{row['final_ndofs']} DOFs, {row['t_sequence']:.1f} s = "
               f"{row['sequence_over_linear']:.1f} linear solves at the finest level", flush=True)
-    budgets = zip([s for s, _ in SEQUENCES], args.sequence_max_dofs, strict=True)
-    frame = run_sequences(list(budgets), args.backend, on_row=show, cells=args.cell)
+    budgets = [(strategy, budget) for strategy, budget in zip(
+        [s for s, _ in SEQUENCES], args.sequence_max_dofs, strict=True)
+        if strategy in args.sequence_strategies]
+    frame = run_sequences(budgets, args.backend, on_row=show, cells=args.cell,
+                          stopping=args.stopping)
     print(f"wrote {write_sequences(frame, args.out, args.readme)}")
     return 0

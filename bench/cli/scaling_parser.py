@@ -14,6 +14,7 @@ from bench.perf.scaling_3d import SIZES_3D
 from bench.perf.sequence import SEQUENCES
 from formulations.cells import DEFAULT_CELL, cell_names
 from formulations.solvers.backends import backend_names
+from formulations.solvers.stopping import STOPPING_RULES
 
 
 def add_scaling_parser(sub) -> None:
@@ -48,6 +49,16 @@ def add_scaling_parser(sub) -> None:
                          help="with --sequence: the cell shape(s) of the sequences, "
                               f"comma-separated, from {', '.join(cell_names())} (default: "
                               f"{DEFAULT_CELL})")
+    scaling.add_argument("--stopping", type=name_list("stopping", STOPPING_RULES.names()),
+                         default=["fixed"],
+                         help="with --sequence: the stopping rule(s) of the solvers, "
+                              f"comma-separated, from {', '.join(STOPPING_RULES.names())} "
+                              "(docs/theory.md, 18; default: fixed)")
+    scaling.add_argument("--sequence-strategies", type=name_list("strategy", ["adaptive",
+                                                                             "uniform"]),
+                         default=["adaptive", "uniform"],
+                         help="with --sequence: which of the two sequences run (default: "
+                              "adaptive,uniform)")
     scaling.add_argument("--sequence-max-dofs", type=sequence_budgets,
                          default=[b for _, b in SEQUENCES],
                          help="the DOF budgets of the adaptive and the uniform sequence, "

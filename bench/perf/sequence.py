@@ -30,8 +30,10 @@ README_START, README_END = "<!-- sequence:start -->", "<!-- sequence:end -->"
 
 
 def measure_sequence(strategy: str, max_dofs: int, backend: str | None = None,
-                     reference_dofs: int = REFERENCE_DOFS, cell: str = DEFAULT_CELL) -> dict:
-    """Run one sequence and time it; run in a fresh process for a meaningful peak."""
+                     reference_dofs: int = REFERENCE_DOFS, cell: str = DEFAULT_CELL,
+                     stopping: str = "fixed") -> dict:
+    """Run one sequence and time it (``stopping``: the solvers' stopping rule, docs/theory.md
+    18); run in a fresh process for a meaningful peak."""
     from bench.matrix.store import ResultStore
     from bench.perf.scaling import peak_gib
     from bench.sequence.loop import LoopConfig, run_sequence
@@ -43,7 +45,7 @@ def measure_sequence(strategy: str, max_dofs: int, backend: str | None = None,
     scene = get_scene("paper")
     truth = truth_for(scene, reference_dofs, max_dofs)
     config = LoopConfig(strategy=strategy, max_dofs=max_dofs, max_levels=60, cell=cell,
-                        backend=backend)
+                        backend=backend, stopping=stopping)
     rows, t_store, last = [], 0.0, None
     with tempfile.TemporaryDirectory() as folder:
         store = ResultStore(folder)
@@ -62,6 +64,9 @@ def measure_sequence(strategy: str, max_dofs: int, backend: str | None = None,
     factorise(K, backend, last.solution.elasticity.rigid_modes)(np.ones(K.shape[0]))
     t_linear = time.perf_counter() - clock
     out = {"strategy": strategy, "cell": cell, "max_dofs": max_dofs, "backend": backend,
+           "stopping": stopping, "krylov_iterations": int(frame["krylov_iterations"].sum()),
+           "newton_steps": int(frame["newton_steps"].sum()),
+           "energy_error_finest": float(frame["energy_error"].iloc[-1]),
            "levels": len(rows), "final_ndofs": int(frame["ndofs"].iloc[-1]),
            "status": ",".join(sorted(set(frame["status"]))), "t_sequence": t_sequence,
            "t_linear_finest": t_linear}
@@ -74,15 +79,15 @@ def measure_sequence(strategy: str, max_dofs: int, backend: str | None = None,
 
 
 def run_sequences(sequences=SEQUENCES, backend=None, on_row=None,
-                  cells=(DEFAULT_CELL,)) -> pd.DataFrame:
-    """``measure_sequence`` for every (strategy, budget) and cell shape, each in its own
-    spawned process."""
+                  cells=(DEFAULT_CELL,), stopping=("fixed",)) -> pd.DataFrame:
+    """``measure_sequence`` for every (strategy, budget), cell shape and stopping rule, each
+    in its own spawned process."""
     from bench.perf.scaling import in_fresh_process
 
     rows = []
-    for (strategy, max_dofs), cell in itertools.product(sequences, cells):
+    for (strategy, max_dofs), cell, rule in itertools.product(sequences, cells, stopping):
         row = in_fresh_process(measure_sequence, strategy, max_dofs, backend, REFERENCE_DOFS,
-                               cell)
+                               cell, rule)
         rows.append(row)
         if on_row is not None:
             on_row(row)
@@ -96,12 +101,17 @@ def sequence_table(frame: pd.DataFrame) -> str:
         "sequence": frame["strategy"] + " to " + frame["max_dofs"].map(
             lambda n: f"{n:.2g}".replace("e+0", "e").replace("e+", "e"))
         + frame.get("cell", pd.Series("tri", index=frame.index)).map(
-            lambda c: "" if c == DEFAULT_CELL else f", {c}"),
+            lambda c: "" if c == DEFAULT_CELL else f", {c}")
+        + frame.get("stopping", pd.Series("fixed", index=frame.index)).map(
+            lambda r: "" if r == "fixed" else f", {r} stopping"),
         "levels": frame["levels"], "finest N": frame["final_ndofs"],
         "whole sequence [s]": frame["t_sequence"].map("{:.1f}".format),
         "linear solve at finest [s]": frame["t_linear_finest"].map("{:.2f}".format),
         "sequence / linear": frame["sequence_over_linear"].map("{:.1f}".format),
         "peak [GiB]": frame["peak_gib"].map("{:.2f}".format),
+        "Krylov iterations": frame.get("krylov_iterations", pd.Series(0, index=frame.index)),
+        "error at finest": frame.get("energy_error_finest", pd.Series(np.nan, index=frame.index))
+        .map("{:.3g}".format),
     })
     for phase in (*LEVEL_PHASES, "t_store"):
         name = phase.removeprefix("t_")
