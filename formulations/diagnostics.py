@@ -40,7 +40,7 @@ def inf_sup_constant(discretisation, backend: str | None = None,
     if multiplier_gram is None or qp is None or qp.m == 0:
         return float("nan")
     if condensed is None:
-        solve = factorise(qp.K, backend)
+        solve = factorise(qp.K, backend, qp.near_null)
         Bt = qp.B.T.tocsc()
         X = np.column_stack([solve(Bt[:, k:k + SOLVE_BLOCK].toarray())
                              for k in range(0, qp.m, SOLVE_BLOCK)])

@@ -109,7 +109,7 @@ def solve_active_set(qp: ContactQP, warm_start: np.ndarray | None = None,
         u, lam, iterations, status, reason, diagnostics = (
             solve_projected(qp, active, max_iter, backend, stopping, initial)
             if iterative(backend)
-            else solve_augmented(qp, active, max_iter))
+            else solve_augmented(qp, active, max_iter, stopping))
         if status != STATUS_OK:
             return _fallback(qp, f"plain active set failed ({reason})", diagnostics, start)
         return QPSolution(u=u, multipliers=lam, status=status, reason=reason,

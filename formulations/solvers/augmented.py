@@ -11,6 +11,8 @@ level costs one to three factorisations.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 from scipy import sparse
 from scipy.sparse.linalg import LinearOperator, onenormest, splu
@@ -18,6 +20,7 @@ from scipy.sparse.linalg import LinearOperator, onenormest, splu
 from formulations.base import STATUS_FAILED, STATUS_OK, ContactQP, SolverDiagnostics
 from formulations.solvers.backends import factorise
 from formulations.solvers.lcp import SINGULAR
+from formulations.solvers.stopping import FIXED_STOPPING, QPLinearisation, Stopping
 
 VIOLATION_TOLERANCE = 1e-12  # relative to the displacement scale: round-off, not penetration
 
@@ -46,10 +49,13 @@ def condition_estimate(system: sparse.csc_matrix, lu) -> float:
     return float(abs(system).sum(axis=0).max() * norm)
 
 
-def solve_augmented(qp: ContactQP, active: np.ndarray, max_iter: int):
+def solve_augmented(qp: ContactQP, active: np.ndarray, max_iter: int,
+                    stopping: Stopping = FIXED_STOPPING):
     """Returns (u, lambda, iterations, status, reason, diagnostics): the diagnostics hold the
     active-set changes of every iteration, whether a set repeated (``cycled``) and the
-    condition estimate of the last (scaled) saddle-point matrix factorised."""
+    condition estimate of the last (scaled) saddle-point matrix factorised. An adaptive
+    ``stopping`` ends the iteration at the first iterate whose eta_lin meets its criterion
+    (each solve is direct: no algebraic part; docs/theory.md, 18.3)."""
     n, m = qp.n, qp.m
     # scaled like the reference: K / E, rows of B / row_scale (an O(1) saddle-point matrix)
     K = sparse.csr_matrix(qp.K) / qp.objective_scale
@@ -89,6 +95,10 @@ def solve_augmented(qp: ContactQP, active: np.ndarray, max_iter: int):
         changes.append(int((new_active != active).sum()))
         if changes[-1] == 0:
             return u, lam, iteration, STATUS_OK, "", diagnostics(False, system, lu)
+        if stopping.adaptive and stopping.newton_done(
+                QPLinearisation(qp.K, qp.B, qp.G)(u, lam, stopping.load_norm)):
+            return (u, lam, iteration, STATUS_OK, "",
+                    replace(diagnostics(False, system, lu), stopped_early=True))
         active = new_active
     return (u, lam, max_iter, STATUS_FAILED,
             f"active set still changing after {max_iter} iterations", diagnostics(False))

@@ -104,6 +104,14 @@ class Stopping:
 FIXED_STOPPING = Stopping()
 
 
+@dataclass(frozen=True)
+class _Diagonal:
+    inverse: np.ndarray
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        return self.inverse * b
+
+
 @dataclass(frozen=True, eq=False)
 class QPLinearisation:
     """eta_lin of a QP's iterates (module docstring): one factorisation of B B' per QP."""
@@ -114,7 +122,19 @@ class QPLinearisation:
 
     @functools.cached_property
     def gram(self):
-        return splu(sparse.csc_matrix(self.B @ self.B.T)) if self.B.shape[0] else None
+        """A solve with B B'; where B B' is singular (dependent rows, e.g. a slack form's
+        rows on points no DOF reaches) its diagonal instead: then w is a lift only up to
+        the rows' overlap, which an estimate may live with."""
+        if not self.B.shape[0]:
+            return None
+        gram = sparse.csc_matrix(self.B @ self.B.T)
+        try:
+            return splu(gram)
+        except RuntimeError:
+            diagonal = gram.diagonal()
+            inverse = np.divide(1.0, diagonal, out=np.zeros_like(diagonal),
+                                where=diagonal > 0)
+            return _Diagonal(inverse)
 
     def __call__(self, u: np.ndarray, lam: np.ndarray, load_norm: LoadNorm) -> float:
         return self.measure(self.B @ u - self.G, lam, load_norm)
