@@ -10,9 +10,11 @@ import time
 from bench.measure.contact import zone_error
 from bench.measure.difference import solution_difference
 from bench.measure.discretisation_error import shear_error
+from bench.sequence.components import component_columns
 from formulations import STATUS_FAILED, STATUS_SKIPPED, SolverDiagnostics, solve
 from formulations.diagnostics import inf_sup_constant, pressure_oscillation
 from formulations.discretisation import why_unsolvable
+from formulations.elasticity import element_diameters
 from formulations.solvers.registry import REFERENCE_SOLVER
 
 
@@ -88,3 +90,33 @@ def crosscheck_columns(disc, sol) -> dict:
     energy, pressure = solution_difference(disc, sol, reference)
     out.update(crosscheck_energy_difference=energy, crosscheck_pressure_difference=pressure)
     return out
+
+
+def level_columns(disc, sol, mesh, options: dict) -> dict:
+    """The basic numbers of a solved level: sizes, energy, contact, residuals, status."""
+    h = element_diameters(mesh)
+    return dict(
+        ndofs=disc.ndofs, n_elements=mesh.t.shape[1], h_max=float(h.max()),
+        h_min=float(h.min()), max_h_over_H=sol.max_h_over_H, energy=sol.energy,
+        contact_force=sol.contact_force(), active_constraints=sol.active_constraints,
+        n_constraints=disc.n_constraints, iterations=sol.iterations, backend=sol.backend,
+        warm_started="warm_start" in options, t_solve=sol.solve_time, status=sol.status,
+        reason=sol.reason, **vars(sol.residuals))
+
+def solved_columns(scene, disc, sol, est, config, options: dict, truth,
+                   crosscheck: bool) -> dict:
+    """The columns of a solved level beyond its basic numbers: diagnostics, friction, the
+    estimate and its parts, the iterate's error components, the errors against ``truth``
+    (if given) and the reference solver's cross-check (if ``crosscheck``)."""
+    numbers = dict(diagnostic_columns(disc, sol, config.diagnostics, options.get("backend")),
+                   **friction_columns(scene, sol),
+                   eta=est.eta, eta_0=est.eta_0, eta_geometric=est.eta_geometric,
+                   eta_complementarity=est.eta_complementarity,
+                   **(est.bound.columns() if est.bound is not None else {}),
+                   **component_columns(sol, est))
+    if truth is not None:
+        numbers.update(error_columns(truth, sol, est))
+        numbers.update(total_effectivity(numbers))
+    if crosscheck:
+        numbers.update(crosscheck_columns(disc, sol))
+    return numbers

@@ -11,18 +11,14 @@ from dataclasses import dataclass, field, fields
 from skfem import MeshTri
 
 from bench.sequence.columns import (
-    crosscheck_columns,
-    diagnostic_columns,
-    error_columns,
-    friction_columns,
+    level_columns,
+    solved_columns,
     solver_columns,
-    total_effectivity,
 )
 from bench.sequence.components import (
     Previous,
     check_stopping_cell,
     check_stopping_settings,
-    component_columns,
     level_stopping,
 )
 from bench.sequence.marking import MARKINGS, check_marking, mark
@@ -40,7 +36,7 @@ from formulations import STATUS_FAILED, get_formulation, solve
 from formulations.cells import DEFAULT_CELL, check_cell, family_for
 from formulations.cells.base import Plan
 from formulations.discretisation import dense_block_size, takes_initial
-from formulations.elasticity import check_order, element_diameters
+from formulations.elasticity import check_order
 from formulations.solvers.backends import backend_names, check_backend, iterative
 from formulations.solvers.registry import REFERENCE_SOLVER
 from formulations.solvers.stopping import GAMMA_ALG, GAMMA_LIN, STOPPING_RULES
@@ -158,18 +154,6 @@ class LevelResult:
     estimate: object | None
 
 
-def level_columns(disc, sol, mesh, options: dict) -> dict:
-    """The basic numbers of a solved level: sizes, energy, contact, residuals, status."""
-    h = element_diameters(mesh)
-    return dict(
-        ndofs=disc.ndofs, n_elements=mesh.t.shape[1], h_max=float(h.max()),
-        h_min=float(h.min()), max_h_over_H=sol.max_h_over_H, energy=sol.energy,
-        contact_force=sol.contact_force(), active_constraints=sol.active_constraints,
-        n_constraints=disc.n_constraints, iterations=sol.iterations, backend=sol.backend,
-        warm_started="warm_start" in options, t_solve=sol.solve_time, status=sol.status,
-        reason=sol.reason, **vars(sol.residuals))
-
-
 def refinement(mesh: MeshTri, sol, est, config: LoopConfig) -> Plan:
     """The plan of the next mesh: uniform refinement, or marking (plus the contact grading
     closure)."""
@@ -215,6 +199,12 @@ def level_options(level: int, disc, solver: str, config: LoopConfig, route: Memo
     return options, route
 
 
+def refused_row(ident: dict, level: int, ndofs: int, mesh, reason: str) -> LevelResult:
+    """The failed row of a level that is not built."""
+    return LevelResult(ResultRow(**ident, level=level, ndofs=ndofs, n_elements=mesh.t.shape[1],
+                                 status=STATUS_FAILED, reason=reason), None, None)
+
+
 def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
                  config: LoopConfig, identity: dict | None = None,
                  mesh: MeshTri | None = None, truth=None, crosscheck_dofs: int = 0,
@@ -244,9 +234,7 @@ def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
         if refusal is not None:  # over the budget or the memory: a failed row says so
             end, reason = refusal
             if reason:  # a later level over the budget is just the end
-                yield LevelResult(ResultRow(**ident, level=level, ndofs=ndofs,
-                                            n_elements=mesh.t.shape[1], status=STATUS_FAILED,
-                                            reason=reason), None, None)
+                yield refused_row(ident, level, ndofs, mesh, reason)
             return end
         scene.check_mesh(mesh, level)
         start = time.perf_counter()
@@ -263,19 +251,10 @@ def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
                        t_assemble=t_assemble, t_refine=t_refine, t_estimate=t_estimate,
                        **(solver_columns(sol.diagnostics) if failed else {}))
         if not failed:
-            numbers.update(diagnostic_columns(disc, sol, config.diagnostics,
-                                              options.get("backend")))
-            numbers.update(friction_columns(scene, sol))
-            numbers.update(eta=est.eta, eta_0=est.eta_0, eta_geometric=est.eta_geometric,
-                           eta_complementarity=est.eta_complementarity,
-                           **(est.bound.columns() if est.bound is not None else {}),
-                           **component_columns(sol, est))
+            numbers.update(solved_columns(scene, disc, sol, est, config, options, truth,
+                                          solver != REFERENCE_SOLVER
+                                          and disc.ndofs <= crosscheck_dofs))
             predicted = Previous(numbers["eta_disc"], disc.ndofs)
-            if truth is not None:
-                numbers.update(error_columns(truth, sol, est))
-                numbers.update(total_effectivity(numbers))
-            if solver != REFERENCE_SOLVER and disc.ndofs <= crosscheck_dofs:
-                numbers.update(crosscheck_columns(disc, sol))
         reached = None if failed else target_reason(config, est)
         numbers["reason"] = "; ".join(filter(None, (numbers["reason"], route.note,
                                                     reached)))

@@ -69,6 +69,22 @@ def _fallback(qp: ContactQP, why: str, diagnostics: SolverDiagnostics,
                    diagnostics=replace(diagnostics, safeguard="reference fallback"))
 
 
+def _uncondensed(qp: ContactQP, warm_start, max_iter: int, backend: str, stopping: Stopping,
+                 initial, start: float) -> QPSolution:
+    """The iteration on a back-end without a Schur complement: projected CG (iterative) or
+    the augmented system (splu), the reference solver if it fails."""
+    active = (np.asarray(warm_start) > 0) if warm_start is not None else \
+        initial_active_set(qp, backend)
+    u, lam, iterations, status, reason, diagnostics = (
+        solve_projected(qp, active, max_iter, backend, stopping, initial)
+        if iterative(backend) else solve_augmented(qp, active, max_iter, stopping))
+    if status != STATUS_OK:
+        return _fallback(qp, f"plain active set failed ({reason})", diagnostics, start)
+    return QPSolution(u=u, multipliers=lam, status=status, reason=reason,
+                      iterations=iterations, solve_time=time.perf_counter() - start,
+                      solver=FAST_SOLVER, backend=backend, diagnostics=diagnostics)
+
+
 def dense_block_size(qp: ContactQP, backend: str | None = None) -> int:
     """The columns of the dense Schur block ``solve_active_set`` forms on ``backend`` (0: the
     back-end does not condense): every DOF the constraint rows touch, and the tangential rows'
@@ -104,17 +120,7 @@ def solve_active_set(qp: ContactQP, warm_start: np.ndarray | None = None,
             return answer
         return _fallback(qp, answer.reason, answer.diagnostics, start)
     if not condenses(backend):
-        active = (np.asarray(warm_start) > 0) if warm_start is not None else \
-            initial_active_set(qp, backend)
-        u, lam, iterations, status, reason, diagnostics = (
-            solve_projected(qp, active, max_iter, backend, stopping, initial)
-            if iterative(backend)
-            else solve_augmented(qp, active, max_iter, stopping))
-        if status != STATUS_OK:
-            return _fallback(qp, f"plain active set failed ({reason})", diagnostics, start)
-        return QPSolution(u=u, multipliers=lam, status=status, reason=reason,
-                          iterations=iterations, solve_time=time.perf_counter() - start,
-                          solver=FAST_SOLVER, backend=backend, diagnostics=diagnostics)
+        return _uncondensed(qp, warm_start, max_iter, backend, stopping, initial, start)
     factor = factorise_condensed(qp.K, np.unique(qp.B.indices), backend)
     clock = time.perf_counter()
     u0 = factor.solve(qp.F)

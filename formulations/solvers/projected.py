@@ -102,6 +102,14 @@ def next_rows(qp: ContactQP, active: np.ndarray, u: np.ndarray, lam: np.ndarray)
     return np.where(active, lam > -zero, slack < -VIOLATION_TOLERANCE * scale)
 
 
+def settled_multipliers(lam: np.ndarray, rows: np.ndarray, changes: int) -> np.ndarray:
+    """The multipliers returned: on a set that settled, the active rows' zero-to-accuracy
+    ones exactly zero (as on the fixed route); an early stop keeps the signs it has."""
+    if changes == 0:
+        lam[rows] = np.maximum(lam[rows], 0.0)
+    return lam
+
+
 def solve_set(qp: ContactQP, K, precondition, project, multipliers, active: np.ndarray,
               u: np.ndarray, rtol: float, counts: list[int], stopping: Stopping,
               eta_lin: float) -> tuple[np.ndarray, str, float]:
@@ -171,11 +179,9 @@ def solve_projected(qp: ContactQP, active: np.ndarray, max_iter: int, backend: s
         if stopping.adaptive:
             eta_lin = linearisation(u, lam, stopping.load_norm)
             if solved and (changes[-1] == 0 or stopping.newton_done(eta_lin)):
-                if changes[-1] == 0:  # as below: the zero-to-accuracy ones exactly zero
-                    lam[rows] = np.maximum(lam[rows], 0.0)
-                return (u, lam, iteration, STATUS_OK, "",
-                        replace(diagnostics(False),
-                                stopped_early=changes[-1] != 0 or how == "rule"))
+                return (u, settled_multipliers(lam, rows, changes[-1]), iteration, STATUS_OK,
+                        "", replace(diagnostics(False),
+                                    stopped_early=changes[-1] != 0 or how == "rule"))
         if changes[-1] == 0 and rtol == RTOL:
             lam[rows] = np.maximum(lam[rows], 0.0)  # the zero-to-accuracy ones: exactly zero
             return u, lam, iteration, STATUS_OK, "", diagnostics(False)
