@@ -64,6 +64,7 @@ def solve_augmented(qp: ContactQP, active: np.ndarray, max_iter: int,
     F = qp.F / qp.objective_scale
     seen, changes = set(), []
     u, lam = np.zeros(n), np.zeros(m)
+    linearisation = QPLinearisation(qp.K, qp.B, qp.G)
 
     def diagnostics(cycled, system=None, lu=None):
         return SolverDiagnostics(
@@ -96,7 +97,7 @@ def solve_augmented(qp: ContactQP, active: np.ndarray, max_iter: int,
         if changes[-1] == 0:
             return u, lam, iteration, STATUS_OK, "", diagnostics(False, system, lu)
         if stopping.adaptive and stopping.newton_done(
-                QPLinearisation(qp.K, qp.B, qp.G)(u, lam, stopping.load_norm)):
+                linearisation(u, lam, stopping.load_norm)):
             return (u, lam, iteration, STATUS_OK, "",
                     replace(diagnostics(False, system, lu), stopped_early=True))
         active = new_active

@@ -112,11 +112,10 @@ def settled_multipliers(lam: np.ndarray, rows: np.ndarray, changes: int) -> np.n
 
 def solve_set(qp: ContactQP, K, precondition, project, multipliers, active: np.ndarray,
               u: np.ndarray, rtol: float, counts: list[int], stopping: Stopping,
-              eta_lin: float) -> tuple[np.ndarray, str, float]:
+              eta_lin: float, linearisation: QPLinearisation) -> tuple[np.ndarray, str, float]:
     """CG on one active set from ``u``: (u, how it ended, eta_lin). Under an adaptive rule
     the solve ends by its eta_alg criterion, which uses eta_lin, which the solve itself
     changes: solved on while eta_lin falls."""
-    linearisation = QPLinearisation(K, qp.B, qp.G)
     for _ in range(RESOLVES):
         done = (lambda r, e=eta_lin: stopping.krylov_done(r, e)) if stopping.adaptive \
             else None
@@ -172,7 +171,8 @@ def solve_projected(qp: ContactQP, active: np.ndarray, max_iter: int, backend: s
             u, counts, solved, how = np.zeros(qp.n), counts + [0], True, "tolerance"
         else:  # the last u, moved onto the new set
             u, how, eta_lin = solve_set(qp, K, precondition, project, multipliers, active,
-                                        project(u) + u_p, rtol, counts, stopping, eta_lin)
+                                        project(u) + u_p, rtol, counts, stopping, eta_lin,
+                                        linearisation)
             solved = how == "rule" or rtol <= RTOL
         lam, new_active = next_active_set(qp, active, u, K, multipliers)
         changes.append(int((new_active != active).sum()))
