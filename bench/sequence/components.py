@@ -37,8 +37,8 @@ class Previous:
     ndofs: int
 
 
-def measured(scene, estimator: str, rule: str) -> bool:
-    """Whether a level's components are measured: under the adaptive rule, and with a
+def measured(estimator: str, rule: str) -> bool:
+    """Whether a level's components are measured: under the adaptive rule, or with a
     guaranteed estimator (whose domain constants are computed anyway)."""
     return rule == ADAPTIVE or bool(ESTIMATORS.meta(estimator, "guaranteed", False))
 
@@ -55,7 +55,7 @@ def expected_disc(previous: Previous | None, ndofs: int, order: int, dim: int) -
 def level_stopping(scene, disc, config, estimator: str, previous: Previous | None) -> Stopping:
     """The stopping rule of a level's solve (``config``: a ``LoopConfig``)."""
     rule = config.stopping
-    if not measured(scene, estimator, rule) or not simplex_mesh(disc.elasticity):
+    if not measured(estimator, rule) or not simplex_mesh(disc.elasticity):
         return Stopping(rule=rule, gamma_alg=config.gamma_alg, gamma_lin=config.gamma_lin)
     norm = load_norm(disc.elasticity, domain_constants(scene).friedrichs)
     return Stopping(rule=rule, load_norm=norm,
