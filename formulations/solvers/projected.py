@@ -140,10 +140,8 @@ def solve_projected(qp: ContactQP, active: np.ndarray, max_iter: int, backend: s
     precondition = factorise(qp.K, backend, qp.near_null).preconditioner.matvec
     K = sparse.csr_matrix(qp.K)
     seen, changes, counts = set(), [], []
-    # under an adaptive rule every solve ends by the rule (RTOL a floor): it is the search
-    # tolerance, loose while eta_lin is large
     u, lam = np.zeros(qp.n), np.zeros(qp.m)
-    rtol = RTOL if stopping.adaptive else SEARCH_RTOL
+    rtol = RTOL if stopping.adaptive else SEARCH_RTOL  # adaptive: the rule ends every solve
     if initial is not None:
         u[:min(initial.size, qp.n)] = initial[:qp.n]
     linearisation, eta_lin = QPLinearisation(K, qp.B, qp.G), float("nan")
@@ -182,9 +180,9 @@ def solve_projected(qp: ContactQP, active: np.ndarray, max_iter: int, backend: s
                 return (u, settled_multipliers(lam, rows, changes[-1]), iteration, STATUS_OK,
                         "", replace(diagnostics(False),
                                     stopped_early=changes[-1] != 0 or how == "rule"))
-        if changes[-1] == 0 and rtol == RTOL:
-            lam[rows] = np.maximum(lam[rows], 0.0)  # the zero-to-accuracy ones: exactly zero
-            return u, lam, iteration, STATUS_OK, "", diagnostics(False)
+        if changes[-1] == 0 and rtol == RTOL:  # settled and exact
+            return u, settled_multipliers(lam, rows, 0), iteration, STATUS_OK, "", \
+                diagnostics(False)
         if changes[-1] == 0:
             rtol = RTOL  # the set has settled: solve it exactly
         active = new_active
