@@ -12,19 +12,29 @@ from bench.hard.verdicts import ACCURATE
 from bench.matrix.files import atomic_text, atomic_write
 
 
+def cell_text(value) -> str:
+    """A hard table cell as an entry matches it: "" for NaN, integers without a decimal."""
+    if value is None or pd.isna(value):
+        return ""
+    if isinstance(value, float) and value.is_integer():
+        return str(int(value))
+    return str(value)
+
+
 def check_expected(table: pd.DataFrame, expected: list[dict]) -> list[dict]:
-    """Each row's verdict against the first matching [[hard]] entry (default: accurate); an
-    entry's verdict may list alternatives, "accurate|inaccurate", for a borderline case. A
-    skipped row (cells that cannot carry the scene) judges no solve and is not checked."""
+    """Each row's verdict against the first matching [[hard]] entry (default: accurate),
+    matched by case, formulation, solver, variant and ndofs (shell patterns, each "*" when
+    left out); an entry's verdict may list alternatives, "accurate|inaccurate", for a
+    borderline case. A skipped row (cells that cannot carry the scene) judges no solve and is
+    not checked."""
     out = []
     for _, row in table.iterrows():
         if row.get("status") == "skipped":
             continue
         want, source = ACCURATE, "default: every solve accurate"
         for entry in expected:
-            if all(fnmatch.fnmatch("" if pd.isna(row[k]) else str(row[k]),
-                                   str(entry.get(k, "*")))
-                   for k in ("case", "formulation", "solver", "variant")):
+            if all(fnmatch.fnmatch(cell_text(row.get(k)), str(entry.get(k, "*")))
+                   for k in ("case", "formulation", "solver", "variant", "ndofs")):
                 want, source = entry["verdict"], entry["source"]
                 break
         out.append({"case": row["case"], "formulation": row["formulation"],

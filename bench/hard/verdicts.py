@@ -14,6 +14,9 @@ pressure counts because a penalty pressure (u_hn - g_h)_+ / eps magnifies an err
   ``PRESSURE_TOLERANCE``;
 * ``inaccurate``: converged (status ok or inaccurate) but above either bar -- the loss columns
   give the measured loss;
+* ``contact unresolved``: converged, but the discrete constraint did not see the contact (the
+  penetration undoes more than a tenth of the obstacle's approach, or nothing is active where
+  the obstacle is pushed in: ``bench.measure.contact``), whatever the loss;
 * ``failed``: no solution; the reason says why;
 * ``refused``: an invalid problem, rejected with a clear error before any solve.
 
@@ -27,7 +30,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from bench.measure.contact import penetration
+from bench.measure.contact import STATUS_UNRESOLVED, contact_resolution
 from bench.measure.difference import solution_difference
 from formulations import STATUS_FAILED, STATUS_OK, get_formulation, solve, solver_names
 from formulations.diagnostics import inf_sup_constant, pressure_oscillation
@@ -41,10 +44,13 @@ LOSS_TOLERANCE = 1e-6  # the same bar as a residual for status "ok" (formulation
 # formulations.methods.penalty.PRESSURE_CONSISTENCY) separates that from a wrong pressure
 PRESSURE_TOLERANCE = 1e-3
 ACCURATE, INACCURATE, FAILED, REFUSED = "accurate", "inaccurate", "failed", "refused"
+UNRESOLVED = STATUS_UNRESOLVED
 
 
 def _record(case, scene, formulation, disc, sol, variant, level) -> dict:
     residual = max(vars(sol.residuals).values())
+    solved = sol.status != STATUS_FAILED
+    resolution = contact_resolution(scene, sol) if solved else None
     return dict(case=case, scene=scene.name, formulation=formulation, solver=sol.solver,
                 variant=variant, level=level, ndofs=disc.ndofs, status=sol.status,
                 reason=sol.reason, backend=sol.backend,
@@ -54,8 +60,10 @@ def _record(case, scene, formulation, disc, sol, variant, level) -> dict:
                 inf_sup=np.nan, pressure_oscillation=pressure_oscillation(sol),
                 contact_force=sol.contact_force() if sol.status != STATUS_FAILED else np.nan,
                 active_constraints=sol.active_constraints, n_constraints=disc.n_constraints,
-                penetration=penetration(scene, sol) if sol.status != STATUS_FAILED else np.nan,
-                finding="")
+                penetration=resolution.penetration if solved else np.nan,
+                nodal_penetration=resolution.nodal_penetration if solved else np.nan,
+                penetration_share=resolution.penetration_share if solved else np.nan,
+                unresolved=resolution.unresolved if solved else "", finding="")
 
 
 def _certificate(record: dict, sol) -> float:
@@ -66,9 +74,11 @@ def _certificate(record: dict, sol) -> float:
     return value if np.isfinite(value) else np.inf
 
 
-def verdict(status: str, loss: float, pressure_loss: float = 0.0) -> str:
+def verdict(status: str, loss: float, pressure_loss: float = 0.0, unresolved: str = "") -> str:
     if status == STATUS_FAILED or not np.isfinite(loss):
         return FAILED
+    if unresolved:
+        return UNRESOLVED
     accurate = loss <= LOSS_TOLERANCE and pressure_loss <= PRESSURE_TOLERANCE
     return ACCURATE if status == STATUS_OK and accurate else INACCURATE
 
@@ -95,5 +105,6 @@ def solve_both(case: str, scene: Scene, formulation: str, mesh, variant: str = "
         # the penalty's own pressure self-check is a measured pressure loss too
         record.update(loss=max(record["max_residual"], differences[0]),
                       pressure_loss=max(differences[1], sol.pressure_mismatch), inf_sup=beta)
-        record["verdict"] = verdict(record["status"], record["loss"], record["pressure_loss"])
+        record["verdict"] = verdict(record["status"], record["loss"], record["pressure_loss"],
+                                    record["unresolved"])
     return records, solutions

@@ -7,11 +7,11 @@ from __future__ import annotations
 import math
 import time
 
-from bench.measure.contact import zone_error
+from bench.measure.contact import STATUS_UNRESOLVED, contact_resolution, zone_error
 from bench.measure.difference import solution_difference
 from bench.measure.discretisation_error import shear_error
 from bench.sequence.components import component_columns
-from formulations import STATUS_FAILED, STATUS_SKIPPED, SolverDiagnostics, solve
+from formulations import STATUS_FAILED, STATUS_OK, STATUS_SKIPPED, SolverDiagnostics, solve
 from formulations.diagnostics import inf_sup_constant, pressure_oscillation
 from formulations.discretisation import why_unsolvable
 from formulations.elasticity import element_diameters
@@ -103,6 +103,17 @@ def level_columns(disc, sol, mesh, options: dict) -> dict:
         warm_started="warm_start" in options, t_solve=sol.solve_time, status=sol.status,
         reason=sol.reason, **vars(sol.residuals))
 
+def resolution_columns(scene, sol) -> dict:
+    """The penetration columns of a solved level and, when the discrete constraint did not see
+    the contact, the status ``contact unresolved`` with the reason (never a plain ok)."""
+    resolution = contact_resolution(scene, sol)
+    out = resolution.columns()
+    if resolution.unresolved and sol.status == STATUS_OK:
+        out.update(status=STATUS_UNRESOLVED, reason="; ".join(filter(None, (
+            sol.reason, resolution.unresolved))))
+    return out
+
+
 def solved_columns(scene, disc, sol, est, config, options: dict, truth,
                    crosscheck: bool) -> dict:
     """The columns of a solved level beyond its basic numbers: diagnostics, friction, the
@@ -113,7 +124,7 @@ def solved_columns(scene, disc, sol, est, config, options: dict, truth,
                    eta=est.eta, eta_0=est.eta_0, eta_geometric=est.eta_geometric,
                    eta_complementarity=est.eta_complementarity,
                    **(est.bound.columns() if est.bound is not None else {}),
-                   **component_columns(sol, est))
+                   **component_columns(sol, est), **resolution_columns(scene, sol))
     if truth is not None:
         numbers.update(error_columns(truth, sol, est))
         numbers.update(total_effectivity(numbers))

@@ -60,6 +60,11 @@ class ResultRow:
     zone_error: float = math.nan
     contact_zone_start: float = math.nan
     contact_zone_end: float = math.nan
+    # how far u_h goes through the obstacle (bench.measure.contact, docs/theory.md, 19.1)
+    penetration: float = math.nan
+    nodal_penetration: float = math.nan
+    approach: float = math.nan
+    penetration_share: float = math.nan
     friction: str = ""  # the scene's friction law (scenes.friction): none, tresca, coulomb(mu=..)
     stick_points: int = 0
     slip_points: int = 0

@@ -69,15 +69,23 @@ def star_patches(surface, admissible: np.ndarray) -> np.ndarray:
     patch = np.full(v.shape[1], -1)
     has = hits.any(axis=0)
     patch[has] = patch_of_centre[v[hits.argmax(axis=0), np.arange(v.shape[1])]][has]
+    return join_by_vertex(v, patch, n_vertices)
+
+
+def join_by_vertex(vertices: np.ndarray, patch: np.ndarray, n_vertices: int) -> np.ndarray:
+    """Give every triangle without a patch (-1) a patch it shares a vertex with; triangles out
+    of reach of any patch get their own."""
+    patch = patch.copy()
     while (patch < 0).any():
         of_vertex = np.full(n_vertices, -1)
-        np.maximum.at(of_vertex, v[:, patch >= 0].ravel(), np.tile(patch[patch >= 0], 3))
-        joined = np.where(patch < 0, of_vertex[v].max(axis=0), patch)
-        if np.array_equal(joined, patch):  # triangles out of reach of any star: their own
+        np.maximum.at(of_vertex, vertices[:, patch >= 0].ravel(),
+                      np.tile(patch[patch >= 0], 3))
+        joined = np.where(patch < 0, of_vertex[vertices].max(axis=0), patch)
+        if np.array_equal(joined, patch):
             left = patch < 0
             joined[left] = patch.max() + 1 + np.arange(left.sum())
         patch = joined
-    return patch
+    return np.unique(patch, return_inverse=True)[1]
 
 
 def patches(surface, kind: str, admissible: np.ndarray) -> np.ndarray:

@@ -19,15 +19,14 @@ On a quadrilateral hierarchy the segments are the seed's T_CH instead: the Gamma
 contact cells' ancestors log2(H/h) levels up (one for h/H = 1/2), from the cell family
 (``formulations.cells``; docs/theory.md, section 15.3).
 
-On tetrahedra (``discretise_surface``, docs/theory.md, section 14.7) lambda_H is piecewise
-constant on patches of contact triangles, each holding the whole star of a vertex
-(``formulations.contact.patches``), for P1 and P2 alike.
+On tetrahedra (``formulations.methods.mixed_surface``, docs/theory.md, section 19.2) lambda_H
+lives on the contact surface one level coarser: piecewise constant on its triangles (P1) or
+continuous piecewise linear (P2).
 """
 
 from __future__ import annotations
 
 import functools
-from dataclasses import dataclass
 from math import comb
 
 import numpy as np
@@ -36,38 +35,19 @@ from skfem import MeshTri
 
 from formulations.base import ContactQP, DiscreteSolution, QPSolution, Residuals
 from formulations.cells import family_of
-from formulations.cells.evaluation import drop_roundoff, normal_trace_matrix
+from formulations.cells.evaluation import normal_trace_matrix
 from formulations.contact import contact_trace
-from formulations.contact.patches import (
-    free_normal_vertices,
-    patch_sizes,
-    patch_sum,
-    patches,
-)
 from formulations.contact.reference_facets import gauss_legendre
 from formulations.discretisation import Discretisation, discrete_solution
 from formulations.elasticity import assemble_elasticity, check_order
-from formulations.friction.mixed import (
-    mixed_friction_rows,
-    mixed_friction_state,
-    surface_friction_rows,
-    surface_friction_state,
-)
+from formulations.friction.mixed import mixed_friction_rows, mixed_friction_state
 from formulations.kkt import count_active
+from formulations.methods.mixed_surface import MixedDetails, discretise_surface
 from formulations.registry import register_formulation
 from scenes import Scene
 from scenes.base import is_integer, is_number
 
 GAP_QUADRATURE_POINTS = 6  # G_i = int g: g is smooth on each facet; 6 Gauss points is plenty
-GAP_RULE_DEGREE = 6  # the same on a contact triangle: a rule exact to degree 6
-
-
-@dataclass(frozen=True, eq=False)
-class MixedDetails:
-    """The mixed method's own arrays: the multiplier segment (3D: patch) of every contact
-    facet."""
-
-    segment_of_facet: np.ndarray
 
 
 def multiplier_segments(lengths: np.ndarray, h_over_H: float = 0.5) -> np.ndarray:
@@ -160,29 +140,40 @@ def no_multiplier_space(scene=None, family=None, **_) -> str | None:
 
 @register_formulation("mixed", "Haslinger's mixed method: multiplier of degree p - 1 "
                                "(piecewise constant for P1) on a coarser contact mesh, "
-                               "h/H <= 1/2 (seed paper, eq. (3)); in 3D piecewise constant "
-                               "on vertex-star patches of contact triangles; Tresca or "
+                               "h/H <= 1/2 (seed paper, eq. (3)); in 3D on the contact "
+                               "surface one level coarser, piecewise constant (P1) or "
+                               "continuous piecewise linear (P2); Tresca or "
                                "Coulomb friction with a tangential multiplier in the same "
                                "space (2D and 3D)", no_multiplier_space, friction=(2, 3))
-def discretise(scene: Scene, mesh: MeshTri, h_over_H: float = 0.5, order: int = 1,
-               multiplier_degree: int | None = None) -> Discretisation:
+def discretise(scene: Scene, mesh: MeshTri, h_over_H: float | None = None, order: int = 1,
+               multiplier_degree: int | None = None,
+               multiplier_mesh: str | None = None) -> Discretisation:
     """``h_over_H``: the largest allowed ratio of a facet to its multiplier segment. The
-    paper's 1/2 (default) keeps the pair uniformly inf-sup stable; 1 (multiplier mesh = trace
-    mesh) is not guaranteed to be (a hard case, see ``formulations.diagnostics``).
+    paper's 1/2 (the default in 2D) keeps the pair uniformly inf-sup stable; 1 (multiplier
+    mesh = trace mesh) is not guaranteed to be (a hard case, see ``formulations.diagnostics``).
     ``multiplier_degree``: the polynomial degree q of lambda_H on each segment (default
     p - 1, docs/theory.md, section 9). On a quadrilateral hierarchy h_over_H = 2^-k takes the
-    edges k levels up (module docstring). On tetrahedra (``discretise_surface``) h_over_H = 1/2
-    means star patches, 1 the contact triangles, and q is 0."""
+    edges k levels up (module docstring). On tetrahedra (``mixed_surface``) h_over_H = 1/2
+    means the surface one level coarser, 1 the contact triangles, q is 0 or 1 (default 1:
+    P1 on the coarse surface, P2 on the trace mesh), and ``multiplier_mesh = "star"`` takes
+    the vertex-star patches instead (q = 0, the default with friction)."""
     why = no_multiplier_space(family=family_of(mesh))
     if why is not None:
         raise ValueError(why)
     return MULTIPLIER_SPACES[family_of(mesh).contact_boundary](scene, mesh, h_over_H, order,
-                                                               multiplier_degree)
+                                                               multiplier_degree,
+                                                               multiplier_mesh)
 
 
-def discretise_segments(scene: Scene, mesh, h_over_H: float, order: int,
-                        multiplier_degree: int | None) -> Discretisation:
-    """The mixed method on a 2D Gamma_C: lambda_H of degree q on segments of edges."""
+def discretise_segments(scene: Scene, mesh, h_over_H: float | None, order: int,
+                        multiplier_degree: int | None,
+                        multiplier_mesh: str | None = None) -> Discretisation:
+    """The mixed method on a 2D Gamma_C: lambda_H of degree q on segments of edges (the
+    coarser contact mesh; ``multiplier_mesh`` has no other value here)."""
+    h_over_H = 0.5 if h_over_H is None else h_over_H
+    if multiplier_mesh not in (None, "coarse"):
+        raise ValueError(f"multiplier_mesh={multiplier_mesh!r} is not allowed on a 2D contact "
+                         f"boundary: coarse")
     order, degree = checked_options(h_over_H, order, multiplier_degree)
     elasticity = assemble_elasticity(scene, mesh, order)
     trace = contact_trace(scene, mesh)
@@ -230,55 +221,6 @@ def discretise_segments(scene: Scene, mesh, h_over_H: float, order: int,
     return Discretisation(formulation="mixed", elasticity=elasticity, trace=trace, qp=qp,
                           recover=recover, row_coordinate=row_coordinate,
                           multiplier_gram=gram)
-
-
-def discretise_surface(scene: Scene, mesh, h_over_H: float, order: int,
-                       multiplier_degree: int | None) -> Discretisation:
-    """The mixed method on tetrahedra (docs/theory.md, section 14.7): lambda_H piecewise
-    constant on the patches of ``formulations.contact.patches`` (star patches for
-    h_over_H = 1/2, the contact triangles for 1), whatever p: B_(P) j = int_P phi_j . n ds,
-    G_P = int_P g ds, and the multiplier of row P is lambda_H on P."""
-    if not (is_number(h_over_H) and h_over_H in (0.5, 1.0)):
-        raise ValueError(f"h_over_H={h_over_H!r} is not allowed on a 3D contact surface: 0.5 "
-                         f"(vertex-star patches) or 1 (the contact triangles)")
-    if multiplier_degree not in (None, 0):
-        raise ValueError(f"multiplier_degree={multiplier_degree!r} is not allowed on a 3D "
-                         f"contact surface: 0 (piecewise constant on patches)")
-    elasticity = assemble_elasticity(scene, mesh, check_order(order))
-    surface = contact_trace(scene, mesh)
-    admissible = free_normal_vertices(surface, elasticity.basis.nodal_dofs, elasticity.free)
-    patch = patches(surface, "star" if h_over_H < 1 else "triangle", admissible)
-    area, H = patch_sizes(surface, patch)
-    t, w = surface.rule(elasticity.order)  # phi_j . n has degree p on a flat triangle
-    weights = patch_sum(patch, t.shape[1]) @ sparse.diags(np.outer(surface.measure, w).ravel())
-    B = weights @ normal_trace_matrix(elasticity.basis, surface, t)
-    friction, frame = surface_friction_rows(scene, elasticity, surface, patch, weights, t,
-                                            surface.rule(GAP_RULE_DEGREE))
-    t, w = surface.rule(GAP_RULE_DEGREE)
-    G = patch_sum(patch, t.shape[1]) @ (np.asarray(scene.gap(surface.points(t)))
-                                        * np.outer(surface.measure, w)).ravel()
-    qp = ContactQP(K=elasticity.K_free, F=elasticity.F_free,
-                   B=drop_roundoff(elasticity.restrict(B)), G=G, row_scale=area,
-                   objective_scale=float(scene.material.young_modulus),
-                   near_null=elasticity.rigid_modes, friction=friction)
-    centroid = np.array([np.bincount(patch, weights=c * surface.measure) / area
-                         for c in surface.coordinate.mean(axis=1)])
-
-    def recover(answer: QPSolution, residuals: Residuals, status: str,
-                reason: str) -> DiscreteSolution:
-        lam = np.maximum(answer.multipliers, 0.0)
-        return discrete_solution(
-            "mixed", elasticity, surface, answer, residuals, status, reason, u_free=answer.u,
-            pressure=lambda tt: np.repeat(lam[patch][:, None], np.shape(tt)[-1], axis=1),
-            multiplier_breaks=np.zeros(0), active_constraints=count_active(qp, answer.u, lam),
-            max_h_over_H=float(np.sqrt(surface.measure / area[patch]).max()),
-            details=MixedDetails(segment_of_facet=patch),
-            friction=None if friction is None else surface_friction_state(
-                friction, answer.u, lam, answer.tangential, centroid, patch, frame))
-
-    # sum_P H_P ||mu||_{0,P}^2 = H_P |P| mu_P^2 (in 2D H_S^2, as |S| = H_S)
-    return Discretisation(formulation="mixed", elasticity=elasticity, trace=surface, qp=qp,
-                          recover=recover, row_coordinate=centroid, multiplier_gram=H * area)
 
 
 # the multiplier space of the mixed method on each contact boundary (formulations.contact)

@@ -6,6 +6,7 @@ from bench.hard.cases import (  # noqa: F401
     cycling,
     friction,
     invalid,
+    lost_contact,
     mixed_patches_3d,
     mixed_ratio,
     nitsche_gamma,

@@ -24,7 +24,7 @@ def penalty_sweep() -> list[dict]:
         rows, _ = solve_both("penalty-eps", scene, "penalty", mesh, variant=f"eps_0={eps:g}",
                              level=3, epsilon_0=eps)
         for row in rows:
-            row["finding"] = f"penetration {row['penetration']:.2e}" + (
+            row["finding"] = f"nodal penetration {row['nodal_penetration']:.2e}" + (
                 f", condition {row['condition_estimate']:.2e}"
                 if np.isfinite(row["condition_estimate"]) else "")
         records += rows
@@ -39,7 +39,7 @@ def penalty_figure(rows: pd.DataFrame):
     axes = fig.subplots(1, 2)
     fast = rows[rows["solver"] == FAST_SOLVER]
     eps = fast["variant"].str.split("=").str[1].astype(float)
-    axes[0].loglog(eps, fast["penetration"], marker="o", label="max penetration")
+    axes[0].loglog(eps, fast["nodal_penetration"], marker="o", label="max nodal penetration")
     axes[0].loglog(eps, fast["condition_estimate"], marker="s", label="condition estimate")
     axes[0].set(xlabel="eps_0", title=f"penalty ({FAST_SOLVER}): penetration, conditioning")
     for solver, group in rows.groupby("solver"):
