@@ -9,6 +9,7 @@ import numpy as np
 import pandas as pd
 
 from bench.matrix.store import ResultsError, read_results
+from bench.measure.contact import SOLVED_STATUSES
 
 COMPARED = ("energy", "contact_force", "eta", "eta_0", "energy_error", "pressure_error",
             "effectivity_index")
@@ -61,7 +62,7 @@ def diff_results(old_folder, new_folder) -> pd.DataFrame:
         if missing:
             raise ResultsError(f"results folder {str(folder)!r} is of another schema: no "
                                f"column {', '.join(missing)}; rerun it with this version")
-        tables.append(table[(table["status"] == "ok") & (table["level"] >= 0)])
+        tables.append(table[table["status"].isin(SOLVED_STATUSES) & (table["level"] >= 0)])
     old, new = tables
     rows = []
     for key in sorted(set(old["sequence_key"]) | set(new["sequence_key"])):

@@ -16,6 +16,9 @@ UNRESOLVED_SHARE = 0.1  # a discrete constraint that lets the body undo more tha
 SAMPLE_DEGREE = 4  # the interior sample points: a rule exact to degree 4 on every facet, so the
 # maximum of u_h . n - g between the Lagrange nodes (a convex gap) is seen too
 STATUS_UNRESOLVED = "contact unresolved"
+# the statuses of a level with an answer: its numbers are those of the discrete problem,
+# whether or not its constraint saw the contact
+SOLVED_STATUSES = ("ok", STATUS_UNRESOLVED)
 
 
 @dataclass(frozen=True)
@@ -24,8 +27,8 @@ class ContactResolution:
     (u_h . n - g)^+ on Gamma_C (a length), ``approach`` = the largest -g (how far the
     obstacle is pushed into the undeformed body; 0 when the loads make the contact),
     ``nodal_penetration`` = the same at the Lagrange nodes only (what a nodal constraint
-    controls), ``penetration_share`` = penetration / approach (with no approach: / max |u_h . n|), and
-    ``unresolved``: why the discrete constraint did not see the contact, or ""."""
+    controls), ``penetration_share`` = penetration / approach (with no approach: / max
+    |u_h . n|), and ``unresolved``: why the discrete constraint did not see the contact, or ""."""
 
     penetration: float
     nodal_penetration: float

@@ -57,7 +57,8 @@ def error_bar_table(section: dict, quick: bool = False) -> pd.DataFrame:
     for order in config["orders"]:
         ndofs, differences = [], []
         recipe = Recipe(f"mixed-p{order}", "mixed", order)
-        for n, sol, difference in reference_levels(scene, max_dofs, recipe):
+        for row, sol, difference in reference_levels(scene, max_dofs, recipe):
+            n = row.ndofs
             ndofs.append(n)
             if difference is None:
                 continue

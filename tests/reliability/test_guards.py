@@ -17,6 +17,7 @@ from bench.cli import main
 from bench.matrix.artifacts import file_stem
 from bench.matrix.folder_state import FolderState
 from bench.matrix.store import ResultStore
+from bench.measure.contact import SOLVED_STATUSES as SOLVED
 from bench.report import write_report
 from bench.sequence.loop import LoopConfig, run_sequence
 from bench.sequence.memory import available_gib, memory_line, predict_peak_gib
@@ -61,7 +62,9 @@ def test_a_level_that_would_not_fit_in_memory_is_refused_before_it_is_built(monk
         get_scene("paper"), "mixed", "active-set", "residual",
         LoopConfig(strategy="uniform", max_dofs=10**8, max_memory_gib=limit))]
     last = rows[-1]
-    assert [r.status for r in rows[:-1]] == ["ok"] * 4 and rows[-2].ndofs == 2112
+    # paper's 40 and 144 DOFs miss part of the contact (bench.measure.contact)
+    assert all(r.status in SOLVED for r in rows[:-1]) and len(rows) == 5
+    assert rows[-2].status == "ok" and rows[-2].ndofs == 2112
     assert last.status == "failed" and last.ndofs == 8320 and 8320 not in sizes
     assert last.reason.startswith("memory: level 4 needs ~") and "available" in last.reason
 
@@ -308,7 +311,7 @@ def test_sigint_ends_with_one_line_and_keeps_every_finished_row(tmp_path):
     assert process.returncode == 130, err
     assert "Traceback" not in err and "interrupted: every finished row is kept" in err
     table = pd.read_parquet(out / "results.parquet")
-    assert len(table) >= 3 and (table["status"] == "ok").all()
+    assert len(table) >= 3 and table["status"].isin(SOLVED).all()
 
 
 @pytest.mark.long

@@ -75,7 +75,8 @@ def test_the_fast_solver_is_exact_on_every_hard_case(hard):
     by_reference = qp["safeguard"] == "reference fallback"  # Clarabel at 1e-10: 1.7e-12
     assert (qp["max_residual"][~by_reference] < 1e-12).all()
     assert (qp["max_residual"][by_reference] < 1e-9).all()
-    assert (qp["verdict"] == "accurate").all()
+    # exact, whether or not the discretisation saw the contact (bench.measure.contact)
+    assert qp["verdict"].isin(["accurate", "contact unresolved"]).all()
     # the penalised equation: round-off times its condition, which grows like 1/eps_0
     # (measured residual / condition 1.7e-15 at eps_0 = 0.1 and 1e-2, 4e-17 from 1e-4 to
     # 1e-12); above the 1e-6 bar, hence flagged, at eps_0 = 1e-10 and 1e-12 only

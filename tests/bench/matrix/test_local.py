@@ -3,6 +3,7 @@
 import pytest
 
 from bench.matrix import RunConfig, run
+from bench.measure.contact import SOLVED_STATUSES as SOLVED
 from estimators import estimator_names
 from estimators.base import ESTIMATORS, register_estimator
 from formulations import formulation_names
@@ -53,5 +54,5 @@ def test_impossible_combination_becomes_one_skipped_row(tmp_path, picky_estimato
     skipped = [r for r in rows if r.status == "skipped"]
     assert len(skipped) == 1 and skipped[0].formulation == "penalty"
     assert skipped[0].reason == "needs a multiplier" and skipped[0].level == -1
-    assert {r.status for r in rows if r.formulation == "mixed"} == {"ok"}
+    assert {r.status for r in rows if r.formulation == "mixed"} <= set(SOLVED)
     assert (store.table()["status"] == "skipped").sum() == 1

@@ -4,6 +4,7 @@ import pandas as pd
 import pytest
 
 from bench.cli import main
+from bench.measure.contact import SOLVED_STATUSES as SOLVED
 from bench.perf.sequence import LEVEL_PHASES, measure_sequence, sequence_table, write_sequences
 
 
@@ -13,7 +14,7 @@ def adaptive():
 
 
 def test_a_sequence_is_timed_level_by_level_and_phase_by_phase(adaptive):
-    assert adaptive["status"] == "ok" and adaptive["levels"] >= 3
+    assert set(adaptive["status"].split(",")) <= set(SOLVED) and adaptive["levels"] >= 3
     assert adaptive["final_ndofs"] <= 3000
     phases = sum(adaptive[phase] for phase in LEVEL_PHASES) + adaptive["t_store"]
     # the phases are disjoint parts of the sequence: together no more than its wall time
@@ -44,5 +45,6 @@ def test_bad_budgets_are_refused_in_one_line(budgets, capsys):
 
 def test_a_quadrilateral_sequence_is_timed_and_named_by_its_cells():
     quad = measure_sequence("adaptive", 3000, reference_dofs=20000, cell="quad")
-    assert quad["status"] == "ok" and quad["cell"] == "quad" and quad["levels"] >= 3
+    assert set(quad["status"].split(",")) <= set(SOLVED)
+    assert quad["cell"] == "quad" and quad["levels"] >= 3
     assert "adaptive to 3e3, quad" in sequence_table(pd.DataFrame([quad]))

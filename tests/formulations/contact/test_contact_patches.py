@@ -1,6 +1,7 @@
-"""The mixed method's multiplier patches on tetrahedra: the macro-element condition checked on
-the patches themselves, the inf-sup constant of the stable and the unstable choice, and clear
-errors for options that do not exist in 3D (docs/theory.md, section 14.7)."""
+"""The mixed method's multiplier spaces on tetrahedra: the macro-element condition of the star
+patches checked on the patches themselves, the inf-sup constant of the stable and the unstable
+choices, and clear errors for options that do not exist in 3D (docs/theory.md, sections 14.7
+and 19.2)."""
 
 import re
 from dataclasses import replace
@@ -72,7 +73,8 @@ def test_B_integrates_normal_displacement_and_G_a_linear_gap_exactly(order):
     # on a graded mesh: B u = int_P u . n over each patch for a field of degree p, and
     # G_P = int_P g = |T| g(centroid) summed over its triangles for a linear g (round-off)
     scene = replace(get_scene("paper-3d"), gap=lambda x: 0.3 * x[0] - 0.2 * x[1] + 0.05)
-    disc = get_formulation("mixed")(scene, graded_mesh(scene, steps=1), order=order)
+    disc = get_formulation("mixed")(scene, graded_mesh(scene, steps=1), order=order,
+                                    multiplier_mesh="star")
     surface, patch = disc.trace, star_patches_of(scene, disc.elasticity.mesh)[2]
     x = disc.elasticity.basis.doflocs  # (3, N): every DOF's location
     u = np.where(np.arange(x.shape[1]) % 3 == 2, x[0] ** order + 0.5 * x[1] - 0.1, 7.0)
@@ -88,27 +90,32 @@ def test_B_integrates_normal_displacement_and_G_a_linear_gap_exactly(order):
     assert disc.qp.G == pytest.approx(expected_G, rel=1e-12, abs=1e-14)
 
 
-def test_star_patches_are_inf_sup_stable_and_the_triangles_are_not():
-    # beta_h on paper-3d, P1, uniform levels 0..2 (300, 1944, 13 872 DOFs): measured 0.673,
-    # 0.404, 0.344 for star patches (then 0.336 at 104 544) and 0 for the triangles, whose
-    # multipliers outnumber the normal displacements (B' has a kernel: round-off only).
-    # The floor 0.25 and the last ratio 0.8 leave room for round-off, not for a decay like h
-    scene = get_scene("paper-3d")
-    star, triangle = [], []
-    for level in range(3):
-        mesh = scene.mesh.refined(level)
-        for ratio, values in ((0.5, star), (1.0, triangle)):
-            values.append(inf_sup_constant(get_formulation("mixed")(scene, mesh,
-                                                                    h_over_H=ratio)))
-    assert min(star) > 0.25 and star[2] > 0.8 * star[1]
-    assert max(triangle) < 1e-6
+SPACES = {"coarse P1": {}, "star": dict(multiplier_mesh="star"),
+          "triangle": dict(h_over_H=1.0, multiplier_degree=0)}
 
 
-def test_star_patches_stay_stable_on_a_graded_mesh():
-    # measured 0.39 on this mesh (1.5e4 DOFs); the uniform level 2 has 0.344
+def test_coarse_hats_and_stars_are_inf_sup_stable_and_the_triangles_are_not():
+    # beta_h on paper-3d, P1, uniform levels 0..2 (300, 1944, 13 872 DOFs): measured 0.517,
+    # 0.521, 0.525 for P1 on the coarse surface (the default), 0.673, 0.404, 0.344 for star
+    # patches (then 0.336 at 104 544) and 0 for P0 on the triangles, whose multipliers
+    # outnumber the normal displacements (B' has a kernel: round-off only). The floors and
+    # the last ratios leave room for round-off, not for a decay like h (a ratio of 1/2)
     scene = get_scene("paper-3d")
-    beta = inf_sup_constant(get_formulation("mixed")(scene, graded_mesh(scene)))
-    assert beta > 0.25
+    beta = {name: [inf_sup_constant(get_formulation("mixed")(scene, scene.mesh.refined(level),
+                                                             **options))
+                   for level in range(3)] for name, options in SPACES.items()}
+    assert min(beta["coarse P1"]) > 0.45 and beta["coarse P1"][2] > 0.95 * beta["coarse P1"][1]
+    assert min(beta["star"]) > 0.25 and beta["star"][2] > 0.8 * beta["star"][1]
+    assert max(beta["triangle"]) < 1e-6
+
+
+def test_star_patches_and_coarse_hats_stay_stable_on_a_graded_mesh():
+    # measured on this mesh (1.5e4 DOFs): stars 0.39 (the uniform level 2 has 0.344), P1 on
+    # the coarse surface 0.577 (uniform: 0.525)
+    scene = get_scene("paper-3d")
+    mesh = graded_mesh(scene)
+    assert inf_sup_constant(get_formulation("mixed")(scene, mesh, multiplier_mesh="star")) > 0.25
+    assert inf_sup_constant(get_formulation("mixed")(scene, mesh)) > 0.4
 
 
 def test_the_unstable_choice_still_gets_the_unique_displacement():
@@ -117,16 +124,30 @@ def test_the_unstable_choice_still_gets_the_unique_displacement():
     # lets a Cholesky factor through first is not asserted); u is unique, so the energies agree
     # (Clarabel's relative gap ~1e-8)
     scene = get_scene("paper-3d")
-    disc = get_formulation("mixed")(scene, scene.mesh.refined(), h_over_H=1.0)
+    disc = get_formulation("mixed")(scene, scene.mesh.refined(), h_over_H=1.0,
+                                    multiplier_degree=0)
     fast, reference = solve(disc, "active-set"), solve(disc, "reference")
     assert fast.ok and reference.ok
     assert fast.energy == pytest.approx(reference.energy, rel=1e-7)
 
 
-@pytest.mark.parametrize(("option", "value", "allowed"), [
-    ("h_over_H", 0.25, "0.5 (vertex-star patches) or 1"),
-    ("multiplier_degree", 1, "0 (piecewise constant on patches)")])
-def test_options_that_have_no_3d_meaning_are_refused(option, value, allowed):
+@pytest.mark.parametrize(("options", "allowed"), [
+    (dict(h_over_H=0.25), "h_over_H=0.25 is not allowed on a 3D contact surface: 0.5 (the "
+                          "surface one level coarser) or 1"),
+    (dict(multiplier_degree=2), "multiplier_degree=2 is not allowed on a 3D contact surface: "
+                                "0 or 1"),
+    (dict(multiplier_degree=1, multiplier_mesh="star"), "multiplier_degree=1 is not allowed "
+                                                        "on a 3D contact surface with "
+                                                        "multiplier_mesh='star': 0"),
+    (dict(multiplier_mesh="stars"), "multiplier_mesh='stars' is not one of coarse, star")])
+def test_options_that_have_no_3d_meaning_are_refused(options, allowed):
     scene = get_scene("paper-3d")
-    with pytest.raises(ValueError, match=rf"{option}={value!r}.*{re.escape(allowed)}"):
-        get_formulation("mixed")(scene, scene.mesh, **{option: value})
+    with pytest.raises(ValueError, match=re.escape(allowed)):
+        get_formulation("mixed")(scene, scene.mesh, **options)
+
+
+def test_a_2d_boundary_refuses_a_3d_multiplier_mesh():
+    scene = get_scene("paper")
+    with pytest.raises(ValueError, match=re.escape("multiplier_mesh='star' is not allowed on a "
+                                                   "2D contact boundary: coarse")):
+        get_formulation("mixed")(scene, scene.mesh, multiplier_mesh="star")
