@@ -106,6 +106,8 @@ class ContactPrediction:
     label: str = ""
 
     def pressure(self, s: np.ndarray) -> np.ndarray:
+        if not self.half_width > 0:  # no contact force: no pressure anywhere
+            return np.zeros(np.shape(s))
         r = (np.asarray(s, dtype=float) - self.centre) / self.half_width
         return self.peak_pressure * np.sqrt(np.clip(1.0 - r**2, 0.0, None))
 

@@ -13,13 +13,15 @@ valid while b << D and b << W (the half-space assumption); the defaults give b ~
 D = W = 2. The approach delta itself has no closed form in 2D (it depends on the body's size),
 which is why the comparison is made at the computed force P.
 
-With Coulomb friction (``friction="coulomb"``, ``mu``) and an obstacle that slides along x by
-``slide`` after pressing (Cattaneo and Mindlin's loading: normal first, then tangential), the
-tangential force Q < mu P leaves a stick zone |x| < c = b sqrt(1 - Q / (mu P)) and the shear
-traction q(x) = mu p0 (sqrt(1 - x^2/b^2) - (c/b) sqrt(1 - x^2/c^2)) (Johnson, section 7.1),
-compared at the computed P and Q. That theory neglects the coupling of normal and tangential
-tractions, exact for an incompressible body on a rigid base (nu -> 1/2) and an approximation
-otherwise.
+With Coulomb friction (``friction="coulomb"``, ``mu``) the obstacle also slides along x by
+``slide``, in the same single step as it presses: the slip is u_t minus the whole slide, as if
+both were applied together from the unloaded state. Where the normal-tangential coupling
+vanishes (nu -> 1/2) that is Cattaneo and Mindlin's problem: the tangential force Q < mu P
+leaves a stick zone |x| < c = b sqrt(1 - Q / (mu P)) and the shear traction
+q(x) = mu p0 (sqrt(1 - x^2/b^2) - (c/b) sqrt(1 - x^2/c^2)) (Johnson, section 7.1). For
+nu < 1/2 the stick zone shrinks and moves towards the trailing edge; the prediction is then
+the coupled half-plane's (``scenes.half_plane``, the same one-step loading), compared at the
+computed P and Q.
 """
 
 from __future__ import annotations
@@ -39,6 +41,7 @@ from scenes.base import (
 from scenes.budget import tensor_mesh
 from scenes.corners import Corner
 from scenes.friction import friction_law
+from scenes.half_plane import coupled_partial_slip_prediction
 from scenes.registry import register_scene
 
 _TOL = 1e-10
@@ -55,6 +58,8 @@ def hertz_prediction(scene: Scene, contact_force: float) -> dict:
 def hertz_contact(young_modulus: float, poisson_ratio: float, radius: float,
                   contact_force: float) -> ContactPrediction:
     """Hertz's pressure p0 sqrt(1 - (x/b)^2) at the force ``contact_force``."""
+    if not contact_force > 0:  # no contact (a constraint that missed it): nothing to predict
+        return ContactPrediction(0.0, 0.0, label="no contact force")
     e_star = young_modulus / (1 - poisson_ratio**2)
     b = float(np.sqrt(4 * contact_force * radius / (np.pi * e_star)))
     p0 = float(2 * contact_force / (np.pi * b))
@@ -79,6 +84,15 @@ def cattaneo_mindlin(mu: float, slide: float):
     """(P, Q) -> Cattaneo-Mindlin's partial slip under Hertz's pressure: the stick zone
     c = b sqrt(1 - |Q| / (mu P)), the shear traction along the obstacle's slide."""
     return partial_slip(hertz_contact, 0.5, "Cattaneo-Mindlin", mu, slide)
+
+
+def stick_prediction(poisson_ratio: float, mu: float, slide: float):
+    """Cattaneo-Mindlin's partial slip where the coupling vanishes (nu = 1/2), else the coupled
+    half-plane's (``scenes.half_plane``: the scene's own one-step loading, docs/theory.md,
+    19.4)."""
+    if poisson_ratio >= 0.5:
+        return cattaneo_mindlin(mu, slide)
+    return coupled_partial_slip_prediction(mu, slide)
 
 
 @register_scene("hertz", "Hertz line contact: a block pressed by a rigid parabola of radius R "
@@ -116,6 +130,7 @@ def hertz(young_modulus: float = 1000.0, poisson_ratio: float = 0.3, radius: flo
         corners=(Corner((-W, 0.0), np.pi / 2, ("clamped", "free")),
                  Corner((W, 0.0), np.pi / 2, ("clamped", "free"))),
         friction=law,
-        predict_stick=(functools.partial(cattaneo_mindlin(mu, law.slide), material, radius)
+        predict_stick=(functools.partial(stick_prediction(poisson_ratio, mu, law.slide),
+                                         material, radius)
                        if law.kind == "coulomb" and law.slide else None),
     )

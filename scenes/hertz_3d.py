@@ -43,6 +43,8 @@ def hertz_sphere(young_modulus: float, poisson_ratio: float, radius: float,
                  contact_force: float) -> ContactPrediction:
     """Hertz's pressure p0 sqrt(1 - (r/a)^2) at the force ``contact_force`` (``half_width``
     is the contact radius a)."""
+    if not contact_force > 0:  # no contact (a constraint that missed it): nothing to predict
+        return ContactPrediction(0.0, 0.0, label="no contact force")
     e_star = young_modulus / (1 - poisson_ratio**2)
     a = float(np.cbrt(3 * contact_force * radius / (4 * e_star)))
     p0 = float(3 * contact_force / (2 * np.pi * a**2))
