@@ -8,6 +8,7 @@ import numpy as np
 import pandas as pd
 
 from bench.matrix.rates import judged_levels
+from bench.measure.contact import STATUS_UNRESOLVED
 from bench.measure.slope import SlopeFit
 from bench.report.verdict import EFFECTIVITY_FROM_DOFS
 from bench.sequence.rows import KEYS, LABELS, phase_time
@@ -224,6 +225,11 @@ def agreement_table(rows: pd.DataFrame) -> pd.DataFrame:
                                "reference_ok": "reference ok"})
 
 
+UNRESOLVED_REASON = ("the discrete constraint did not see the contact: the penetration undoes "
+                     "more than 10 % of the obstacle's approach, or nothing is active where it "
+                     "is pushed in (docs/theory.md 19.1); usually the coarsest levels")
+
+
 def failure_table(everything: pd.DataFrame) -> pd.DataFrame:
     """Every row not ok, identical ones (same status and reason) in one line with their count
     and the first combinations."""
@@ -232,10 +238,15 @@ def failure_table(everything: pd.DataFrame) -> pd.DataFrame:
         return pd.DataFrame()
     bad = bad.assign(reason=bad["reason"].fillna("").astype(str),
                      combination=bad[KEYS[:5]].astype(str).agg("/".join, axis=1))
+    # each unresolved row states its own figure: one line for all of them, with the worst
+    unresolved = bad["status"] == STATUS_UNRESOLVED
+    bad.loc[unresolved, "reason"] = UNRESOLVED_REASON
     out = []
     for (status, reason), group in bad.groupby(["status", "reason"], sort=True):
         names = list(dict.fromkeys(group["combination"]))
         shown = ", ".join(names[:3]) + (f" and {len(names) - 3} more" if len(names) > 3 else "")
+        if status == STATUS_UNRESOLVED and "penetration_share" in group:
+            reason += f"; the worst undoes {group['penetration_share'].max():.0%}"
         out.append({"status": status, "rows": len(group), "reason": reason,
                     "combinations": shown})
     return pd.DataFrame(out).sort_values("rows", ascending=False)

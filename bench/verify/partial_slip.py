@@ -43,6 +43,8 @@ def partial_slip_table(run: dict) -> pd.DataFrame:
         table["peak_shear_error"] = table["peak_shear"] / table["predicted_peak_shear"] - 1
         table["stick_centre_error"] = ((table["stick_centre"] - table["predicted_stick_centre"])
                                        / table["half_width"])
+        table["cattaneo_mindlin_error"] = (table["stick_half_width"]
+                                           / table["cattaneo_mindlin_stick_half_width"] - 1)
     return table
 
 
@@ -77,11 +79,14 @@ def compare(scene, solution) -> dict:
     start, end = stick_ends(state)
     nodes = state.zone("stick")
     b = predicted.half_width
+    hertz_b = scene.predict_contact(normal_force).half_width
     samples = np.linspace(predicted.centre - b, predicted.centre + b, PEAK_SAMPLES)
     return {"contact_force": normal_force, "tangential_force": tangential_force,
             "stick_half_width": 0.5 * (end - start), "stick_centre": 0.5 * (end + start),
             "stick_half_width_nodes": 0.5 * (nodes[1] - nodes[0]),
             "predicted_stick_half_width": predicted.stick_half_width, "half_width": b,
             "predicted_stick_centre": predicted.centre,
+            "cattaneo_mindlin_stick_half_width": hertz_b * np.sqrt(max(
+                1 - abs(tangential_force) / (predicted.coefficient * normal_force), 0.0)),
             "peak_shear": float(peak.max()),
             "predicted_peak_shear": float(np.abs(predicted.shear(samples)).max())}
