@@ -81,7 +81,8 @@ def test_a_level_too_large_for_a_factorisation_is_solved_by_the_iterative_back_e
     rows = [r.row for r in run_sequence(
         get_scene("paper"), "mixed", "active-set", "residual",
         LoopConfig(strategy="uniform", max_dofs=8400, max_memory_gib=1.0))]
-    assert [r.status for r in rows] == ["ok"] * 5 and rows[-1].ndofs == 8320
+    assert all(r.status in SOLVED for r in rows) and len(rows) == 5
+    assert rows[-1].status == "ok" and rows[-1].ndofs == 8320
     assert [r.backend for r in rows] == [direct] * 4 + ["amg"]
     assert rows[-1].reason == (f"memory: level 4 needs ~100.00 GiB (8320 DOFs, {direct}), "
                                "1.00 available; solved by amg instead")

@@ -5,6 +5,7 @@ import json
 import pytest
 
 from bench.matrix import RunConfig, run
+from bench.measure.contact import SOLVED_STATUSES as SOLVED
 
 
 @pytest.mark.slow  # solves against a paper reference built on a fresh clone: ~37 s
@@ -14,7 +15,7 @@ def test_nitsche_energy_is_as_close_to_the_reference_as_the_mixed_methods(tmp_pa
                            reference_dofs=200000, out=str(tmp_path)))
     reference = json.loads((tmp_path / "truth.json").read_text())["paper"]["energy"]
     table = result.table
-    assert (table["status"] == "ok").all()
+    assert table["status"].isin(SOLVED).all()
     finest = table.sort_values("level").groupby("formulation").tail(1).set_index("formulation")
     gap = (finest["energy"] - reference).abs()
     # both converge to the reference energy 402.2811 (its own error 2.5e-4 in the energy
