@@ -21,7 +21,7 @@ LEVELS = (("hertz-3d", 1, (0, 1)), ("hertz-3d", 2, (0,)), ("hertz", 2, (0,)))
 @hard_case("lost-contact", "Hertz's sphere (3D, P1 and P2) and cylinder (2D, P2) on meshes "
                            "coarser than the contact zone: a constraint that does not see the "
                            "contact is 'contact unresolved', never accurate",
-           meta={"seconds": 20})  # measured on 2 cores
+           meta={"seconds": 15})  # measured on 2 cores
 def lost_contact() -> list[dict]:
     records = []
     for name, order, levels in LEVELS:

@@ -25,7 +25,7 @@ LEVELS = (0, 1, 2)  # paper-3d, P1: 300, 1944, 13 872 DOFs
 @hard_case("mixed-patches-3d", "mixed method on paper-3d with P1 multipliers on the coarse "
                                "surface and on the contact triangles, P0 on coarse triangles, "
                                "stars and triangles: discrete inf-sup constant under "
-                               "refinement", meta={"seconds": 60})  # measured on 2 cores
+                               "refinement", meta={"seconds": 28})  # measured on 2 cores
 def mixed_patches_3d() -> list[dict]:
     scene, records = get_scene("paper-3d"), []
     for variant, options in PATCHES.items():
