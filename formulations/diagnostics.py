@@ -24,7 +24,7 @@ from the assembled arrays and the returned solution, never taken from a solver.
 from __future__ import annotations
 
 import numpy as np
-from scipy import linalg
+from scipy import linalg, sparse
 
 from formulations.base import DiscreteSolution
 from formulations.solvers.backends import factorise
@@ -47,7 +47,8 @@ def inf_sup_constant(discretisation, backend: str | None = None,
         condensed = qp.B @ X
     S = qp.objective_scale * np.asarray(condensed)
     S = 0.5 * (S + S.T)
-    gram = np.asarray(multiplier_gram)
+    gram = (multiplier_gram.toarray() if sparse.issparse(multiplier_gram)
+            else np.asarray(multiplier_gram))
     smallest = linalg.eigh(S, np.diag(gram) if gram.ndim == 1 else gram, eigvals_only=True,
                            subset_by_index=[0, 0])[0]
     return float(np.sqrt(max(smallest, 0.0)))

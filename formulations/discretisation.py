@@ -6,6 +6,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, replace
 
 import numpy as np
+from scipy import sparse
 
 from formulations.base import (
     STATUS_FAILED,
@@ -49,7 +50,7 @@ class Discretisation:
     transfer: Callable[[DiscreteSolution], np.ndarray] | None = None
     # Gram matrix (its diagonal if 1-D) of the mesh-dependent H^-1/2 norm of the multipliers, for
     # formulations whose constraint rows are a multiplier space (formulations.diagnostics)
-    multiplier_gram: np.ndarray | None = None
+    multiplier_gram: np.ndarray | sparse.spmatrix | None = None  # a vector is its diagonal
     system: SemismoothSystem | None = None
     no_qp: str = ""  # why qp is None
     # the QP is the system's slack form (formulations.base.slack_qp): per point of the system,

@@ -70,11 +70,8 @@ def normal_gap(scene, solution: DiscreteSolution) -> tuple[np.ndarray, np.ndarra
 def penetration(scene, solution: DiscreteSolution, nodal: bool = False) -> float:
     """max over the sample points of Gamma_C (``nodal``: its Lagrange nodes only) of
     (u_h . n - g)^+ (a length)."""
-    u_n, gap = normal_gap(scene, solution)
-    if nodal:
-        n = solution.trace.lagrange_points(solution.elasticity.order).shape[-1]
-        u_n, gap = u_n[:, :n], gap[:, :n]
-    return float(np.maximum(u_n - gap, 0.0).max(initial=0.0))
+    resolution = contact_resolution(scene, solution)
+    return resolution.nodal_penetration if nodal else resolution.penetration
 
 
 def contact_resolution(scene, solution: DiscreteSolution) -> ContactResolution:

@@ -20,8 +20,9 @@ contact cells' ancestors log2(H/h) levels up (one for h/H = 1/2), from the cell 
 (``formulations.cells``; docs/theory.md, section 15.3).
 
 On tetrahedra (``formulations.methods.mixed_surface``, docs/theory.md, section 19.2) lambda_H
-lives on the contact surface one level coarser: piecewise constant on its triangles (P1) or
-continuous piecewise linear (P2).
+is continuous and piecewise linear on the contact surface one level coarser than the trace's
+Lagrange lattice (P1: the coarse surface; P2: the trace mesh), or piecewise constant on patches
+(the coarse triangles, or vertex stars: the default with friction).
 """
 
 from __future__ import annotations

@@ -151,12 +151,12 @@ def hat_rows(scene, elasticity, surface, patch: np.ndarray, coarse: np.ndarray,
     # the weighted mass sum_T H_T int_T mu^2 of the coarse hats, H_T its coarse triangle's
     # size (in 2D H_S^2 times the Bernstein mass)
     tm, wm = surface.rule(2)
+    integrals = hat_weights(surface, P, tm, wm)  # int psi_Z v over the points of rule tm
     H = patch_sizes(surface, patch)[1][patch]
-    weighted = hat_weights(surface, P, tm, wm) @ sparse.diags(np.repeat(H, tm.shape[1]))
     values = hat_weights(surface, P, tm, np.ones_like(wm)) @ sparse.diags(
         np.repeat(1.0 / surface.measure, tm.shape[1]))  # psi_Z at the points
-    gram = (weighted @ values.T).toarray()
-    row_scale = np.asarray(hat_weights(surface, P, tm, wm).sum(axis=1)).ravel()
+    gram = (integrals @ sparse.diags(np.repeat(H, tm.shape[1])) @ values.T).tocsr()
+    row_scale = np.asarray(integrals.sum(axis=1)).ravel()
     coordinate = np.asarray(scene.contact_coordinate(elasticity.mesh.p[:, coarse]))
     return B, G, row_scale, gram, coordinate
 
