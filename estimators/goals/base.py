@@ -1,0 +1,56 @@
+"""The estimate of a quantity of interest's error, and the registry of goal-oriented estimators
+(docs/theory.md, section 20). A goal estimator is ``estimate(scene, solution, quantity,
+backend=None) -> GoalEstimate``, one module and one ``register_goal_estimator`` each."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from formulations.cells import family_of
+from formulations.registry import frictionless_only
+from scenes.registry import Registry
+
+GOAL_ESTIMATORS = Registry("goal estimator")
+goal_estimator_names = GOAL_ESTIMATORS.names
+goal_estimator_descriptions = GOAL_ESTIMATORS.descriptions
+DEFAULT_GOAL_ESTIMATOR = "dwr"
+
+
+@dataclass(frozen=True, eq=False)
+class GoalEstimate:
+    """``estimate`` approximates J(u, lambda) - J(u_h, lambda_h) with its sign: the residual
+    part rho(z) plus the contact part (pi, g - u_h.n) on the contact set (docs/theory.md,
+    20.2). ``indicators`` (>= 0, per element) are what marking refines by; ``guaranteed``
+    whether [value + lower, value + upper] is proved to hold J(u, lambda) (never for dwr:
+    its dual problem is linearised at the discrete contact set)."""
+
+    estimator: str
+    quantity: str
+    value: float
+    estimate: float
+    residual_part: float
+    contact_part: float
+    indicators: np.ndarray
+    dual_dofs: int
+    seconds: float
+    guaranteed: bool = False
+    lower: float = float("nan")
+    upper: float = float("nan")
+
+
+def register_goal_estimator(name: str, description: str, applies=None):
+    """Register a goal estimator; ``applies(scene=..., solution=...)`` says why it does not
+    run (a scene with friction is refused: its dual problem is not built)."""
+    return GOAL_ESTIMATORS.register(name, description,
+                                    frictionless_only("goal estimator", name, applies))
+
+
+def why_no_goal_estimate(name: str, scene, solution) -> str | None:
+    """Why goal estimator ``name`` does not run on ``solution`` (None if it does)."""
+    return GOAL_ESTIMATORS.why_not(name, scene=scene, solution=solution)
+
+
+def cell_family(solution):
+    return family_of(solution.elasticity.mesh)

@@ -1,0 +1,154 @@
+"""The dual (adjoint) problem of a goal, linearised at the discrete contact set (docs/theory.md,
+20.2): find z in V^+ (the displacements of order p + 1 on the same mesh) and a reaction pi on
+the contact nodes A_h where lambda_h > 0 such that
+
+    a(v, z) + (pi, v.n)_{A_h} = j(v)   for all v,      z.n = omega   on A_h,
+
+the contact set held like a clamped normal displacement (a bilateral constraint), free
+elsewhere. The constraint is imposed at the Lagrange nodes of order p + 1 by turning each
+constrained node's DOFs into its (n, t) frame, so z.n = omega becomes a Dirichlet value and
+the system stays symmetric positive definite for any back-end.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import sparse
+
+from formulations.contact.boundary import tangent_frame
+from formulations.elasticity import Elasticity, assemble_elasticity
+from formulations.solvers.backends import factorise
+
+ACTIVE_SHARE = 1e-6  # a node is in A_h where lambda_h exceeds this share of its maximum
+
+
+@dataclass(frozen=True, eq=False)
+class DualSolution:
+    """z (every DOF of ``elasticity``'s basis), the constrained nodes' points (d, m), the rows
+    v -> v(x_i).n_i over the basis's DOFs, the reactions pi (forces), an element holding each
+    node (for local indicators) and the time of the solve."""
+
+    elasticity: Elasticity
+    z: np.ndarray
+    points: np.ndarray
+    normal_rows: sparse.csr_matrix
+    reaction: np.ndarray
+    elements: np.ndarray
+    seconds: float
+
+
+def node_pressure(solution, nodes, order: int) -> np.ndarray:
+    """lambda_h at the trace nodes of ``nodes`` (its largest value over the facets at a node:
+    a pressure discontinuous at a node counts as present)."""
+    trace = solution.trace
+    values = solution.pressure(trace.lagrange_points(order))  # (n_facets, k), facet_rows' order
+    out = np.zeros(nodes.weight.size)
+    np.maximum.at(out, nodes.facet_rows.ravel(), values.ravel())
+    return out
+
+
+def contact_set(scene, solution, nodes, order: int) -> np.ndarray:
+    """A_h at the trace nodes of ``order``: lambda_h > 0 (above ACTIVE_SHARE of its maximum)
+    or u_h through the obstacle (a constraint that missed the contact still has one)."""
+    lam = node_pressure(solution, nodes, order)
+    t = solution.trace.lagrange_points(order)
+    through = np.zeros(nodes.weight.size, dtype=bool)
+    excess = solution.normal_displacement(t) - np.asarray(
+        scene.gap(solution.trace.points(t)), dtype=float)
+    through[nodes.facet_rows[excess > 0]] = True
+    return ((lam > ACTIVE_SHARE * lam.max(initial=0.0)) & (lam > 0)) | through
+
+
+def node_dofs(elasticity: Elasticity, trace, nodes) -> tuple[np.ndarray, np.ndarray]:
+    """The unknowns (d, m) of each trace node's components and whether the node has its own
+    (False at a clamped or hanging node, which the dual's constraint leaves alone)."""
+    d = nodes.points.shape[0]
+    columns = np.full((d, nodes.weight.size), -1)
+    own = np.ones(nodes.weight.size, dtype=bool)
+    for c in range(d):
+        axis = np.zeros_like(nodes.points)
+        axis[c] = 1.0
+        rows = elasticity.restrict(trace.node_rows(elasticity, nodes, axis)).tocsr()
+        rows.data[np.abs(rows.data) < 1e-12] = 0.0
+        rows.eliminate_zeros()
+        single = (np.diff(rows.indptr) == 1)
+        single[single] = np.abs(rows.data[rows.indptr[:-1][single]] - 1.0) < 1e-12
+        own &= single
+        columns[c, single] = rows.indices[rows.indptr[:-1][single]]
+    return columns, own
+
+
+def rotation(n: int, columns: np.ndarray, normal: np.ndarray) -> sparse.csr_matrix:
+    """T (n x n): the identity but for each constrained node's block, whose columns are its
+    normal and tangents (the node's first unknown carries z.n)."""
+    frame = [normal, *tangent_frame(normal)]
+    d, m = columns.shape
+    rows = np.concatenate([columns[a] for a in range(d) for _ in range(d)])
+    cols = np.concatenate([columns[b] for _ in range(d) for b in range(d)])
+    vals = np.concatenate([frame[b][a] for a in range(d) for b in range(d)])
+    keep = np.ones(n, dtype=bool)
+    keep[columns.ravel()] = False
+    eye = np.flatnonzero(keep)
+    return sparse.csr_matrix((np.concatenate([vals, np.ones(eye.size)]),
+                              (np.concatenate([rows, eye]), np.concatenate([cols, eye]))),
+                             shape=(n, n))
+
+
+def solve_dual(scene, solution, quantity, backend: str | None = None) -> DualSolution:
+    """The dual problem of ``quantity`` (``estimators.quantities``) at ``solution``'s contact
+    set, in the space of order p + 1 on its mesh."""
+    start = time.perf_counter()
+    elasticity = assemble_elasticity(scene, solution.elasticity.mesh,
+                                     solution.elasticity.order + 1)
+    trace = solution.trace
+    nodes = trace.nodes(elasticity.order)
+    columns, own = node_dofs(elasticity, trace, nodes)
+    active = own & contact_set(scene, solution, nodes, elasticity.order)
+    columns, normal = columns[:, active], nodes.normal[:, active]
+    points = nodes.points[:, active]
+    load = dual_load(elasticity, quantity)
+    T = rotation(elasticity.ndofs, columns, normal)
+    K = (T.T @ elasticity.K_free @ T).tocsr()
+    rhs = T.T @ load
+    fixed = columns[0]
+    omega = (np.asarray(quantity.weight(points), dtype=float) if quantity.weight is not None
+             else np.zeros(fixed.size))
+    zeta = np.zeros(elasticity.ndofs)
+    zeta[fixed] = omega
+    free = np.ones(elasticity.ndofs, dtype=bool)
+    free[fixed] = False
+    inner = np.flatnonzero(free)
+    factor = factorise(K[inner][:, inner], backend, T[:, inner].T @ elasticity.rigid_modes
+                       if backend == "amg" else None)
+    zeta[inner] = factor(rhs[inner] - K[inner][:, fixed] @ omega)
+    reaction = rhs[fixed] - K[fixed] @ zeta  # a(v, z) + pi v.n = j(v) at v = the node's normal
+    return DualSolution(elasticity=elasticity, z=elasticity.expand(T @ zeta), points=points,
+                        normal_rows=trace.node_rows(elasticity, nodes)[np.flatnonzero(active)],
+                        reaction=reaction, elements=node_elements(trace, nodes)[active],
+                        seconds=time.perf_counter() - start)
+
+
+def node_elements(trace, nodes) -> np.ndarray:
+    """An element holding each trace node (that of a facet it lies on)."""
+    out = np.empty(nodes.weight.size, dtype=np.int64)
+    out[nodes.facet_rows.ravel()] = np.repeat(trace.element, nodes.facet_rows.shape[1])
+    return out
+
+
+def dual_load(elasticity: Elasticity, quantity) -> np.ndarray:
+    """j(phi_i) over the unknowns: the quantity's kernel as a body force (0 without one)."""
+    if quantity.kernel is None:
+        return np.zeros(elasticity.ndofs)
+    family_load = elasticity_load(elasticity, quantity.kernel)
+    return (family_load[elasticity.free] if elasticity.constraint is None
+            else elasticity.constraint[:, elasticity.free].T @ family_load)
+
+
+def elasticity_load(elasticity: Elasticity, kernel) -> np.ndarray:
+    """(kernel, phi_i) over every DOF of the basis, by the cell family's body-load rule."""
+    from formulations.cells import family_of
+
+    return family_of(elasticity.mesh).body_load(kernel, elasticity.basis, elasticity.order)
