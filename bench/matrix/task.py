@@ -11,6 +11,7 @@ from dataclasses import dataclass, replace
 from bench.matrix.artifacts import level_artifact_path, publish_last_level, save_artifact
 from bench.matrix.files import FULL
 from bench.matrix.spec import SequenceSpec, build_scene, check_formulation_options
+from bench.sequence.goal import why_no_goal
 from bench.sequence.loop import LevelResult, run_sequence
 from bench.sequence.rows import ResultRow, identity_columns
 from estimators.base import ESTIMATORS, why_not_on
@@ -32,7 +33,7 @@ class Outcome:
 
 def why_skipped(scene: Scene, formulation: str, solver: str, estimator: str,
                 options: dict | None = None, order: int = 1, cell: str = DEFAULT_CELL,
-                strategy: str = "uniform") -> str | None:
+                strategy: str = "uniform", goal: str | None = None) -> str | None:
     """The reason a combination is impossible (declared by the registrations and the cell
     family, or no method of the solver for the problem the formulation offers with these
     options), or None."""
@@ -45,7 +46,8 @@ def why_skipped(scene: Scene, formulation: str, solver: str, estimator: str,
               or (SOLVERS.why_not(solver, scene=scene, formulation=formulation)
                   if solver in SOLVERS.names() else None)
               or ESTIMATORS.why_not(estimator, scene=scene, formulation=formulation)
-              or why_not_on(estimator, family))
+              or why_not_on(estimator, family)
+              or why_no_goal(scene, goal, strategy, order, family))
     if reason is not None:
         return reason
     coarse = get_formulation(formulation)(scene, family.starting_mesh(scene), order=order,
@@ -91,7 +93,7 @@ def run_spec(spec: SequenceSpec, run: dict, out, truth_of: Callable[[Scene], obj
         names["cell"] = spec.cell
         reason = why_skipped(scene, spec.formulation, spec.solver, spec.estimator,
                              dict(spec.formulation_options), spec.order, spec.cell,
-                             spec.strategy)
+                             spec.strategy, spec.loop_config().goal)
         if reason is not None:
             record(whole_sequence_row(names, STATUS_SKIPPED, reason))
             return STATUS_SKIPPED  # also its end reason

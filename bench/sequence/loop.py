@@ -21,6 +21,7 @@ from bench.sequence.components import (
     check_stopping_settings,
     level_stopping,
 )
+from bench.sequence.goal import GOAL_STRATEGY, goal_level, marking_indicators
 from bench.sequence.marking import MARKINGS, check_marking, mark
 from bench.sequence.memory import (
     MemoryRoute,
@@ -32,6 +33,7 @@ from bench.sequence.nested import initial_displacement
 from bench.sequence.options import option
 from bench.sequence.rows import ResultRow, identity_columns
 from estimators.base import estimator_on
+from estimators.quantities import quantity_names
 from formulations import STATUS_FAILED, get_formulation, solve
 from formulations.cells import DEFAULT_CELL, check_cell, family_for
 from formulations.cells.base import Plan
@@ -43,7 +45,7 @@ from formulations.solvers.stopping import GAMMA_ALG, GAMMA_LIN, STOPPING_RULES
 from scenes import Scene
 from scenes.base import is_integer, is_number
 
-STRATEGIES = ("uniform", "adaptive")
+STRATEGIES = ("uniform", "adaptive", GOAL_STRATEGY)  # goal: marked by the goal's indicators
 
 
 @dataclass(frozen=True)
@@ -56,6 +58,12 @@ class LoopSettings:
                            flag="max-dofs", kind="int>0", section="how")
     max_levels: int = option(40, "maximum number of levels", flag="max-levels", kind="int>0",
                              section="how")
+    goal: str | None = option(
+        None, "a quantity of interest (docs/theory.md, 20): every row gets its value, true "
+        "error and dual-weighted estimate (the qoi columns), and the strategy goal refines by "
+        "its dual-weighted indicators", flag="goal", kind="choice", section="what",
+        choices=quantity_names, metavar="NAME",
+        default_text="none (the strategy goal alone: contact-force)")
     target_error: float | None = option(
         None, "stop each sequence at the first level whose guaranteed error bound is at most "
         "TOL (energy norm; needs a guaranteed estimator such as equilibrated)",
@@ -112,6 +120,8 @@ class LoopSettings:
         if self.backend is not None:
             check_backend(self.backend)
         check_stopping_settings(self.stopping, self.gamma_alg, self.gamma_lin)
+        if self.goal is not None and self.goal not in quantity_names():
+            raise ValueError(f"goal={self.goal!r} is not one of {', '.join(quantity_names())}")
 
     def settings(self) -> dict:
         """The values of ``LoopSettings``' own fields (what a ``LoopConfig`` inherits)."""
@@ -154,13 +164,14 @@ class LevelResult:
     estimate: object | None
 
 
-def refinement(mesh: MeshTri, sol, est, config: LoopConfig) -> Plan:
-    """The plan of the next mesh: uniform refinement, or marking (plus the contact grading
-    closure)."""
+def refinement(mesh: MeshTri, sol, est, config: LoopConfig, indicators=None) -> Plan:
+    """The plan of the next mesh: uniform refinement, or marking by ``indicators`` (default:
+    the estimate's) plus the contact grading closure."""
     family = family_for(config.cell, mesh.dim())
     if config.strategy == "uniform":
         return family.refinement(mesh)
-    marked = mark(est.indicators, config.marking, config.theta)
+    marked = mark(est.indicators if indicators is None else indicators, config.marking,
+                  config.theta)
     if config.grade_contact:  # a 2:1 grading along Gamma_C, where it has an order
         marked = sol.trace.graded(marked, mesh.t.shape[1])
     return family.refinement(mesh, marked)
@@ -250,21 +261,24 @@ def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
         numbers = dict(level_columns(disc, sol, mesh, options), level=level,
                        t_assemble=t_assemble, t_refine=t_refine, t_estimate=t_estimate,
                        **(solver_columns(sol.diagnostics) if failed else {}))
+        goal = None if failed else goal_level(scene, sol, config, truth,
+                                              options.get("backend"))
         if not failed:
             numbers.update(solved_columns(scene, disc, sol, est, config, options, truth,
                                           solver != REFERENCE_SOLVER
-                                          and disc.ndofs <= crosscheck_dofs))
+                                          and disc.ndofs <= crosscheck_dofs), **goal.columns)
             predicted = Previous(numbers["eta_disc"], disc.ndofs)
+        indicators, marked_by = (None, "") if failed else marking_indicators(config, est, goal)
         reached = None if failed else target_reason(config, est)
         numbers["reason"] = "; ".join(filter(None, (numbers["reason"], route.note,
-                                                    reached)))
+                                                    marked_by, reached)))
         yield LevelResult(ResultRow(**ident, **numbers), sol, est)
         if failed:
             return "failed"
         if reached:
             return "target"
         start = time.perf_counter()
-        plan = refinement(mesh, sol, est, config)
+        plan = refinement(mesh, sol, est, config, indicators)
         # the next level's size before its triangles are made: no refinement is wasted
         if plan.free_dofs(scene, config.order) > config.max_dofs:
             return "budget"

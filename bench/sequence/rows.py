@@ -9,6 +9,8 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass, fields
 
+from bench.sequence.goal import goal_of
+
 
 @dataclass(frozen=True)
 class ResultRow:
@@ -101,6 +103,25 @@ class ResultRow:
     stopped_early: bool = False  # the adaptive rule ended it before the fixed tolerances
     newton_steps: int = 0
     krylov_iterations: int = 0
+    # the run's quantity of interest (bench.sequence.goal, docs/theory.md section 20)
+    goal: str = ""
+    goal_estimator: str = ""
+    goal_status: str = ""  # why the goal has no estimate on this level ("" if it has one)
+    qoi: float = math.nan
+    qoi_exact: float = math.nan
+    qoi_true: float = math.nan
+    qoi_error: float = math.nan
+    qoi_relative_error: float = math.nan
+    qoi_estimate: float = math.nan
+    qoi_effectivity: float = math.nan
+    qoi_sign_right: bool = False
+    qoi_residual_part: float = math.nan
+    qoi_contact_part: float = math.nan
+    qoi_guaranteed: bool = False
+    qoi_lower: float = math.nan
+    qoi_upper: float = math.nan
+    dual_dofs: int = 0
+    t_goal: float = math.nan
     scene_parameters: str = ""  # a sweep's scene parameters, "name=value:name=value"
     formulation_options: str = ""  # a sweep's formulation options, the same way
     sequence_key: str = ""  # hash of everything that determines the sequence
@@ -118,13 +139,13 @@ class ResultRow:
 COLUMNS = [f.name for f in fields(ResultRow)]
 # identity of a combination (the sweep labels are empty outside sweeps)
 KEYS = ["scene", "formulation", "solver", "estimator", "strategy", "order", "cell",
-        "stopping", "scene_parameters", "formulation_options"]
+        "stopping", "goal", "scene_parameters", "formulation_options"]
 LABELS = ["scene_parameters", "formulation_options"]
 # sequence_end of a complete sequence; INTERRUPTED (or no end at all) marks one cut short
 FINISHED = ("budget", "max_levels", "memory", "failed", "skipped", "target")
 INTERRUPTED = "interrupted"
 # the phases of a level whose wall times add up to the level's time
-PHASE_TIMES = ["t_assemble", "t_solve", "t_estimate", "t_refine"]
+PHASE_TIMES = ["t_assemble", "t_solve", "t_estimate", "t_goal", "t_refine"]
 
 
 def identity_columns(scene: str, formulation: str, solver: str, estimator: str, config,
@@ -134,7 +155,7 @@ def identity_columns(scene: str, formulation: str, solver: str, estimator: str, 
     (``run``) and the body's dimension."""
     return dict(scene=scene, formulation=formulation, solver=solver, estimator=estimator,
                 strategy=config.strategy, order=config.order, dim=dim, cell=config.cell,
-                stopping=config.stopping,
+                stopping=config.stopping, goal=goal_of(config) or "",
                 marking=config.marking,
                 theta=config.theta,
                 **(run or {}))
@@ -144,7 +165,8 @@ def name_parts(row) -> list:
     """The values of KEYS of a row, the default cell left out: what names its files (so that
     a triangle sequence keeps the names it had before cells were an axis)."""
     return [getattr(row, k) for k in KEYS if not (k == "cell" and getattr(row, k) == "tri")
-            and not (k == "stopping" and getattr(row, k) in ("fixed", ""))]
+            and not (k == "stopping" and getattr(row, k) in ("fixed", ""))
+            and not (k == "goal" and not getattr(row, k))]
 
 
 def with_labels(frame):
@@ -158,7 +180,7 @@ def with_labels(frame):
                      else "tri")
     frame["stopping"] = (frame["stopping"].astype(object).fillna("fixed").replace("", "fixed")
                          .astype(str) if "stopping" in frame else "fixed")
-    for column in LABELS + ["sequence_key", "sequence_end"]:
+    for column in LABELS + ["goal", "sequence_key", "sequence_end"]:
         frame[column] = (frame[column].astype(object).fillna("").astype(str) if column in frame
                          else "")
     return frame

@@ -41,16 +41,16 @@ class GoalEstimate:
 
 
 def register_goal_estimator(name: str, description: str, applies=None):
-    """Register a goal estimator; ``applies(scene=..., solution=...)`` says why it does not
-    run (a scene with friction is refused: its dual problem is not built)."""
+    """Register a goal estimator; ``applies(scene=..., family=..., order=..., quantity=...)``
+    says why it does not run (a scene with friction is refused: its dual problem is not
+    built)."""
     return GOAL_ESTIMATORS.register(name, description,
                                     frictionless_only("goal estimator", name, applies))
 
 
-def why_no_goal_estimate(name: str, scene, solution) -> str | None:
-    """Why goal estimator ``name`` does not run on ``solution`` (None if it does)."""
-    return GOAL_ESTIMATORS.why_not(name, scene=scene, solution=solution)
-
-
-def cell_family(solution):
-    return family_of(solution.elasticity.mesh)
+def why_no_goal_estimate(name: str, scene, quantity, order: int, family=None) -> str | None:
+    """Why goal estimator ``name`` does not estimate ``quantity`` on ``scene`` at ``order``
+    on the cells of ``family`` (default: the scene's own mesh's), or None."""
+    family = family_of(scene.mesh) if family is None else family
+    return GOAL_ESTIMATORS.why_not(name, scene=scene, family=family, order=order,
+                                   quantity=quantity)

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import sparse
 
+from formulations.cells.evaluation import drop_roundoff, evaluate_at
 from formulations.contact.boundary import tangent_frame
 from formulations.elasticity import Elasticity, assemble_elasticity
 from formulations.solvers.backends import factorise
@@ -51,15 +52,23 @@ def node_pressure(solution, nodes, order: int) -> np.ndarray:
 
 
 def contact_set(scene, solution, nodes, order: int) -> np.ndarray:
-    """A_h at the trace nodes of ``order``: lambda_h > 0 (above ACTIVE_SHARE of its maximum)
-    or u_h through the obstacle (a constraint that missed the contact still has one)."""
+    """A_h at the trace nodes of ``order``: a vertex where lambda_h > 0 (above ACTIVE_SHARE of
+    its maximum) or u_h goes through the obstacle; a node inside a facet where its facet's
+    vertices all are (a node half-way to a free vertex is not in contact, whatever lambda_h's
+    interpolant says there: the nodal methods' pressure is linear across the zone's end)."""
     lam = node_pressure(solution, nodes, order)
     t = solution.trace.lagrange_points(order)
     through = np.zeros(nodes.weight.size, dtype=bool)
     excess = solution.normal_displacement(t) - np.asarray(
         scene.gap(solution.trace.points(t)), dtype=float)
     through[nodes.facet_rows[excess > 0]] = True
-    return ((lam > ACTIVE_SHARE * lam.max(initial=0.0)) & (lam > 0)) | through
+    at = ((lam > ACTIVE_SHARE * lam.max(initial=0.0)) & (lam > 0)) | through
+    is_vertex = np.arange(nodes.weight.size) < nodes.vertices.size
+    rows = nodes.facet_rows
+    whole = np.all(at[rows] | ~is_vertex[rows], axis=1)  # every vertex of the facet in A_h
+    inner = np.zeros(nodes.weight.size, dtype=bool)
+    inner[rows[whole].ravel()] = True
+    return np.where(is_vertex, at, inner)
 
 
 def node_dofs(elasticity: Elasticity, trace, nodes) -> tuple[np.ndarray, np.ndarray]:
@@ -126,9 +135,16 @@ def solve_dual(scene, solution, quantity, backend: str | None = None) -> DualSol
     zeta[inner] = factor(rhs[inner] - K[inner][:, fixed] @ omega)
     reaction = rhs[fixed] - K[fixed] @ zeta  # a(v, z) + pi v.n = j(v) at v = the node's normal
     return DualSolution(elasticity=elasticity, z=elasticity.expand(T @ zeta), points=points,
-                        normal_rows=trace.node_rows(elasticity, nodes)[np.flatnonzero(active)],
+                        normal_rows=normal_rows(elasticity, trace, nodes)[np.flatnonzero(active)],
                         reaction=reaction, elements=node_elements(trace, nodes)[active],
                         seconds=time.perf_counter() - start)
+
+
+def normal_rows(elasticity: Elasticity, trace, nodes) -> sparse.csr_matrix:
+    """v -> v(x_i) . n_i at the trace nodes x_i of any order, over every DOF of
+    ``elasticity``'s basis (of any order)."""
+    evaluation = evaluate_at(elasticity.basis, nodes.points, node_elements(trace, nodes))
+    return drop_roundoff(evaluation.matrix(nodes.normal))
 
 
 def node_elements(trace, nodes) -> np.ndarray:

@@ -16,28 +16,52 @@ from __future__ import annotations
 import numpy as np
 
 from estimators.goals.base import GoalEstimate, register_goal_estimator
-from estimators.goals.dual import DualSolution, solve_dual
+from estimators.goals.dual import DualSolution, normal_rows, solve_dual
 from formulations.cells.evaluation import normal_trace_matrix
 from formulations.cells.order_interpolation import interpolation_matrix
 
 
-def no_dual_space(scene=None, solution=None, **_) -> str | None:
-    """Why the order p + 1 space is missing (3D P2, P3), or a quantity has no dual."""
-    if solution is None:
-        return None
-    from formulations.cells import family_of
-
-    family, order = family_of(solution.elasticity.mesh), solution.elasticity.order
-    why = family.why_no_element(order + 1)
+def no_dual_space(scene=None, family=None, order=None, quantity=None, **_) -> str | None:
+    """Why the dual problem cannot be posed: the order p + 1 space is missing on ``family``
+    (a ``CellFamily``: 3D P2, P3), or ``quantity`` has none."""
+    if quantity is not None and quantity.why_no_dual is not None:
+        return f"{quantity.name}: {quantity.why_no_dual}"
+    why = None if family is None or order is None else family.why_no_element(order + 1)
     return None if why is None else f"dwr solves its dual problem with P{order + 1}: {why}"
 
 
+def nodal_reactions(solution) -> np.ndarray | None:
+    """The contact reactions of a nodal formulation (forces at the trace nodes of its order,
+    ``details.reactions``), None where lambda_h is a function of its own."""
+    return getattr(solution.details, "reactions", None)
+
+
 def contact_load(solution, elasticity) -> np.ndarray:
-    """(lambda_h, phi_i . n)_{Gamma_C} over every DOF of ``elasticity``'s basis."""
-    trace = solution.trace
+    """The discrete contact traction on every basis function of ``elasticity``: (lambda_h,
+    phi_i . n)_{Gamma_C}, or where the formulation's discrete equation has nodal reactions
+    R_j (vi), sum_j R_j phi_i(x_j) . n_j: the traction the discrete equation holds with, so
+    that rho vanishes on the discrete space and lambda_h lives on the contact nodes only."""
+    trace, reactions = solution.trace, nodal_reactions(solution)
+    if reactions is not None:
+        nodes = trace.nodes(solution.elasticity.order)
+        return normal_rows(elasticity, trace, nodes).T @ reactions
     t, w = trace.rule(trace.kink_degree)
     pressure = solution.pressure(t) * w[None, :] * trace.measure[:, None]
     return normal_trace_matrix(elasticity.basis, trace, t).T @ pressure.ravel()
+
+
+def nodal_value_gap(solution, quantity) -> float:
+    """(lambda_h^nodal - lambda_h, omega): what J takes from the nodal reactions (the
+    traction ``contact_load`` uses) beyond what it takes from the reported lambda_h (vi's
+    lumped pressure); 0 for the other formulations."""
+    reactions = nodal_reactions(solution)
+    if reactions is None or quantity.weight is None:
+        return 0.0
+    nodes = solution.trace.nodes(solution.elasticity.order)
+    from estimators.quantities.base import weighted_pressure
+
+    return float(reactions @ quantity.weight(nodes.points)
+                 - weighted_pressure(solution, quantity.weight))
 
 
 def element_shares(basis, values: np.ndarray) -> np.ndarray:
@@ -63,7 +87,7 @@ def estimate(scene, solution, quantity, backend: str | None = None) -> GoalEstim
     contact = dual.reaction * gap
     local = element_shares(plus.basis, residual * filtered)
     np.add.at(local, dual.elements, contact)
-    residual_part = float(residual @ dual.z)
+    residual_part = float(residual @ dual.z) + nodal_value_gap(solution, quantity)
     return GoalEstimate(estimator="dwr", quantity=quantity.name,
                         value=float(quantity.evaluate(solution)),
                         estimate=residual_part + float(contact.sum()),
