@@ -53,6 +53,20 @@ def zone_error(zone: tuple[float, float], true_zone: tuple[float, float]) -> flo
     return float(max(abs(zone[0] - true_zone[0]), abs(zone[1] - true_zone[1])))
 
 
+def zone_jaccard(zone: tuple[float, float], true_zone: tuple[float, float]) -> float:
+    """Jaccard's distance 1 - |Z_h n Z| / |Z_h u Z| of two contact zones taken as intervals
+    of the contact coordinate (their extent along the first one in 3D); a missing zone (NaN
+    ends) is empty: 1 against a zone, 0 against none."""
+    def length(z):
+        return float(z[1] - z[0]) if z[0] == z[0] and z[1] == z[1] else 0.0
+
+    a, b = length(zone), length(true_zone)
+    both = (max(0.0, min(zone[1], true_zone[1]) - max(zone[0], true_zone[0]))
+            if a > 0 and b > 0 else 0.0)
+    union = a + b - both
+    return 1.0 - both / union if union > 0 else 0.0
+
+
 def sample_points(trace, order: int) -> np.ndarray:
     """The Lagrange nodes of degree ``order`` and the points of a degree-``SAMPLE_DEGREE``
     rule on every facet (local coordinates)."""

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 from skfem import Basis
 
-from bench.measure.contact import contact_zone, zone_error
+from bench.measure.contact import contact_zone, zone_error, zone_jaccard
 from formulations import DiscreteSolution
 from formulations.elasticity import stress_from_gradient, stress_tensor_from_gradient
 from formulations.friction.state import traction_size
@@ -33,6 +33,7 @@ class Errors:
     zone_error: float
     contact_zone_start: float
     contact_zone_end: float
+    zone_jaccard: float = float("nan")  # Jaccard's distance to the true zone
 
 
 def energy_density(grad: np.ndarray, lam: float, mu: float) -> np.ndarray:
@@ -67,7 +68,7 @@ def errors_from(energy_error: float, solution: DiscreteSolution, true_pressure,
     """The pressure and zone errors of ``solution`` beside a measured energy-norm error."""
     zone = contact_zone(solution)
     return Errors(energy_error, pressure_error(solution, true_pressure),
-                  zone_error(zone, true_zone), *zone)
+                  zone_error(zone, true_zone), *zone, zone_jaccard(zone, true_zone))
 
 
 def element_energy_errors(scene, solution: DiscreteSolution) -> np.ndarray:

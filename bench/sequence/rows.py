@@ -62,6 +62,7 @@ class ResultRow:
     zone_error: float = math.nan
     contact_zone_start: float = math.nan
     contact_zone_end: float = math.nan
+    zone_jaccard: float = math.nan  # 1 - |Z_h n Z| / |Z_h u Z| against the true zone
     # how far u_h goes through the obstacle (bench.measure.contact, docs/theory.md, 19.1)
     penetration: float = math.nan
     nodal_penetration: float = math.nan
