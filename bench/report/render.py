@@ -18,6 +18,7 @@ from bench.matrix.artifacts import file_stem
 from bench.matrix.files import atomic_text
 from bench.matrix.rates import RATE_LEVELS, judged_levels, rates_table
 from bench.matrix.scene_files import load_scene_files
+from bench.report.goal_figures import goal_section
 from bench.report.estimator_figures import ESTIMATOR_CAPTION, estimator_effectivity
 from bench.report.orders import order_section
 from bench.report.questions import questions
@@ -141,6 +142,7 @@ def write_report(table: pd.DataFrame, out: str | Path, results: str | Path | Non
         "stopping_figure": figs.add(components_figure(rows) if len(rows) else None,
                                     "stopping", STOPPING_CAPTION),
         "stopping_table": work_saved(rows) if len(rows) else pd.DataFrame(),
+        "goals": goal_section(rows, figs),
         "hard_run": hard is not None, "hard_figures": hard_figures, "hard_matrix": hard_matrix,
         "n_rows": len(everything), "n_too_coarse": int(rows["reference_too_coarse"]
                                                         .fillna(False).astype(bool).sum()),

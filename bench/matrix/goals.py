@@ -1,0 +1,74 @@
+"""The goal table: per sequence with a quantity of interest, how its error fell and how well
+the goal estimate judged it (docs/report.md, "Quantities of interest"; docs/theory.md 20.5).
+
+One row per sequence (``KEYS``) whose rows carry a goal: the DOFs at which the quantity's
+relative error first reached TARGET (and stayed below 2 TARGET on every later level), the
+effectivity's range and the levels with the wrong sign from JUDGED_FROM DOFs on, and for a
+goal-driven sequence the energy-driven one's DOFs to the same target beside its own (the
+ratio is what goal-driven refinement saves).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+
+from bench.measure.contact import SOLVED_STATUSES
+from bench.sequence.goal import GOAL_STRATEGY
+from bench.sequence.rows import KEYS, with_labels
+
+TARGET = 1e-4  # relative error of the quantity the DOF counts are taken at
+JUDGED_FROM = 1000  # DOFs: the effectivity is judged on the levels from here on
+PAIRED = [k for k in KEYS if k != "strategy"]  # a goal-driven sequence's energy-driven twin
+
+
+def dofs_to(frame: pd.DataFrame, target: float = TARGET) -> float:
+    """The DOFs of the first level whose relative error is at most ``target`` and whose later
+    levels all stay below 2 ``target`` (a sign change of the error can pass through 0 on the
+    way: one lucky level is not reaching it); NaN if none."""
+    error = frame["qoi_relative_error"].to_numpy(dtype=float)
+    ndofs = frame["ndofs"].to_numpy(dtype=float)
+    for k in range(error.size):
+        if error[k] <= target and np.all(error[k:] <= 2 * target):
+            return float(ndofs[k])
+    return math.nan
+
+
+def sequence_row(frame: pd.DataFrame) -> dict:
+    """The goal columns of one sequence's solved levels (sorted by level)."""
+    judged = frame[(frame["ndofs"] >= JUDGED_FROM) & frame["qoi_effectivity"].notna()]
+    last = frame.iloc[-1]
+    return {"levels": len(frame), "ndofs": int(last["ndofs"]), "qoi": float(last["qoi"]),
+            "qoi_relative_error": float(last["qoi_relative_error"]),
+            "dofs_to_target": dofs_to(frame),
+            "effectivity_min": float(judged["qoi_effectivity"].min()) if len(judged)
+            else math.nan,
+            "effectivity_max": float(judged["qoi_effectivity"].max()) if len(judged)
+            else math.nan,
+            "judged_levels": len(judged),
+            "wrong_sign": int((~judged["qoi_sign_right"].astype(bool)).sum()),
+            "t_goal": float(frame["t_goal"].sum())}
+
+
+def goal_table(table: pd.DataFrame) -> pd.DataFrame:
+    """One row per sequence with a goal (empty without any), with ``energy_dofs_to_target``
+    and ``dofs_ratio`` (energy-driven over goal-driven DOFs to TARGET) on the goal-driven
+    ones."""
+    table = with_labels(table)
+    if "qoi_relative_error" not in table or not (table["goal"] != "").any():
+        return pd.DataFrame()
+    solved = table[(table["goal"] != "") & table["status"].isin(SOLVED_STATUSES)
+                   & (table["level"] >= 0)]
+    rows = [{**dict(zip(KEYS, key, strict=True)), "dim": int(group["dim"].iloc[0]),
+             **sequence_row(group.sort_values("level"))}
+            for key, group in solved.groupby(KEYS, sort=True, dropna=False)]
+    out = pd.DataFrame(rows)
+    if out.empty:
+        return out
+    energy = out[out["strategy"] == "adaptive"].set_index(PAIRED)["dofs_to_target"]
+    twin = out.set_index(PAIRED).index.map(lambda k: energy.get(k, math.nan))
+    out["energy_dofs_to_target"] = np.where(out["strategy"] == GOAL_STRATEGY, twin, math.nan)
+    out["dofs_ratio"] = out["energy_dofs_to_target"] / out["dofs_to_target"]
+    return out
