@@ -18,8 +18,8 @@ from bench.matrix.artifacts import file_stem
 from bench.matrix.files import atomic_text
 from bench.matrix.rates import RATE_LEVELS, judged_levels, rates_table
 from bench.matrix.scene_files import load_scene_files
-from bench.report.goal_figures import goal_section
 from bench.report.estimator_figures import ESTIMATOR_CAPTION, estimator_effectivity
+from bench.report.goal_figures import goal_section
 from bench.report.orders import order_section
 from bench.report.questions import questions
 from bench.report.sections import Figures, scene_section
