@@ -9,6 +9,8 @@ from bench.matrix.plugins import FAILURES
 from bench.matrix.scene_files import FILE_FAILURES
 from estimators import estimator_descriptions
 from estimators.base import ESTIMATORS
+from estimators.goals.base import GOAL_ESTIMATORS
+from estimators.quantities.base import QUANTITIES
 from formulations import formulation_descriptions, solver_descriptions
 from formulations.cells import CELL_FAMILIES
 from formulations.elasticity import order_descriptions
@@ -50,6 +52,8 @@ LISTINGS = (("scenes", scene_descriptions, SCENES.origin),
             ("solvers", solver_descriptions, _solver_origin),
             ("sparse back-ends (--backend)", BACKENDS.descriptions, BACKENDS.origin),
             ("estimators", estimator_descriptions, ESTIMATORS.origin),
+            ("quantities of interest (--goal)", QUANTITIES.descriptions, QUANTITIES.origin),
+            ("goal estimators", GOAL_ESTIMATORS.descriptions, GOAL_ESTIMATORS.origin),
             ("orders (--order)", order_descriptions, lambda name: BUILT_IN),
             ("cell families (--cell tri: simplices, quad: tensor-product cells)",
              CELL_FAMILIES.descriptions, CELL_FAMILIES.origin),

@@ -16,6 +16,7 @@ import pandas as pd
 from bench.hard import check_expected, run_hard, write_hard
 from bench.matrix import RunConfig, run
 from bench.matrix.config_files import run_fields
+from bench.matrix.goals import goal_table
 from bench.matrix.rates import rates_table
 from bench.sequence.rows import KEYS
 from bench.verify.closed_form import closed_form_table
@@ -120,15 +121,16 @@ def verify(out: str | Path = "results-verify", expected_path: str | Path = EXPEC
     ``run_gate_matrices``; the results do not depend on it)."""
     expected = load_expected(expected_path)
     rows = run_gate_matrices(expected, out, on_level, workers)
-    rates = rates_table(rows)
+    rates, goals = rates_table(rows), goal_table(rows)
     closed_form = closed_form_table(expected["closed_form"])
     partial_slip = partial_slip_table(expected["partial_slip"])
     truth = truth_table(expected["truth"], quick)
     bars = error_bar_table(expected["truth"], quick)
-    for name, table in (("rates", rates), ("closed-form", closed_form),
+    for name, table in (("rates", rates), ("goals", goals), ("closed-form", closed_form),
                         ("partial-slip", partial_slip), ("truth", truth), ("error-bar", bars)):
         table.to_csv(Path(out) / f"{name}.csv", index=False)
-    verdicts = check_gates(expected, [rates, closed_form, partial_slip, truth, bars], quick)
+    verdicts = check_gates(expected, [rates, goals, closed_form, partial_slip, truth, bars],
+                           quick)
     if hard:
         table = run_hard()
         write_hard(table, out)

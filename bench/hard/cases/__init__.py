@@ -5,6 +5,7 @@ case is one new module here and one import line below."""
 from bench.hard.cases import (  # noqa: F401
     cycling,
     friction,
+    goal_estimate,
     invalid,
     lost_contact,
     mixed_patches_3d,
