@@ -3,7 +3,8 @@ the goal estimate judged it (docs/report.md, "Quantities of interest"; docs/theo
 
 One row per sequence (``KEYS``) whose rows carry a goal: the DOFs at which the quantity's
 relative error first reached TARGET (and stayed below 2 TARGET on every later level), the
-effectivity's range and the levels with the wrong sign from JUDGED_FROM DOFs on, and for a
+effectivity's range and the levels with the wrong sign from JUDGED_FROM DOFs on (a level where
+the signed error crossed zero is judged by how far its estimate misses instead), and for a
 goal-driven sequence the energy-driven one's DOFs to the same target beside its own (the
 ratio is what goal-driven refinement saves).
 """
@@ -38,28 +39,54 @@ def dofs_to(frame: pd.DataFrame, target: float = TARGET) -> float:
     return math.nan
 
 
-def effectivity_range(frame: pd.DataFrame, from_dofs: int) -> tuple[float, float, int, int]:
+CROSSING = 0.1  # a level whose error is below this share of both neighbours' crossed zero
+MISS = 0.25  # a crossing's estimate may miss its error by this share of the neighbours' errors
+
+
+def zero_crossings(frame: pd.DataFrame) -> tuple[np.ndarray, np.ndarray]:
+    """Per level: whether its signed error passed through zero between its neighbours (|e|
+    below CROSSING times both neighbours' |e|: its effectivity is a ratio of two round-offs of
+    the same small number and says nothing), and whether its estimate then misses e by more
+    than MISS times the smaller neighbour's |e| (the same test in absolute terms)."""
+    error = frame["qoi_error"].abs().to_numpy(dtype=float)
+    miss = (frame["qoi_estimate"] - frame["qoi_error"]).abs().to_numpy(dtype=float)
+    crossing, missed = np.zeros(error.size, dtype=bool), np.zeros(error.size, dtype=bool)
+    if error.size >= 3:
+        neighbours = np.minimum(error[:-2], error[2:])
+        crossing[1:-1] = error[1:-1] < CROSSING * neighbours
+        missed[1:-1] = crossing[1:-1] & (miss[1:-1] > MISS * neighbours)
+    return crossing, missed
+
+
+def effectivity_range(frame: pd.DataFrame, from_dofs: int) -> tuple[float, float, int, int,
+                                                                    int]:
     """(min, max) of the effectivity on the levels from ``from_dofs`` DOFs whose contact is
-    resolved (status ok), their number and how many have the wrong sign."""
-    judged = frame[(frame["ndofs"] >= from_dofs) & (frame["status"] == "ok")
-                   & frame["qoi_effectivity"].notna()]
-    if not len(judged):
-        return math.nan, math.nan, 0, 0
-    return (float(judged["qoi_effectivity"].min()), float(judged["qoi_effectivity"].max()),
-            len(judged), int((~judged["qoi_sign_right"].astype(bool)).sum()))
+    resolved (status ok), zero crossings left out; their number; how many of them have the
+    wrong sign; how many crossings the estimate missed (``zero_crossings``)."""
+    crossing, missed = zero_crossings(frame)
+    judged = ((frame["ndofs"] >= from_dofs) & (frame["status"] == "ok")
+              & frame["qoi_effectivity"].notna()).to_numpy()
+    plain = frame[judged & ~crossing]
+    missed_crossings = int((judged & missed).sum())
+    if not len(plain):
+        return math.nan, math.nan, 0, 0, missed_crossings
+    return (float(plain["qoi_effectivity"].min()), float(plain["qoi_effectivity"].max()),
+            len(plain), int((~plain["qoi_sign_right"].astype(bool)).sum()), missed_crossings)
 
 
 def sequence_row(frame: pd.DataFrame) -> dict:
     """The goal columns of one sequence's solved levels (sorted by level)."""
-    low, high, judged, wrong = effectivity_range(frame, JUDGED_FROM)
+    low, high, judged, wrong, missed = effectivity_range(frame, JUDGED_FROM)
     later = effectivity_range(frame, 2 * JUDGED_FROM)
     last = frame.iloc[-1]
     return {"levels": len(frame), "ndofs": int(last["ndofs"]), "qoi": float(last["qoi"]),
             "qoi_relative_error": float(last["qoi_relative_error"]),
             "dofs_to_target": dofs_to(frame), "effectivity_min": low,
             "effectivity_max": high, "judged_levels": judged, "wrong_sign": wrong,
+            "crossings_missed": missed,
             "effectivity_min_from_2000": later[0], "effectivity_max_from_2000": later[1],
-            "wrong_sign_from_2000": later[3], "t_goal": float(frame["t_goal"].sum())}
+            "wrong_sign_from_2000": later[3], "crossings_missed_from_2000": later[4],
+            "t_goal": float(frame["t_goal"].sum())}
 
 
 def goal_table(table: pd.DataFrame) -> pd.DataFrame:
