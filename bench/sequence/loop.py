@@ -210,10 +210,47 @@ def level_options(level: int, disc, solver: str, config: LoopConfig, route: Memo
     return options, route
 
 
+def refused(ident: dict, level: int, ndofs: int, mesh, refusal: tuple[str, str]):
+    """Yield the failed row of a refused level (none for a later level merely over the
+    budget: that is just the end); return the end reason."""
+    end, reason = refusal
+    if reason:
+        yield refused_row(ident, level, ndofs, mesh, reason)
+    return end
+
+
+def timed(function, *args):
+    """(function(*args), its wall time in s)."""
+    start = time.perf_counter()
+    return function(*args), time.perf_counter() - start
+
+
 def refused_row(ident: dict, level: int, ndofs: int, mesh, reason: str) -> LevelResult:
     """The failed row of a level that is not built."""
     return LevelResult(ResultRow(**ident, level=level, ndofs=ndofs, n_elements=mesh.t.shape[1],
                                  status=STATUS_FAILED, reason=reason), None, None)
+
+
+@dataclass(frozen=True, eq=False)
+class JudgedLevel:
+    """A solved level's columns beyond its basic numbers, what it is marked by (None: the
+    estimate's indicators), the note on that and why the sequence ends here (or None)."""
+
+    numbers: dict
+    indicators: object
+    note: str
+    reached: str | None
+
+
+def judge_level(scene: Scene, disc, sol, est, config: LoopConfig, options: dict, truth,
+                crosscheck: bool) -> JudgedLevel:
+    """The solved level's columns (``solved_columns``, the goal's), its marking indicators
+    and the target reason."""
+    goal = goal_level(scene, sol, config, truth, options.get("backend"))
+    numbers = dict(solved_columns(scene, disc, sol, est, config, options, truth, crosscheck),
+                   **goal.columns)
+    indicators, note = marking_indicators(config, est, goal)
+    return JudgedLevel(numbers, indicators, note, target_reason(config, est))
 
 
 def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
@@ -222,11 +259,8 @@ def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
                  formulation_options: dict | None = None) -> Generator[LevelResult, None, str]:
     """Yield one ``LevelResult`` per level until the DOF budget or the level count is reached,
     or a level fails (its row says why); return why it ended (``budget``, ``max_levels``,
-    ``memory``, ``failed``, ``target``: the guaranteed bound reached ``config.target_error``).
-    With a ``truth`` (``bench.truth``) every level also gets its
-    errors and effectivity indices; ``identity``: the run's columns (run id, provenance, sweep
-    labels); ``formulation_options`` go to the formulation's ``discretise``, with the
-    configuration's ``order``."""
+    ``memory``, ``failed``, ``target``). ``truth`` (``bench.truth``): errors and effectivity
+    per level; ``identity``: the run's columns; ``formulation_options``: to ``discretise``."""
     discretise = functools.partial(get_formulation(formulation), order=config.order,
                                    **(formulation_options or {}))
     family = family_for(config.cell, scene.dim)
@@ -243,10 +277,7 @@ def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
         route = level_memory(level, ndofs, solver, config, scene.dim)
         refusal = level_refusal(level, ndofs, config, route)
         if refusal is not None:  # over the budget or the memory: a failed row says so
-            end, reason = refusal
-            if reason:  # a later level over the budget is just the end
-                yield refused_row(ident, level, ndofs, mesh, reason)
-            return end
+            return (yield from refused(ident, level, ndofs, mesh, refusal))
         scene.check_mesh(mesh, level)
         start = time.perf_counter()
         disc = discretise(scene, mesh)
@@ -255,30 +286,26 @@ def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,
         stopping = level_stopping(scene, disc, config, estimator, predicted)
         sol = previous = solve(disc, solver, stopping=stopping, **options)
         failed = sol.status == STATUS_FAILED
-        start = time.perf_counter()
-        est = None if failed else estimate(scene, sol)
-        t_estimate = float("nan") if failed else time.perf_counter() - start
+        est, t_estimate = (None, float("nan")) if failed else timed(estimate, scene, sol)
         numbers = dict(level_columns(disc, sol, mesh, options), level=level,
                        t_assemble=t_assemble, t_refine=t_refine, t_estimate=t_estimate,
                        **(solver_columns(sol.diagnostics) if failed else {}))
-        goal = None if failed else goal_level(scene, sol, config, truth,
-                                              options.get("backend"))
-        if not failed:
-            numbers.update(solved_columns(scene, disc, sol, est, config, options, truth,
-                                          solver != REFERENCE_SOLVER
-                                          and disc.ndofs <= crosscheck_dofs), **goal.columns)
+        judged = None if failed else judge_level(scene, disc, sol, est, config, options, truth,
+                                                 solver != REFERENCE_SOLVER
+                                                 and disc.ndofs <= crosscheck_dofs)
+        if judged is not None:
+            numbers.update(judged.numbers)
             predicted = Previous(numbers["eta_disc"], disc.ndofs)
-        indicators, marked_by = (None, "") if failed else marking_indicators(config, est, goal)
-        reached = None if failed else target_reason(config, est)
+        reached = None if failed else judged.reached
         numbers["reason"] = "; ".join(filter(None, (numbers["reason"], route.note,
-                                                    marked_by, reached)))
+                                                    judged and judged.note, reached)))
         yield LevelResult(ResultRow(**ident, **numbers), sol, est)
         if failed:
             return "failed"
         if reached:
             return "target"
         start = time.perf_counter()
-        plan = refinement(mesh, sol, est, config, indicators)
+        plan = refinement(mesh, sol, est, config, judged.indicators)
         # the next level's size before its triangles are made: no refinement is wasted
         if plan.free_dofs(scene, config.order) > config.max_dofs:
             return "budget"

@@ -24,10 +24,11 @@ from formulations.elasticity import Elasticity, assemble_elasticity
 from formulations.solvers.backends import factorise
 
 ACTIVE_SHARE = 1e-6  # a node is in A_h where lambda_h exceeds this share of its maximum
-# a 3D dual problem larger than this is solved by the amg back-end when the run names none: its
-# P(p+1) system has ~7 times the primal's unknowns, and at 1.5e5 of them amg and PARDISO agreed
-# to 1e-11 in the estimate (hertz-3d, vi P1) while PARDISO's factor grew past 9 GiB at 5.6e5
-DUAL_DIRECT_MAX_3D = 150_000
+# a dual problem whose matrix has more nonzeros than this is solved by the amg back-end when the
+# run names none: in 3D its P(p+1) system has ~7 times the primal's unknowns and ~80 nonzeros
+# per row; at 1.5e5 unknowns (1.2e7 nonzeros) amg and PARDISO agreed to 1e-11 in the estimate
+# (hertz-3d, vi P1), and PARDISO's factor grew past 9 GiB at 5.6e5 (planar P2: 3.3e5 unknowns)
+DUAL_DIRECT_MAX_NONZEROS = 12_000_000
 
 
 @dataclass(frozen=True, eq=False)
@@ -134,9 +135,10 @@ def solve_dual(scene, solution, quantity, backend: str | None = None) -> DualSol
     free = np.ones(elasticity.ndofs, dtype=bool)
     free[fixed] = False
     inner = np.flatnonzero(free)
-    if backend is None and elasticity.mesh.dim() == 3 and inner.size > DUAL_DIRECT_MAX_3D:
+    system = K[inner][:, inner]
+    if backend is None and system.nnz > DUAL_DIRECT_MAX_NONZEROS:
         backend = "amg"
-    factor = factorise(K[inner][:, inner], backend, T[:, inner].T @ elasticity.rigid_modes
+    factor = factorise(system, backend, T[:, inner].T @ elasticity.rigid_modes
                        if backend == "amg" else None)
     zeta[inner] = factor(rhs[inner] - K[inner][:, fixed] @ omega)
     reaction = rhs[fixed] - K[fixed] @ zeta  # a(v, z) + pi v.n = j(v) at v = the node's normal

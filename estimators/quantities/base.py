@@ -120,13 +120,20 @@ def exact_pressure_integral(scene, weight) -> float | None:
     free-boundary): the rule's relative error is about 1e-9 in 2D (tests)."""
     if scene.exact is None:
         return None
-    s, w = box_rule(contact_box(scene), PANELS if scene.dim == 2 else PANELS // 4)
-    s = s[0] if scene.dim == 2 else s
+    s, w = coordinate_rule(scene)
     return float(np.sum(w * scene.exact.pressure(s) * weight(s)))
 
 
 def reference_pressure_integral(reference, scene, weight) -> float:
     """(lambda_ref, omega) of an overkill reference's sampled pressure, on the same rule."""
-    s, w = box_rule(contact_box(scene), PANELS if scene.dim == 2 else PANELS // 4)
-    s = s[0] if scene.dim == 2 else s
+    s, w = coordinate_rule(scene)
     return float(np.sum(w * reference.pressure(s) * weight(s)))
+
+
+def coordinate_rule(scene):
+    """``box_rule`` on the contact coordinates' box, PANELS per axis of a line and a quarter
+    of that per axis of a surface, the points shaped as the scene's contact coordinates ((n,)
+    along a line, (k, n) on a surface)."""
+    box = contact_box(scene)
+    s, w = box_rule(box, PANELS >> 2 * (len(box) - 1))
+    return (s.reshape(-1) if len(box) == 1 else s), w

@@ -43,7 +43,7 @@ def mean_pressure(scene) -> Quantity:
         return omega(scene.contact_coordinate(x)).reshape(np.shape(x)[1:]) / area
 
     def along(s):
-        return omega(s).reshape(np.shape(s)[-1:] if scene.dim == 2 else np.shape(s)[1:]) / area
+        return omega(s).reshape(np.shape(s)[-1:]) / area
 
     exact = exact_pressure_integral(scene, along)
     return Quantity(name="mean-pressure", evaluate=lambda sol: weighted_pressure(sol, weight),

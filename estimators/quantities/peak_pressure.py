@@ -51,7 +51,7 @@ def peak_pressure(scene) -> Quantity:
         return omega(scene.contact_coordinate(x)).reshape(np.shape(x)[1:])
 
     def along(s):
-        return omega(s).reshape(np.shape(s)[-1:] if scene.dim == 2 else np.shape(s)[1:])
+        return omega(s).reshape(np.shape(s)[-1:])
 
     return Quantity(name="peak-pressure", evaluate=lambda sol: weighted_pressure(sol, weight),
                     exact=exact_pressure_integral(scene, along), weight=weight,
