@@ -74,6 +74,23 @@ def effectivity_range(frame: pd.DataFrame, from_dofs: int) -> tuple[float, float
             len(plain), int((~plain["qoi_sign_right"].astype(bool)).sum()), missed_crossings)
 
 
+def interval_columns(frame: pd.DataFrame) -> dict:
+    """The guaranteed intervals of a sequence (rows with ``qoi_guaranteed``): how many levels
+    have one, how many miss the true value (the gate: none), and the last one's half-width
+    relative to the true value."""
+    if "qoi_guaranteed" not in frame:
+        return {"interval_levels": 0, "interval_misses": 0, "interval_half_width": math.nan}
+    held = frame[frame["qoi_guaranteed"].fillna(False).astype(bool)
+                 & frame["qoi_true"].notna()]
+    if not len(held):
+        return {"interval_levels": 0, "interval_misses": 0, "interval_half_width": math.nan}
+    last = held.iloc[-1]
+    return {"interval_levels": len(held),
+            "interval_misses": int((~held["qoi_interval_holds"].astype(bool)).sum()),
+            "interval_half_width": float((last["qoi_upper"] - last["qoi_lower"]) / 2
+                                         / abs(last["qoi_true"]))}
+
+
 def sequence_row(frame: pd.DataFrame) -> dict:
     """The goal columns of one sequence's solved levels (sorted by level)."""
     low, high, judged, wrong, missed = effectivity_range(frame, JUDGED_FROM)
@@ -86,7 +103,7 @@ def sequence_row(frame: pd.DataFrame) -> dict:
             "crossings_missed": missed,
             "effectivity_min_from_2000": later[0], "effectivity_max_from_2000": later[1],
             "wrong_sign_from_2000": later[3], "crossings_missed_from_2000": later[4],
-            "t_goal": float(frame["t_goal"].sum())}
+            **interval_columns(frame), "t_goal": float(frame["t_goal"].sum())}
 
 
 def goal_table(table: pd.DataFrame) -> pd.DataFrame:

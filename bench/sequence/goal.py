@@ -17,6 +17,7 @@ import numpy as np
 
 from estimators.goals import DEFAULT_GOAL_ESTIMATOR, why_no_goal_estimate
 from estimators.goals.base import GOAL_ESTIMATORS
+from estimators.goals.force_interval import force_interval, why_no_interval
 from estimators.quantities import DEFAULT_QUANTITY, get_quantity
 from estimators.quantities.base import QUANTITIES
 
@@ -59,8 +60,10 @@ class GoalLevel:
     estimate: object | None
 
 
-def goal_level(scene, solution, config, truth, backend: str | None = None) -> GoalLevel:
-    """The goal columns of a solved level (docs/columns.md, "Quantities of interest")."""
+def goal_level(scene, solution, config, truth, backend: str | None = None,
+               energy=None) -> GoalLevel:
+    """The goal columns of a solved level (docs/columns.md); ``energy``: the level's energy
+    estimate, whose guaranteed bound gives the contact force its guaranteed interval."""
     goal = goal_of(config)
     if goal is None:
         return GoalLevel({}, None)
@@ -76,6 +79,9 @@ def goal_level(scene, solution, config, truth, backend: str | None = None) -> Go
     estimate, columns["goal_status"] = goal_estimate(scene, solution, quantity, config, backend)
     if estimate is not None:
         columns.update(estimate_columns(estimate, columns.get("qoi_error", math.nan)))
+    if quantity.energy_interval and energy is not None and energy.guaranteed:
+        columns.update(interval_columns(solution, energy.eta, columns.get("qoi_true"),
+                                        backend))
     columns["t_goal"] = time.perf_counter() - start
     return GoalLevel(columns, estimate)
 
@@ -98,12 +104,23 @@ def goal_estimate(scene, solution, quantity, config, backend):
 def estimate_columns(estimate, error: float) -> dict:
     """The estimate's columns and its effectivity estimate / true error."""
     out = dict(qoi_estimate=estimate.estimate, qoi_residual_part=estimate.residual_part,
-               qoi_contact_part=estimate.contact_part, qoi_guaranteed=estimate.guaranteed,
-               qoi_lower=estimate.value + estimate.lower,
-               qoi_upper=estimate.value + estimate.upper, dual_dofs=estimate.dual_dofs)
+               qoi_contact_part=estimate.contact_part, dual_dofs=estimate.dual_dofs)
     if math.isfinite(error) and error != 0:
         out.update(qoi_effectivity=estimate.estimate / error,
                    qoi_sign_right=bool(np.sign(estimate.estimate) == np.sign(error)))
+    return out
+
+
+def interval_columns(solution, energy_bound: float, true: float | None,
+                     backend: str | None) -> dict:
+    """The guaranteed interval of the contact force (``force_interval``) and whether it
+    holds the truth's value; empty where it cannot be had."""
+    if why_no_interval(solution) is not None:
+        return {}
+    interval = force_interval(solution, energy_bound, backend)
+    out = dict(qoi_guaranteed=True, qoi_lower=interval.lower, qoi_upper=interval.upper)
+    if true is not None and math.isfinite(true):
+        out["qoi_interval_holds"] = bool(interval.lower <= true <= interval.upper)
     return out
 
 

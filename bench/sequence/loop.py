@@ -246,7 +246,7 @@ def judge_level(scene: Scene, disc, sol, est, config: LoopConfig, options: dict,
                 crosscheck: bool) -> JudgedLevel:
     """The solved level's columns (``solved_columns``, the goal's), its marking indicators
     and the target reason."""
-    goal = goal_level(scene, sol, config, truth, options.get("backend"))
+    goal = goal_level(scene, sol, config, truth, options.get("backend"), est)
     numbers = dict(solved_columns(scene, disc, sol, est, config, options, truth, crosscheck),
                    **goal.columns)
     indicators, note = marking_indicators(config, est, goal)

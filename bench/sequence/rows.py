@@ -121,6 +121,7 @@ class ResultRow:
     qoi_guaranteed: bool = False
     qoi_lower: float = math.nan
     qoi_upper: float = math.nan
+    qoi_interval_holds: bool = False  # qoi_lower <= qoi_true <= qoi_upper
     dual_dofs: int = 0
     t_goal: float = math.nan
     scene_parameters: str = ""  # a sweep's scene parameters, "name=value:name=value"

@@ -22,9 +22,10 @@ DEFAULT_GOAL_ESTIMATOR = "dwr"
 class GoalEstimate:
     """``estimate`` approximates J(u, lambda) - J(u_h, lambda_h) with its sign: the residual
     part rho(z) plus the contact part (pi, g - u_h.n) on the contact set (docs/theory.md,
-    20.2). ``indicators`` (>= 0, per element) are what marking refines by; ``guaranteed``
-    whether [value + lower, value + upper] is proved to hold J(u, lambda) (never for dwr:
-    its dual problem is linearised at the discrete contact set)."""
+    20.2). ``indicators`` (>= 0, per element) are what marking refines by; ``guaranteed``:
+    whether the estimate is a proved bound (never for dwr: its dual problem is linearised at
+    the discrete contact set; the guaranteed interval of the contact force is
+    ``estimators.goals.force_interval``'s)."""
 
     estimator: str
     quantity: str
@@ -36,8 +37,6 @@ class GoalEstimate:
     dual_dofs: int
     seconds: float
     guaranteed: bool = False
-    lower: float = float("nan")
-    upper: float = float("nan")
 
 
 def register_goal_estimator(name: str, description: str, applies=None):

@@ -123,26 +123,11 @@ def solve_dual(scene, solution, quantity, backend: str | None = None) -> DualSol
     active = own & contact_set(scene, solution, nodes, elasticity.order)
     columns, normal = columns[:, active], nodes.normal[:, active]
     points = nodes.points[:, active]
-    load = dual_load(elasticity, quantity)
-    T = rotation(elasticity.ndofs, columns, normal)
-    K = (T.T @ elasticity.K_free @ T).tocsr()
-    rhs = T.T @ load
-    fixed = columns[0]
     omega = (np.asarray(quantity.weight(points), dtype=float) if quantity.weight is not None
-             else np.zeros(fixed.size))
-    zeta = np.zeros(elasticity.ndofs)
-    zeta[fixed] = omega
-    free = np.ones(elasticity.ndofs, dtype=bool)
-    free[fixed] = False
-    inner = np.flatnonzero(free)
-    system = K[inner][:, inner]
-    if backend is None and system.nnz > DUAL_DIRECT_MAX_NONZEROS:
-        backend = "amg"
-    factor = factorise(system, backend, T[:, inner].T @ elasticity.rigid_modes
-                       if backend == "amg" else None)
-    zeta[inner] = factor(rhs[inner] - K[inner][:, fixed] @ omega)
-    reaction = rhs[fixed] - K[fixed] @ zeta  # a(v, z) + pi v.n = j(v) at v = the node's normal
-    return DualSolution(elasticity=elasticity, z=elasticity.expand(T @ zeta), points=points,
+             else np.zeros(points.shape[1]))
+    z_free, reaction = held_normal(elasticity, columns, normal, omega,
+                                   dual_load(elasticity, quantity), backend)
+    return DualSolution(elasticity=elasticity, z=elasticity.expand(z_free), points=points,
                         normal_rows=normal_rows(elasticity, trace, nodes)[np.flatnonzero(active)],
                         reaction=reaction, elements=node_elements(trace, nodes)[active],
                         seconds=time.perf_counter() - start)
@@ -160,6 +145,30 @@ def node_elements(trace, nodes) -> np.ndarray:
     out = np.empty(nodes.weight.size, dtype=np.int64)
     out[nodes.facet_rows.ravel()] = np.repeat(trace.element, nodes.facet_rows.shape[1])
     return out
+
+
+def held_normal(elasticity: Elasticity, columns: np.ndarray, normal: np.ndarray,
+                omega: np.ndarray, load: np.ndarray, backend: str | None = None
+                ) -> tuple[np.ndarray, np.ndarray]:
+    """min 1/2 a(z, z) - (load, z) over the unknowns with z.n = omega at the nodes whose
+    unknowns are ``columns`` (d, m), normals ``normal``: z on the unknowns and the nodes'
+    reactions pi (a(v, z) + sum pi_i v.n_i = (load, v) for all v)."""
+    T = rotation(elasticity.ndofs, columns, normal)
+    K = (T.T @ elasticity.K_free @ T).tocsr()
+    rhs = T.T @ load
+    fixed = columns[0]
+    zeta = np.zeros(elasticity.ndofs)
+    zeta[fixed] = omega
+    free = np.ones(elasticity.ndofs, dtype=bool)
+    free[fixed] = False
+    inner = np.flatnonzero(free)
+    system = K[inner][:, inner]
+    if backend is None and system.nnz > DUAL_DIRECT_MAX_NONZEROS:
+        backend = "amg"
+    factor = factorise(system, backend, T[:, inner].T @ elasticity.rigid_modes
+                       if backend == "amg" else None)
+    zeta[inner] = factor(rhs[inner] - K[inner][:, fixed] @ omega)
+    return T @ zeta, rhs[fixed] - K[fixed] @ zeta
 
 
 def dual_load(elasticity: Elasticity, quantity) -> np.ndarray:

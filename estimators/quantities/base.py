@@ -45,6 +45,9 @@ class Quantity:
     kernel: Callable[[np.ndarray], np.ndarray] | None = None
     why_no_dual: str | None = None
     unit: str = ""
+    # a guaranteed interval from a guaranteed energy bound exists (the contact force:
+    # estimators.goals.force_interval)
+    energy_interval: bool = False
 
     def true_value(self, truth) -> float | None:
         """J of ``truth`` (``bench.truth``: the exact solution, else its reference)."""

@@ -25,4 +25,4 @@ def contact_force(scene) -> Quantity:
     return Quantity(name="contact-force", evaluate=lambda sol: weighted_pressure(sol, ones),
                     exact=exact_pressure_integral(scene, ones),
                     from_reference=lambda reference: float(reference.contact_force),
-                    weight=ones, unit="force")
+                    weight=ones, unit="force", energy_interval=True)

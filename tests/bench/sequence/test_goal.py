@@ -65,3 +65,14 @@ def test_a_goal_strategy_the_estimator_cannot_serve_is_skipped():
 def test_an_unknown_goal_is_refused_with_the_names():
     with pytest.raises(ValueError, match="goal='stress' is not one of contact-force"):
         LoopConfig(goal="stress")
+
+
+def test_a_guaranteed_energy_bound_gives_the_force_an_interval_that_holds():
+    config = LoopConfig(strategy="adaptive", goal="contact-force", max_dofs=800)
+    levels = [r.row for r in run_sequence(SCENE, "vi", "active-set", "equilibrated", config,
+                                          truth=ExactTruth(SCENE))]
+    assert all(r.qoi_guaranteed and r.qoi_interval_holds for r in levels)
+    assert all(r.qoi_lower <= r.qoi_true <= r.qoi_upper for r in levels)
+    plain = rows("adaptive", max_dofs=300)  # residual: no guaranteed bound, no interval
+    assert not any(r.qoi_guaranteed for r in plain) and all(math.isnan(r.qoi_lower)
+                                                             for r in plain)
