@@ -16,7 +16,7 @@ CAPTION = ("Quantity of interest: relative error |J(u) - J(u_h)| / |J(u)| (left)
            "effectivity of the dual-weighted estimate (right) against DOFs; solid: goal-driven "
            "(strategy goal), dashed: energy-driven (adaptive); the dotted lines mark the "
            f"target {TARGET:g} and the band 0.8-1.25 judged from {JUDGED_FROM} DOFs")
-TABLE_COLUMNS = ["scene", "goal", "formulation", "order", "strategy", "ndofs",
+TABLE_COLUMNS = ["scene", "scene_parameters", "goal", "formulation", "order", "strategy", "ndofs",
                  "qoi_relative_error", "dofs_to_target", "energy_dofs_to_target", "dofs_ratio",
                  "effectivity_min", "effectivity_max", "wrong_sign"]
 
