@@ -39,17 +39,22 @@ class GoalEstimate:
     guaranteed: bool = False
 
 
-def register_goal_estimator(name: str, description: str, applies=None):
+def register_goal_estimator(name: str, description: str, applies=None,
+                            families: tuple[str, ...] = ("tri", "tet", "quad")):
     """Register a goal estimator; ``applies(scene=..., family=..., order=..., quantity=...)``
     says why it does not run (a scene with friction is refused: its dual problem is not
-    built)."""
+    built); ``families``: the cell families (``formulations.cells``) it is verified on."""
     return GOAL_ESTIMATORS.register(name, description,
-                                    frictionless_only("goal estimator", name, applies))
+                                    frictionless_only("goal estimator", name, applies),
+                                    meta={"families": tuple(families)})
 
 
 def why_no_goal_estimate(name: str, scene, quantity, order: int, family=None) -> str | None:
     """Why goal estimator ``name`` does not estimate ``quantity`` on ``scene`` at ``order``
     on the cells of ``family`` (default: the scene's own mesh's), or None."""
     family = family_of(scene.mesh) if family is None else family
+    if family.name not in GOAL_ESTIMATORS.meta(name, "families", ()):
+        return (f"goal estimator {name!r} is not verified on {family.shape} "
+                "(docs/theory.md, 20.4)")
     return GOAL_ESTIMATORS.why_not(name, scene=scene, family=family, order=order,
                                    quantity=quantity)

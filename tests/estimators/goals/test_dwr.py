@@ -71,3 +71,13 @@ def test_a_quantity_without_a_dual_is_refused():
     with pytest.raises(ValueError, match="no dual problem"):
         estimate(SCENE, solution, quantity)
     assert np.isfinite(quantity.evaluate(solution))
+
+
+def test_hexahedra_are_refused_until_verified():
+    from formulations.cells import family_for
+
+    scene = get_scene("hertz-3d")
+    quantity = Q.get_quantity("contact-force", scene)
+    assert "not verified on hexahedra" in why_no_goal_estimate(
+        "dwr", scene, quantity, 1, family_for("quad", 3))
+    assert why_no_goal_estimate("dwr", scene, quantity, 1, family_for("tri", 3)) is None
