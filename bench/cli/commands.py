@@ -22,6 +22,7 @@ from bench.cli.guards import (
     check_output_folders,
     full_disk,
 )
+from bench.cli.history import history_command
 from bench.cli.listing import list_command
 from bench.cli.parser import build_parser, with_negative_values
 from bench.cli.progress import progress
@@ -224,7 +225,7 @@ COMMANDS = {"run": run_command, "compare": compare_command, "report": report_com
             "export": export_command,
             "verify": verify_command, "hard": hard_command, "scaling": scaling_command,
             "list": list_command, "study": study_command,
-            "diff": diff_command}
+            "diff": diff_command, "history": history_command}
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -214,6 +214,9 @@ def build_parser(defaults: dict | None = None) -> argparse.ArgumentParser:
     from bench.cli.diff import add_diff_parser
 
     add_diff_parser(sub)
+    from bench.cli.history import add_history_parser
+
+    add_history_parser(sub)
     listing = sub.add_parser(
         "list", help="list registered scenes, formulations, solvers, back-ends, estimators and "
         "hard cases, with where each came from",

@@ -135,7 +135,16 @@ def verify(out: str | Path = "results-verify", expected_path: str | Path = EXPEC
         table = run_hard()
         write_hard(table, out)
         verdicts += hard_verdicts(expected, table)
+    verdict_frame(verdicts).to_csv(Path(out) / "verdicts.csv", index=False)
     return verdicts, rates, closed_form
+
+
+def verdict_frame(verdicts: list[Verdict]) -> pd.DataFrame:
+    """The verdicts as a table (``verdicts.csv``: what ``bench history`` records)."""
+    return pd.DataFrame([{"gate": v.gate, "combination": v.combination, "value": v.value,
+                          "low": v.low, "high": v.high, "passed": v.passed}
+                         for v in verdicts], columns=["gate", "combination", "value", "low",
+                                                      "high", "passed"])
 
 
 def verdict_table(verdicts: list[Verdict]) -> str:
