@@ -11,12 +11,14 @@ from bench.cli.guards import InputError
 from bench.history import (
     HISTORY_FILE,
     SOURCES,
+    Figure,
     append_figures,
     figures_of,
     moves,
     read_history,
     write_page,
 )
+from bench.history.readme_source import headline, readme_commits
 
 
 def add_history_parser(sub) -> None:
@@ -24,11 +26,13 @@ def add_history_parser(sub) -> None:
         "history", help="record, check and render the suite's figures across commits",
         description="The figures of verify, scaling and the default comparison, one entry per "
         "commit in a CSV file kept in the repository (docs/history.md).")
-    history.add_argument("action", choices=["record", "check", "page"],
+    history.add_argument("action", choices=["record", "check", "page", "backfill"],
                          help="record: add the figures of the results folders given as "
                               "SOURCE=FOLDER; check: print every figure of the last commit "
                               "that moved beyond its noise band (exit 1 with --strict); "
-                              "page: write OUT/index.html")
+                              "page: write OUT/index.html; backfill: record the comparison's "
+                              "headline of the last --commits commits that changed README.md "
+                              "from their compare blocks")
     history.add_argument("folders", nargs="*", metavar="SOURCE=FOLDER",
                          help=f"(record) a source ({', '.join(SOURCES.names())}) and the "
                               "results folder of its command")
@@ -40,6 +44,8 @@ def add_history_parser(sub) -> None:
                          help="(page) the folder of the page (default: results-history)")
     history.add_argument("--strict", action="store_true",
                          help="(check) exit 1 when a figure moved")
+    history.add_argument("--commits", type=int, default=10,
+                         help="(backfill) how many commits (default: 10)")
 
 
 def head_commit() -> str:
@@ -79,6 +85,8 @@ def history_command(args) -> int:
         return check(args)
     if args.action == "check":
         return check(args)
+    if args.action == "backfill":
+        return backfill(args)
     page = write_page(read_history(args.file), args.out)
     print(f"wrote {page}")
     return 0
@@ -92,3 +100,15 @@ def check(args) -> int:
     print(f"{len(found)} figures against their previous entry; {len(moved)} moved beyond "
           "their noise band")
     return 1 if moved and getattr(args, "strict", False) else 0
+
+
+def backfill(args) -> int:
+    """The comparison's headline of earlier commits, from their README's compare block."""
+    figures = []
+    for commit, date, text in readme_commits(args.commits):
+        figures += [Figure(commit, date, "readme", name, value, kind, noise)
+                    for name, value, kind, noise in headline(text)]
+    frame = append_figures(figures, args.file)
+    print(f"recorded {len(figures)} figures of {frame['commit'].nunique()} commits in "
+          f"{args.file}")
+    return check(args)

@@ -91,3 +91,17 @@ def test_the_command_records_checks_and_refuses_bad_input(tmp_path, capsys):
     assert "SOURCE=FOLDER with SOURCE one of compare, scaling, verify" in (
         capsys.readouterr().err)
     assert main(["history", "check", "--file", history, "--strict"]) == 0
+
+
+def test_the_readme_source_reads_a_compare_block():
+    from bench.history.readme_source import headline
+
+    text = ("Last run: **1827 result rows**; 296 of 296 hard verdicts as expected; 572 s wall "
+            "time in all (references, run, timings, hard cases, report).\n\n"
+            "- hertz: use vi adaptive P3 steered by residual: 0.01 in 0.558 s (4002 DOFs), "
+            "0.001 in 1.92 s (12768 DOFs); stop on equilibrated-local (effectivity 1.04..1.12, "
+            "never below the error).\n")
+    figures = {name: value for name, value, _, _ in headline(text)}
+    assert figures == {"hertz to 0.01: seconds": 0.558, "hertz to 0.01: DOFs": 4002.0,
+                       "hertz to 0.001: seconds": 1.92, "hertz to 0.001: DOFs": 12768.0,
+                       "wall time": 572.0}
