@@ -106,7 +106,7 @@ def backfill(args) -> int:
     """The comparison's headline of earlier commits, from their README's compare block."""
     figures = []
     for commit, date, text in readme_commits(args.commits):
-        figures += [Figure(commit, date, "readme", name, value, kind, noise)
+        figures += [Figure(commit, date, "compare", name, value, kind, noise)
                     for name, value, kind, noise in headline(text)]
     frame = append_figures(figures, args.file)
     print(f"recorded {len(figures)} figures of {frame['commit'].nunique()} commits in "

@@ -2,7 +2,6 @@
 command's results folder into figures, ``store`` keeps them in ``history/figures.csv``,
 ``moves`` says which moved beyond their noise since the last entry, ``page`` renders them."""
 
-from bench.history import readme_source  # noqa: F401  (registers the readme source)
 from bench.history.moves import Move, moves
 from bench.history.page import write_page
 from bench.history.sources import SOURCES, figures_of, register_source

@@ -2,16 +2,14 @@
 commits"): the README's compare block (``bench/cli/compare_block.py`` writes it from a run)
 holds, per scene, the recommended combination's time and DOFs to each target and the run's
 wall time. Read from ``git show COMMIT:README.md``, it gives the history figures of commits
-whose results folders are gone, under the same names as the ``compare`` source."""
+whose results folders are gone, recorded as the ``compare`` source's (the same names), so
+that a new comparison's figures are judged against them."""
 
 from __future__ import annotations
 
 import math
 import re
 import subprocess
-from pathlib import Path
-
-from bench.history.sources import register_source
 
 ANSWER = re.compile(r"^- (?P<scene>[\w-]+): use .*?: (?P<reached>.*?); stop", re.M)
 REACHED = re.compile(r"(?P<target>[0-9.e-]+) in (?P<seconds>[0-9.e+-]+) s \((?P<dofs>\d+) DOFs\)")
@@ -30,15 +28,6 @@ def headline(text: str) -> list[tuple]:
     if wall:
         out.append(("wall time", float(wall["seconds"]), "time", math.nan))
     return out
-
-
-@register_source("readme", "the comparison's headline from a README's compare block (a "
-                           "folder holding README.md)")
-def readme_figures(folder: Path) -> list[tuple]:
-    path = folder / "README.md"
-    if not path.exists():
-        raise ValueError(f"{str(folder)!r} has no README.md")
-    return headline(path.read_text())
 
 
 def readme_commits(count: int, path: str = "README.md") -> list[tuple[str, str, str]]:

@@ -88,7 +88,7 @@ def test_the_command_records_checks_and_refuses_bad_input(tmp_path, capsys):
                  "--commit", "abc"]) == 0
     assert "recorded 2 figures of abc" in capsys.readouterr().out
     assert main(["history", "record", f"nothing={folder}", "--file", history]) == 2
-    assert "SOURCE=FOLDER with SOURCE one of compare, readme, scaling, verify" in (
+    assert "SOURCE=FOLDER with SOURCE one of compare, scaling, verify" in (
         capsys.readouterr().err)
     assert main(["history", "check", "--file", history, "--strict"]) == 0
 
