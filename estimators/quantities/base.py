@@ -140,3 +140,17 @@ def coordinate_rule(scene):
     box = contact_box(scene)
     s, w = box_rule(box, PANELS >> 2 * (len(box) - 1))
     return (s.reshape(-1) if len(box) == 1 else s), w
+
+
+def pressure_quantity(name: str, scene, omega, unit: str = "pressure") -> Quantity:
+    """J = (lambda, omega) with omega a function of the contact coordinate s ((...) along a
+    line, (k, ...) on a surface): its value on a solution, the exact and the reference's."""
+    def weight(x):  # omega at points x of Gamma_C
+        return omega(scene.contact_coordinate(x)).reshape(np.shape(x)[1:])
+
+    def along(s):  # omega at the coordinate rule's points
+        return omega(s).reshape(np.shape(s)[-1:])
+
+    return Quantity(name=name, evaluate=lambda sol: weighted_pressure(sol, weight),
+                    exact=exact_pressure_integral(scene, along), weight=weight, unit=unit,
+                    from_reference=lambda ref: reference_pressure_integral(ref, scene, along))

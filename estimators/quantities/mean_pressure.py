@@ -11,10 +11,8 @@ import numpy as np
 from estimators.quantities.base import (
     Quantity,
     contact_box,
-    exact_pressure_integral,
-    reference_pressure_integral,
+    pressure_quantity,
     register_quantity,
-    weighted_pressure,
 )
 
 PLATEAU, RAMP = 1 / 16, 1 / 32  # half-width of the plateau, width of the ramps (of the extent)
@@ -38,14 +36,4 @@ def trapezoid(box: np.ndarray):
                                     "(a continuous trapezoid weight)")
 def mean_pressure(scene) -> Quantity:
     omega, area = trapezoid(contact_box(scene))
-
-    def weight(x):  # omega / (1, omega) at points x of Gamma_C
-        return omega(scene.contact_coordinate(x)).reshape(np.shape(x)[1:]) / area
-
-    def along(s):
-        return omega(s).reshape(np.shape(s)[-1:]) / area
-
-    exact = exact_pressure_integral(scene, along)
-    return Quantity(name="mean-pressure", evaluate=lambda sol: weighted_pressure(sol, weight),
-                    exact=exact, weight=weight, unit="pressure",
-                    from_reference=lambda ref: reference_pressure_integral(ref, scene, along))
+    return pressure_quantity("mean-pressure", scene, lambda s: omega(s) / area)

@@ -11,10 +11,8 @@ import numpy as np
 from estimators.quantities.base import (
     Quantity,
     contact_box,
-    exact_pressure_integral,
-    reference_pressure_integral,
+    pressure_quantity,
     register_quantity,
-    weighted_pressure,
 )
 
 RADIUS = 1 / 64  # of Gamma_C's extent
@@ -45,15 +43,4 @@ def predicts_peak(scene=None, **_) -> str | None:
                                     "mean), where the closed forms have their peak",
                    applies=predicts_peak)
 def peak_pressure(scene) -> Quantity:
-    omega = bump(contact_box(scene))
-
-    def weight(x):
-        return omega(scene.contact_coordinate(x)).reshape(np.shape(x)[1:])
-
-    def along(s):
-        return omega(s).reshape(np.shape(s)[-1:])
-
-    return Quantity(name="peak-pressure", evaluate=lambda sol: weighted_pressure(sol, weight),
-                    exact=exact_pressure_integral(scene, along), weight=weight,
-                    unit="pressure",
-                    from_reference=lambda ref: reference_pressure_integral(ref, scene, along))
+    return pressure_quantity("peak-pressure", scene, bump(contact_box(scene)))
