@@ -24,7 +24,9 @@ def test_the_section_shows_the_figure_and_the_table(goal_report):
     assert "figures/goal-free-boundary-contact-force.png" in text
     assert (goal_report / "figures" / "goal-free-boundary-contact-force.png").stat().st_size > 0
     section = text.split("### Quantities of interest")[1]
-    assert "dofs_to_target" in section and "| free-boundary | contact-force | mixed" in section
+    assert "dofs_to_target" in section
+    assert any(line.startswith("| free-boundary |") and "| contact-force | mixed " in line
+               for line in section.splitlines())
     assert 'id="goals"' in (goal_report / "index.html").read_text()
 
 
