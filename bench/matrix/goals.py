@@ -98,11 +98,13 @@ def sequence_row(frame: pd.DataFrame) -> dict:
     last = frame.iloc[-1]
     return {"levels": len(frame), "ndofs": int(last["ndofs"]), "qoi": float(last["qoi"]),
             "qoi_relative_error": float(last["qoi_relative_error"]),
-            "dofs_to_target": dofs_to(frame), "effectivity_min": low,
-            "effectivity_max": high, "judged_levels": judged, "wrong_sign": wrong,
-            "crossings_missed": missed,
-            "effectivity_min_from_2000": later[0], "effectivity_max_from_2000": later[1],
-            "wrong_sign_from_2000": later[3], "crossings_missed_from_2000": later[4],
+            "dofs_to_target": dofs_to(frame), "qoi_effectivity_min": low,
+            "qoi_effectivity_max": high, "qoi_judged_levels": judged, "qoi_wrong_sign": wrong,
+            "qoi_crossings_missed": missed,
+            "qoi_effectivity_min_from_2000": later[0],
+            "qoi_effectivity_max_from_2000": later[1],
+            "qoi_wrong_sign_from_2000": later[3],
+            "qoi_crossings_missed_from_2000": later[4],
             **interval_columns(frame), "t_goal": float(frame["t_goal"].sum())}
 
 

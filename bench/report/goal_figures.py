@@ -18,7 +18,7 @@ CAPTION = ("Quantity of interest: relative error |J(u) - J(u_h)| / |J(u)| (left)
            f"target {TARGET:g} and the band 0.8-1.25 judged from {JUDGED_FROM} DOFs")
 TABLE_COLUMNS = ["scene", "scene_parameters", "goal", "formulation", "order", "strategy", "ndofs",
                  "qoi_relative_error", "dofs_to_target", "energy_dofs_to_target", "dofs_ratio",
-                 "effectivity_min", "effectivity_max", "wrong_sign"]
+                 "qoi_effectivity_min", "qoi_effectivity_max", "qoi_wrong_sign"]
 
 
 def goal_figure(group: pd.DataFrame, title: str):

@@ -38,9 +38,9 @@ def test_the_table_pairs_goal_and_energy_driven_sequences():
     assert (energy["dofs_to_target"], goal["dofs_to_target"]) == (8000, 1000)
     assert goal["dofs_ratio"] == pytest.approx(8.0)
     # from 1000 DOFs: -0.9 .. 1.1 and one wrong sign; from 2000: 0.95 .. 1.1
-    assert (goal["effectivity_min"], goal["effectivity_max"], goal["wrong_sign"]) == (
-        -0.9, 1.1, 1)
-    assert goal["effectivity_min_from_2000"] == 0.95 and goal["wrong_sign_from_2000"] == 0
+    assert (goal["qoi_effectivity_min"], goal["qoi_effectivity_max"],
+            goal["qoi_wrong_sign"]) == (-0.9, 1.1, 1)
+    assert (goal["qoi_effectivity_min_from_2000"], goal["qoi_wrong_sign_from_2000"]) == (0.95, 0)
     assert math.isnan(energy["dofs_ratio"])
 
 
@@ -49,9 +49,9 @@ def test_a_level_where_the_error_crossed_zero_is_judged_by_its_miss():
     row = goal_table(pd.DataFrame(rows)).iloc[0]
     # 1e-6 between 1e-3 and 5e-4: a crossing; its estimate 4e-5 misses by 3.9e-5, less than
     # 0.25 x 5e-4; left out of the range
-    assert (row["effectivity_max"], row["crossings_missed"]) == (1.0, 0)
+    assert (row["qoi_effectivity_max"], row["qoi_crossings_missed"]) == (1.0, 0)
     rows[2]["qoi_estimate"] = 2e-4  # misses by 2e-4 > 1.25e-4
-    assert goal_table(pd.DataFrame(rows)).iloc[0]["crossings_missed"] == 1
+    assert goal_table(pd.DataFrame(rows)).iloc[0]["qoi_crossings_missed"] == 1
 
 
 def test_rows_without_a_goal_give_an_empty_table():
