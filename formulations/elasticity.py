@@ -101,7 +101,11 @@ class Elasticity:
     @property
     def F_free(self) -> np.ndarray:
         """F on the unknowns: P_f' F with hanging nodes."""
-        return self.F[self.free] if self.constraint is None else self._free_columns.T @ self.F
+        return self.on_unknowns(self.F)
+
+    def on_unknowns(self, load: np.ndarray) -> np.ndarray:
+        """A load over the basis's DOFs (l(phi_i) for every i) on the unknowns: P_f' l."""
+        return load[self.free] if self.constraint is None else self._free_columns.T @ load
 
     def restrict(self, B: sparse.spmatrix) -> sparse.csr_matrix:
         """Rows over the basis's DOFs (contact constraints, traces) as rows over the

@@ -28,9 +28,9 @@ def source_figure(frame: pd.DataFrame, commits: list[str], moved: set[str]) -> s
     for name, group in frame.groupby("name"):
         group = group[group["commit"].isin(position)].sort_values(
             "commit", key=lambda c: c.map(position))
-        last = group["value"].iloc[-1]
-        if len(group) < 1 or not last:
+        if group.empty or not group["value"].iloc[-1]:  # nothing shown, or no scale
             continue
+        last = group["value"].iloc[-1]
         axes.plot(group["commit"].map(position), group["value"] / last,
                   color="tab:red" if name in moved else "0.6",
                   linewidth=1.4 if name in moved else 0.6, zorder=3 if name in moved else 2)

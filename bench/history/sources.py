@@ -41,6 +41,15 @@ def figures_of(source: str, folder: str | Path, commit: str, recorded: str) -> l
             for name, value, kind, noise in read(folder)]
 
 
+def results_file(folder: Path, name: str, command: str) -> Path:
+    """``folder/name``, or a one-line refusal naming the command that writes it."""
+    path = folder / name
+    if not path.exists():
+        raise ValueError(f"{str(folder)!r} has no {name}: give a folder of "
+                         f"python -m bench {command} --out")
+    return path
+
+
 def gate_kind(gate: str, quantity: str) -> str:
     """The kind of a gate's figure from its quantity's name (a count when nothing says)."""
     text = f"{quantity} {gate}".lower()
@@ -49,11 +58,7 @@ def gate_kind(gate: str, quantity: str) -> str:
 
 @register_source("verify", "every gate's value per combination (verdicts.csv of verify --out)")
 def verify_figures(folder: Path) -> list[tuple]:
-    path = folder / "verdicts.csv"
-    if not path.exists():
-        raise ValueError(f"{str(folder)!r} has no verdicts.csv: give a folder of "
-                         "python -m bench verify --out")
-    frame = pd.read_csv(path)
+    frame = pd.read_csv(results_file(folder, "verdicts.csv", "verify"))
     frame = frame[pd.to_numeric(frame["value"], errors="coerce").notna()]
     return [(f"{row.gate} [{row.combination}]", float(row.value),
              gate_kind(row.gate, ""), math.nan) for row in frame.itertuples()]
@@ -92,11 +97,7 @@ SCALING_FIGURES = (("fast_over_linear", "ratio"), ("t_fast_solve", "time"),
 @register_source("scaling", "per size: the fast contact solve over the linear solve, the "
                             "solve's and the assembly's time, the peak memory")
 def scaling_figures(folder: Path) -> list[tuple]:
-    path = folder / "scaling.csv"
-    if not path.exists():
-        raise ValueError(f"{str(folder)!r} has no scaling.csv: give a folder of "
-                         "python -m bench scaling --out")
-    frame = pd.read_csv(path)
+    frame = pd.read_csv(results_file(folder, "scaling.csv", "scaling"))
     out = []
     for row in frame.to_dict("records"):
         size = (f"{row.get('dim', 2)}D P{row.get('order', 1)} {row.get('backend', '')} "

@@ -20,6 +20,7 @@ from estimators.goals.base import GOAL_ESTIMATORS
 from estimators.goals.force_interval import force_interval, why_no_interval
 from estimators.quantities import DEFAULT_QUANTITY, get_quantity
 from estimators.quantities.base import QUANTITIES
+from formulations.cells import family_of
 
 GOAL_STRATEGY = "goal"
 
@@ -88,8 +89,6 @@ def goal_level(scene, solution, config, truth, backend: str | None = None,
 
 def goal_estimate(scene, solution, quantity, config, backend):
     """(GoalEstimate, "") or (None, why there is none)."""
-    from formulations.cells import family_of
-
     name = DEFAULT_GOAL_ESTIMATOR
     why = why_no_goal_estimate(name, scene, quantity, config.order,
                                family_of(solution.elasticity.mesh))

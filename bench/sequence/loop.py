@@ -10,18 +10,15 @@ from dataclasses import dataclass, field, fields
 
 from skfem import MeshTri
 
-from bench.sequence.columns import (
-    level_columns,
-    solved_columns,
-    solver_columns,
-)
+from bench.sequence.columns import level_columns, solver_columns
 from bench.sequence.components import (
     Previous,
     check_stopping_cell,
     check_stopping_settings,
     level_stopping,
 )
-from bench.sequence.goal import GOAL_STRATEGY, goal_level, marking_indicators
+from bench.sequence.goal import GOAL_STRATEGY
+from bench.sequence.judged import judge_level
 from bench.sequence.marking import MARKINGS, check_marking, mark
 from bench.sequence.memory import (
     MemoryRoute,
@@ -182,14 +179,6 @@ def refine(mesh: MeshTri, sol, est, config: LoopConfig) -> MeshTri:
     return refinement(mesh, sol, est, config).refined
 
 
-def target_reason(config: LoopConfig, est) -> str | None:
-    """Why the sequence ends at this level: its guaranteed bound reached
-    ``config.target_error``; None if it did not."""
-    if config.target_error is None or not est.guaranteed or est.eta > config.target_error:
-        return None
-    return f"target reached: guaranteed eta={est.eta:.4g} <= {config.target_error:g}"
-
-
 def level_options(level: int, disc, solver: str, config: LoopConfig, route: MemoryRoute,
                   previous) -> tuple[dict, MemoryRoute]:
     """The solve's options on the level's ``route``, moved to an iterative back-end if the
@@ -229,28 +218,6 @@ def refused_row(ident: dict, level: int, ndofs: int, mesh, reason: str) -> Level
     """The failed row of a level that is not built."""
     return LevelResult(ResultRow(**ident, level=level, ndofs=ndofs, n_elements=mesh.t.shape[1],
                                  status=STATUS_FAILED, reason=reason), None, None)
-
-
-@dataclass(frozen=True, eq=False)
-class JudgedLevel:
-    """A solved level's columns beyond its basic numbers, what it is marked by (None: the
-    estimate's indicators), the note on that and why the sequence ends here (or None)."""
-
-    numbers: dict
-    indicators: object
-    note: str
-    reached: str | None
-
-
-def judge_level(scene: Scene, disc, sol, est, config: LoopConfig, options: dict, truth,
-                crosscheck: bool) -> JudgedLevel:
-    """The solved level's columns (``solved_columns``, the goal's), its marking indicators
-    and the target reason."""
-    goal = goal_level(scene, sol, config, truth, options.get("backend"), est)
-    numbers = dict(solved_columns(scene, disc, sol, est, config, options, truth, crosscheck),
-                   **goal.columns)
-    indicators, note = marking_indicators(config, est, goal)
-    return JudgedLevel(numbers, indicators, note, target_reason(config, est))
 
 
 def run_sequence(scene: Scene, formulation: str, solver: str, estimator: str,

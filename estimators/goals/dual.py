@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import sparse
 
+from formulations.cells import family_of
 from formulations.cells.evaluation import drop_roundoff, evaluate_at
 from formulations.contact.boundary import tangent_frame
 from formulations.elasticity import Elasticity, assemble_elasticity
@@ -172,16 +173,9 @@ def held_normal(elasticity: Elasticity, columns: np.ndarray, normal: np.ndarray,
 
 
 def dual_load(elasticity: Elasticity, quantity) -> np.ndarray:
-    """j(phi_i) over the unknowns: the quantity's kernel as a body force (0 without one)."""
+    """j(phi_i) over the unknowns: the quantity's kernel as a body force by the cell family's
+    load rule (0 without one)."""
     if quantity.kernel is None:
         return np.zeros(elasticity.ndofs)
-    family_load = elasticity_load(elasticity, quantity.kernel)
-    return (family_load[elasticity.free] if elasticity.constraint is None
-            else elasticity.constraint[:, elasticity.free].T @ family_load)
-
-
-def elasticity_load(elasticity: Elasticity, kernel) -> np.ndarray:
-    """(kernel, phi_i) over every DOF of the basis, by the cell family's body-load rule."""
-    from formulations.cells import family_of
-
-    return family_of(elasticity.mesh).body_load(kernel, elasticity.basis, elasticity.order)
+    return elasticity.on_unknowns(family_of(elasticity.mesh).body_load(
+        quantity.kernel, elasticity.basis, elasticity.order))

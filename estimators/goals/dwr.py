@@ -17,6 +17,7 @@ import numpy as np
 
 from estimators.goals.base import GoalEstimate, register_goal_estimator
 from estimators.goals.dual import DualSolution, normal_rows, solve_dual
+from estimators.quantities.base import weighted_pressure
 from formulations.cells.evaluation import normal_trace_matrix
 from formulations.cells.order_interpolation import interpolation_matrix
 
@@ -58,8 +59,6 @@ def nodal_value_gap(solution, quantity) -> float:
     if reactions is None or quantity.weight is None:
         return 0.0
     nodes = solution.trace.nodes(solution.elasticity.order)
-    from estimators.quantities.base import weighted_pressure
-
     return float(reactions @ quantity.weight(nodes.points)
                  - weighted_pressure(solution, quantity.weight))
 
